@@ -1,0 +1,50 @@
+# cerebx — `make run` and `make test` work on a fresh machine: they create .venv and install first.
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed-stamp
+export NUMBA_CACHE_DIR ?= $(CURDIR)/.cache/numba
+export CEREBX_CACHE ?= $(CURDIR)/.cache/cerebx
+
+# The default experiment of `make run`; override e.g. `make run RUN_ARGS="+task=eight delay=gamma45"`.
+RUN_ARGS ?= +experiment=default
+BENCH_ARGS ?=
+
+.PHONY: help install run test test-full bench report lint format clean
+
+help: ## list the targets
+	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet -e ".[test]"
+	touch $(STAMP)
+
+install: $(STAMP) ## create .venv and install cerebx with its test tools
+
+run: $(STAMP) ## run the default experiment (RUN_ARGS=... to choose another)
+	$(BIN)/cerebx run $(RUN_ARGS)
+
+test: $(STAMP) ## the fast test suite (a few minutes)
+	$(BIN)/pytest -m "not slow"
+
+test-full: $(STAMP) ## every test, including the slow ones
+	$(BIN)/pytest
+
+bench: $(STAMP) ## speed of plant, network and closed loop, as JSON
+	$(BIN)/cerebx bench $(BENCH_ARGS)
+
+report: $(STAMP) ## build reports/ from the runs in runs/
+	$(BIN)/cerebx report
+
+lint: $(STAMP) ## ruff lint
+	$(BIN)/ruff check src tests
+
+format: $(STAMP) ## ruff format
+	$(BIN)/ruff format src tests
+
+clean: ## remove caches (keeps .venv and runs/)
+	rm -rf .cache .pytest_cache .ruff_cache build dist src/*.egg-info
+	find . -name __pycache__ -type d -prune -not -path './.venv/*' -exec rm -rf {} +

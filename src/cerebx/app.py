@@ -1,0 +1,37 @@
+"""The Hydra application behind ``cerebx run``: output folders, multirun, launchers, --cfg."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import hydra
+from hydra.core.hydra_config import HydraConfig
+from omegaconf import DictConfig
+
+from cerebx.config import to_plain
+from cerebx.errors import ConfigError
+from cerebx.schema.experiment import validate
+
+
+@hydra.main(config_path="conf", config_name="config", version_base="1.3")
+def run_app(cfg: DictConfig) -> float | None:
+    from cerebx.loop.runner import run_experiment
+    from cerebx.report.console import print_summary
+
+    hc = HydraConfig.get()
+    run_dir = Path(hc.runtime.output_dir)
+    try:
+        plain = to_plain(cfg)
+        exp = validate(plain)
+    except ConfigError as err:
+        for line in err.problems:
+            print(line, file=sys.stderr)
+        raise SystemExit(2) from None
+    summary = run_experiment(exp, run_dir, plain, overrides=list(hc.overrides.task))
+    print_summary(summary, run_dir)
+    if summary["status"] == "failed":
+        raise SystemExit(1)
+    if summary["status"] == "interrupted":
+        raise SystemExit(130)
+    return summary["final_mae"]

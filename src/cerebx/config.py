@@ -1,0 +1,115 @@
+"""Hydra composes, Pydantic validates: compose a config from overrides without running anything,
+expand sweeps, and turn Hydra's composition errors into one ``path: message`` line each."""
+
+from __future__ import annotations
+
+import itertools
+import re
+from typing import Any
+
+from omegaconf import DictConfig, OmegaConf
+
+from cerebx.errors import ConfigError
+from cerebx.schema.experiment import validate
+
+MAX_SWEEP_CHECK = 2000
+
+
+def to_plain(cfg: DictConfig) -> dict[str, Any]:
+    """The composed config as plain data (interpolations resolved, Hydra's own node dropped)."""
+    from omegaconf.errors import OmegaConfBaseException
+
+    try:
+        data = OmegaConf.to_container(cfg, resolve=True, throw_on_missing=True)
+    except OmegaConfBaseException as err:
+        key = getattr(err, "full_key", None) or "config"
+        raise ConfigError(f"{key}: {str(err).splitlines()[0]}") from None
+    assert isinstance(data, dict)
+    data.pop("hydra", None)
+    return data
+
+
+def _hydra_lines(err: Exception) -> list[str]:
+    text = str(err)
+    m = re.search(r"Could not find '([^']+)/([^']+)'", text)
+    if m:
+        group, option = m.group(1).split("/")[-1], m.group(2)
+        avail = re.findall(r"^\t(\S+)$", text, flags=re.M)
+        tail = f" (available: {', '.join(avail)})" if avail else ""
+        return [f"{group}: unknown option '{option}'{tail}"]
+    m = re.search(r"Could not override '([^']+)'", text)
+    if m:
+        key = m.group(1)
+        if "." in key:
+            return [f"{key}: not in the composed config (schema defaults are not); set it with +{key}=VALUE"]
+        return [f"{key}: '{key}' has no default to override; add it with +{key}=NAME"]
+    m = re.search(r"Could not append to config. An item is already at '([^']+)'", text)
+    if m:
+        return [f"{m.group(1)}: already set; drop the leading '+' to override it"]
+    m = re.search(r"Key '([^']+)' is not in struct", text)
+    if m:
+        return [f"{m.group(1)}: unknown key (add it with +{m.group(1)}=... only if the schema has it)"]
+    first = next((ln.strip() for ln in text.splitlines() if ln.strip()), type(err).__name__)
+    return [f"overrides: {first}"]
+
+
+def compose(overrides: list[str]) -> DictConfig:
+    """Compose ``conf/config.yaml`` with command-line style overrides (no output folders)."""
+    from hydra import compose as hydra_compose
+    from hydra import initialize_config_module
+    from hydra.core.global_hydra import GlobalHydra
+    from hydra.errors import HydraException
+    from omegaconf.errors import OmegaConfBaseException
+
+    GlobalHydra.instance().clear()
+    try:
+        with initialize_config_module(config_module="cerebx.conf", version_base="1.3"):
+            return hydra_compose(config_name="config", overrides=[o for o in overrides if not _is_hydra(o)])
+    except (HydraException, OmegaConfBaseException, ValueError) as err:
+        raise ConfigError(_hydra_lines(err)) from None
+
+
+def _is_hydra(override: str) -> bool:
+    key = override.lstrip("+~").split("=", 1)[0]
+    return key == "hydra" or key.startswith(("hydra.", "hydra/"))
+
+
+def load(overrides: list[str]) -> tuple[Any, dict[str, Any]]:
+    """Compose and validate; returns (validated experiment, plain resolved dict)."""
+    plain = to_plain(compose(overrides))
+    return validate(plain), plain
+
+
+def expand_sweep(overrides: list[str]) -> list[list[str]]:
+    """All override combinations of a ``-m`` sweep (``a=1,2 b=x,y`` -> four lists)."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+    from hydra.errors import HydraException
+
+    try:
+        parsed = OverridesParser.create().parse_overrides([o for o in overrides if not _is_hydra(o)])
+    except HydraException as err:
+        raise ConfigError(_hydra_lines(err)) from None
+    choices = []
+    for o in parsed:
+        if o.is_sweep_override():
+            key = o.get_key_element()
+            choices.append([f"{key}={v}" for v in o.sweep_string_iterator()])
+        else:
+            choices.append([o.input_line])
+    combos = itertools.islice(itertools.product(*choices), MAX_SWEEP_CHECK)
+    return [list(c) for c in combos]
+
+
+def check(overrides: list[str], multirun: bool = False) -> list[str]:
+    """Every problem of every job the command would run, one line each (empty when all is well)."""
+    jobs = expand_sweep(overrides) if multirun else [overrides]
+    seen: list[str] = []
+    for job in jobs:
+        try:
+            load(job)
+        except ConfigError as err:
+            prefix = f"[{' '.join(job)}] " if multirun and len(jobs) > 1 else ""
+            for line in err.problems:
+                if prefix + line not in seen:
+                    seen.append(prefix + line)
+    return seen

@@ -1,0 +1,1 @@
+"""Controllers: map (desired state, delayed sensor message) to stamped torque commands."""

@@ -1,0 +1,78 @@
+"""The controller contract and the small per-step records that flow through the loop."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from cerebx.recording.recorder import Recorder
+
+
+@dataclass(frozen=True)
+class SensorMsg:
+    """Robot-to-controller message: joint state measured at ``stamp_s``."""
+
+    stamp_s: float
+    q: np.ndarray
+    qd: np.ndarray
+
+
+@dataclass(frozen=True)
+class TorqueMsg:
+    """Controller-to-robot message: torque meant to be applied at ``stamp_s``."""
+
+    stamp_s: float
+    tau: np.ndarray
+
+
+@dataclass(frozen=True)
+class ControlInput:
+    """What a controller sees at one control step.
+
+    ``t_s`` is the controller's current time; ``q_des``/``qd_des`` the desired state at ``t_s``;
+    ``sensor`` the newest sensor message that has arrived through the R2C channel (None before
+    the first one arrives); ``ref_at`` gives the desired state at any earlier tick so a controller
+    can pair a delayed measurement with the desired sample of its own time stamp.
+    """
+
+    tick: int
+    t_s: float
+    q_des: np.ndarray
+    qd_des: np.ndarray
+    sensor: SensorMsg | None
+
+
+class Controller(ABC):
+    """Produces torque commands. Stateful controllers also save and load their learned state."""
+
+    n_joints: int
+
+    @abstractmethod
+    def reset(self, rng: np.random.Generator) -> None:
+        """Prepare for a run (called once, before the first step)."""
+
+    @abstractmethod
+    def step(self, inp: ControlInput) -> TorqueMsg:
+        """One 2 ms control step."""
+
+    def end_trial(self, trial: int) -> dict[str, float]:
+        """Called after each trial; may return scalars to record (e.g. weight summaries)."""
+        return {}
+
+    def attach_recorder(self, recorder: Recorder) -> None:
+        """Register extra MCAP channels (spikes, weights) before the run starts."""
+
+    def save_state(self, path: Path) -> None:
+        """Write the learned state; stateless controllers write nothing."""
+
+    def load_state(self, path: Path) -> None:
+        """Restore a state written by :meth:`save_state` (clear error on mismatch)."""
+
+    def describe(self) -> dict[str, Any]:
+        """Static facts for the run summary (sizes, gains)."""
+        return {}

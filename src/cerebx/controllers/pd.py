@@ -1,0 +1,30 @@
+"""PD torque control with saturation: tau = kp (q_d - q) + kd (qd_d - qd), |tau| <= tau_max."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
+from cerebx.schema.controller import PDController
+
+
+class PD(Controller):
+    def __init__(self, cfg: PDController, ctx=None):
+        self.cfg = cfg
+        self.kp, self.kd = np.asarray(cfg.kp, float), np.asarray(cfg.kd, float)
+        self.tau_max = np.asarray(cfg.tau_max_Nm, float)
+        self.n_joints = len(self.kp)
+        self._zero = np.zeros(self.n_joints)
+
+    def reset(self, rng: np.random.Generator) -> None:
+        pass
+
+    def step(self, inp: ControlInput) -> TorqueMsg:
+        s = inp.sensor
+        if s is None:
+            return TorqueMsg(inp.t_s, self._zero)
+        tau = self.kp * (inp.q_des - s.q) + self.kd * (inp.qd_des - s.qd)
+        return TorqueMsg(inp.t_s, np.clip(tau, -self.tau_max, self.tau_max))
+
+    def describe(self) -> dict:
+        return {"kp": list(self.cfg.kp), "kd": list(self.cfg.kd), "tau_max_Nm": list(self.cfg.tau_max_Nm)}

@@ -1,0 +1,1 @@
+"""The closed loop: clock, phases, delay channels, plant-side torque filter and supervisor."""

@@ -1,0 +1,144 @@
+"""Delay models and the timestamped channels that carry messages between robot and controller.
+
+A message sent at tick k with sampled delay d is released at the first tick whose time is at
+least stamp + d; a later message is never released before an earlier one (facts §7).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+
+from cerebx.errors import CerebxError
+from cerebx.schema import delay as schema
+
+STEP_MS = 2.0
+
+
+class DelaySampler(Protocol):
+    def next_ms(self) -> float:
+        """The delay (ms) for the next message on this path."""
+
+
+@dataclass
+class Constant:
+    ms: float
+
+    def next_ms(self) -> float:
+        return self.ms
+
+
+class Gamma:
+    """Gamma(shape, scale) + offset per message, with the original's monotonic limiter."""
+
+    def __init__(self, p: schema.GammaParams, monotonic: bool, rng: np.random.Generator):
+        self.p, self.monotonic, self.rng = p, monotonic, rng
+        self.prev: float | None = None
+
+    def next_ms(self) -> float:
+        g = self.rng.gamma(self.p.shape, self.p.scale_ms)
+        if self.p.inverted:
+            g = 2 * self.p.shape * self.p.scale_ms - g
+        d = max(g + self.p.offset_ms, 0.0)
+        if self.monotonic and self.prev is not None and d < self.prev:
+            d = max(self.prev - STEP_MS, 0.0)
+        self.prev = d
+        return d
+
+
+class Trace:
+    """Replays a recorded delay series (ms per message), looping at the end if asked."""
+
+    def __init__(self, values: np.ndarray, loop: bool):
+        self.values, self.loop, self.i = values, loop, 0
+
+    def next_ms(self) -> float:
+        if self.i >= len(self.values):
+            if not self.loop:
+                return float(self.values[-1])
+            self.i = 0
+        v = float(self.values[self.i])
+        self.i += 1
+        return v
+
+
+class Percentiles:
+    """Inverse-CDF sampling of a distribution given by (percentile, ms) points."""
+
+    def __init__(self, points: list[tuple[float, float]], rng: np.random.Generator):
+        self.p = np.array([p for p, _ in points]) / 100.0
+        self.v = np.array([v for _, v in points])
+        self.rng = rng
+
+    def next_ms(self) -> float:
+        return float(np.interp(self.rng.random(), self.p, self.v))
+
+
+@dataclass
+class DelayModel:
+    """One sampler per direction."""
+
+    r2c: Any
+    c2r: Any
+
+
+def load_trace(path: str) -> np.ndarray:
+    try:
+        data = np.loadtxt(Path(path), delimiter=None if not str(path).endswith(".csv") else ",", ndmin=2)
+    except (OSError, ValueError) as err:
+        raise CerebxError(f"delay.path: cannot read delay trace {path!r} ({err})") from None
+    if data.size == 0 or not np.all(np.isfinite(data)) or np.any(data < 0):
+        raise CerebxError(f"delay.path: {path!r} must hold finite, non-negative delays in ms")
+    return data
+
+
+def build_delay(cfg: Any, ctx: Any) -> DelayModel:
+    rng_r2c, rng_c2r = ctx.rng("delay.r2c"), ctx.rng("delay.c2r")
+    if isinstance(cfg, schema.NoDelay):
+        return DelayModel(Constant(0.0), Constant(0.0))
+    if isinstance(cfg, schema.ConstantDelay):
+        r2c, c2r = cfg.per_direction()
+        return DelayModel(Constant(r2c), Constant(c2r))
+    if isinstance(cfg, schema.GammaDelay):
+        return DelayModel(Gamma(cfg.r2c, cfg.monotonic, rng_r2c), Gamma(cfg.c2r, cfg.monotonic, rng_c2r))
+    if isinstance(cfg, schema.TraceDelay):
+        data = load_trace(cfg.path)
+        r2c = data[:, 0]
+        c2r = data[:, 1] if data.shape[1] > 1 else data[:, 0]
+        return DelayModel(Trace(r2c, cfg.loop), Trace(c2r, cfg.loop))
+    if isinstance(cfg, schema.PercentileDelay):
+        return DelayModel(Percentiles(cfg.r2c_percentiles, rng_r2c), Percentiles(cfg.c2r_percentiles, rng_c2r))
+    raise TypeError(f"no delay builder for {type(cfg).__name__}")
+
+
+class DelayChannel:
+    """FIFO of in-flight messages on the tick grid; releases in order, never overtaking."""
+
+    def __init__(self, sampler: DelaySampler, step_ms: float = STEP_MS):
+        self.sampler = sampler
+        self.step_ms = step_ms
+        self._queue: deque[tuple[int, Any]] = deque()
+        self._last_release = -1
+        self.last_delay_ms = 0.0
+
+    def send(self, msg: Any, tick: int) -> None:
+        d = self.sampler.next_ms()
+        self.last_delay_ms = d
+        release = tick + int(np.ceil(d / self.step_ms - 1e-9))
+        release = max(release, self._last_release)
+        self._last_release = release
+        self._queue.append((release, msg))
+
+    def receive(self, tick: int) -> list[Any]:
+        out = []
+        q = self._queue
+        while q and q[0][0] <= tick:
+            out.append(q.popleft()[1])
+        return out
+
+    def __len__(self) -> int:
+        return len(self._queue)

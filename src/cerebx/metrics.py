@@ -1,0 +1,79 @@
+"""Per-trial metrics (SPEC §6): position MAE per joint and mean (Eq. 2.21-2.22 with |.|),
+velocity MAE, torque variability (Eq. 3.14-3.15, absolute step differences, N·m/ms),
+end-effector Cartesian error; and learning-curve summaries over trial windows."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class TrialMetrics:
+    trial: int
+    mae: float
+    mae_per_joint: tuple[float, ...]
+    vel_mae: float
+    torque_variability_Nm_per_ms: float
+    ee_error_m: float | None
+
+
+class TrialAccumulator:
+    """Collects one trial's rows (preallocated) and reduces them once at the end of the trial."""
+
+    def __init__(self, n_joints: int, steps: int, step_ms: float = 2.0):
+        self.n, self.step_ms = n_joints, step_ms
+        self.pos_err = np.zeros((steps, n_joints))
+        self.vel_err = np.zeros((steps, n_joints))
+        self.tau = np.zeros((steps, n_joints))
+        self.ee_err = np.full(steps, np.nan)
+        self.i = 0
+
+    def add(self, q_des, q, qd_des, qd, tau, ee_des=None, ee=None) -> None:
+        i = self.i
+        np.subtract(q_des, q, out=self.pos_err[i])
+        np.subtract(qd_des, qd, out=self.vel_err[i])
+        self.tau[i] = tau
+        if ee_des is not None and ee is not None:
+            d = ee_des - ee
+            self.ee_err[i] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) ** 0.5
+        self.i = i + 1
+
+    def finish(self, trial: int) -> TrialMetrics:
+        k = self.i
+        per_joint = np.abs(self.pos_err[:k]).mean(0) if k else np.zeros(self.n)
+        dtau = np.abs(np.diff(self.tau[:k], axis=0)).mean() / self.step_ms if k > 1 else 0.0
+        ee = self.ee_err[:k]
+        return TrialMetrics(
+            trial=trial,
+            mae=float(per_joint.mean()),
+            mae_per_joint=tuple(float(x) for x in per_joint),
+            vel_mae=float(np.abs(self.vel_err[:k]).mean()) if k else 0.0,
+            torque_variability_Nm_per_ms=float(dtau),
+            ee_error_m=float(np.nanmean(ee)) if k and np.isfinite(ee).any() else None,
+        )
+
+
+def final_mae(mae_per_trial: list[float]) -> float | None:
+    """Mean of the last 10 % of trials (at least one)."""
+    if not mae_per_trial:
+        return None
+    k = max(1, int(round(0.1 * len(mae_per_trial))))
+    return float(np.mean(mae_per_trial[-k:]))
+
+
+def window_stats(mae_per_trial: list[float], start: int, stop: int) -> tuple[float, float] | None:
+    """Mean and std of trials [start, stop) as in Tables 2.3 / 2.4."""
+    w = np.asarray(mae_per_trial[start:stop])
+    if w.size == 0:
+        return None
+    return float(w.mean()), float(w.std())
+
+
+def trials_to_threshold(mae_per_trial: list[float], threshold: float) -> int | None:
+    """First trial whose MAE is at or below ``threshold`` (Fig. 4.5 B)."""
+    for i, v in enumerate(mae_per_trial):
+        if v <= threshold:
+            return i
+    return None

@@ -1,0 +1,87 @@
+"""The plant contract every registered plant satisfies (checked by :func:`check_plant`).
+
+A plant owns a MuJoCo model. The loop calls, once per 2 ms control step and in this order:
+``sensors()`` -> (controller work) -> ``apply(tau)`` -> ``step()``. ``step`` advances
+``control_dt_s`` in ``substeps`` physics steps with the torque held constant (zero-order hold).
+Units are SI: rad, rad/s, N·m, m, s.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class PlantEvent:
+    """Something that happens to the plant at a scheduled time (payload, force pulse, ...)."""
+
+    time_s: float
+    kind: str
+    params: dict = field(default_factory=dict)
+
+
+class Plant(ABC):
+    """A torque-controlled mechanical system with ``n_joints`` controlled joints."""
+
+    joint_names: tuple[str, ...]
+    control_dt_s: float
+    physics_dt_s: float
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.joint_names)
+
+    @property
+    def substeps(self) -> int:
+        return int(round(self.control_dt_s / self.physics_dt_s))
+
+    @abstractmethod
+    def reset(self, q0: np.ndarray, rng: np.random.Generator) -> None:
+        """Put the plant at rest at joint positions ``q0`` (time 0, events cleared)."""
+
+    @abstractmethod
+    def sensors(self) -> tuple[np.ndarray, np.ndarray]:
+        """Measured joint positions and velocities (copies, possibly noisy)."""
+
+    @abstractmethod
+    def apply(self, tau: np.ndarray) -> np.ndarray:
+        """Set the joint torque for the next step; returns the torque actually applied (saturated)."""
+
+    @abstractmethod
+    def step(self) -> None:
+        """Advance the physics by one control step."""
+
+    @property
+    @abstractmethod
+    def time_s(self) -> float:
+        """Simulated time."""
+
+    @abstractmethod
+    def joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper joint position limits (rad)."""
+
+    def true_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """Noise-free joint positions and velocities (for metrics); defaults to ``sensors()``."""
+        return self.sensors()
+
+    def end_effector(self) -> np.ndarray | None:
+        """Cartesian end-effector position (m) in the world frame, if the plant has one."""
+        return None
+
+    def handle_event(self, event: PlantEvent) -> None:
+        """Apply a scheduled plant event; plants without events refuse them."""
+        raise ValueError(f"{type(self).__name__} does not support event {event.kind!r}")
+
+    def is_diverged(self) -> str | None:
+        """A reason string when the state is non-finite or far outside the joint limits."""
+        q, qd = self.true_state()
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
+            return "non-finite joint state"
+        lo, hi = self.joint_limits()
+        span = hi - lo
+        if np.any(q < lo - span) or np.any(q > hi + span):
+            return "joint position far outside its limits"
+        return None

@@ -1,0 +1,1 @@
+"""One run.mcap and one summary.json per run."""

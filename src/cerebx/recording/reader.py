@@ -1,0 +1,87 @@
+"""Reads run folders and MCAP files back (for `cerebx inspect`, the report and the tests)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+from mcap.decoder import DecoderFactory
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory as ProtobufDecoderFactory
+
+from cerebx.errors import CerebxError
+
+
+class JsonDecoderFactory(DecoderFactory):
+    """mcap ships no JSON decoder: JSON channels decode with json.loads."""
+
+    def decoder_for(self, message_encoding: str, schema: Any):
+        return json.loads if message_encoding == "json" else None
+
+
+def mcap_path(path: Path | str) -> Path:
+    p = Path(path)
+    return p / "run.mcap" if p.is_dir() else p
+
+
+def _reader(fh):
+    try:
+        return make_reader(fh, decoder_factories=[ProtobufDecoderFactory(), JsonDecoderFactory()])
+    except Exception as err:  # mcap raises several types for bad files
+        raise CerebxError(f"{fh.name}: not a readable MCAP file ({err})") from None
+
+
+def read_messages(path: Path | str, topics: list[str] | None = None) -> Iterator[tuple[str, int, Any]]:
+    """Yield (topic, log_time_ns, decoded message) in log-time order."""
+    p = mcap_path(path)
+    if not p.exists():
+        raise CerebxError(f"{p}: no such file")
+    with open(p, "rb") as fh:
+        reader = _reader(fh)
+        try:
+            for _schema, channel, message, decoded in reader.iter_decoded_messages(topics=topics):
+                yield channel.topic, message.log_time, decoded
+        except CerebxError:
+            raise
+        except Exception as err:
+            raise CerebxError(f"{p}: damaged MCAP file ({type(err).__name__}: {err})") from None
+
+
+def channel_counts(path: Path | str) -> dict[str, int]:
+    """Message count per topic, from the file's summary section."""
+    p = mcap_path(path)
+    if not p.exists():
+        raise CerebxError(f"{p}: no such file")
+    with open(p, "rb") as fh:
+        try:
+            summary = _reader(fh).get_summary()
+        except CerebxError:
+            raise
+        except Exception as err:
+            raise CerebxError(f"{p}: damaged MCAP file ({type(err).__name__}: {err})") from None
+        if summary is None or summary.statistics is None:
+            raise CerebxError(f"{p}: MCAP file has no summary (was the run killed?)")
+        return {summary.channels[cid].topic: n for cid, n in sorted(summary.statistics.channel_message_counts.items())}
+
+
+def read_metadata(path: Path | str) -> dict[str, dict[str, str]]:
+    p = mcap_path(path)
+    with open(p, "rb") as fh:
+        try:
+            return {m.name: dict(m.metadata) for m in _reader(fh).iter_metadata()}
+        except CerebxError:
+            raise
+        except Exception as err:
+            raise CerebxError(f"{p}: damaged MCAP file ({type(err).__name__}: {err})") from None
+
+
+def read_summary(run_dir: Path | str) -> dict[str, Any]:
+    p = Path(run_dir) / "summary.json"
+    try:
+        return json.loads(p.read_text())
+    except FileNotFoundError:
+        raise CerebxError(f"{p}: no such file (not a cerebx run folder?)") from None
+    except json.JSONDecodeError as err:
+        raise CerebxError(f"{p}: not valid JSON ({err})") from None

@@ -1,0 +1,122 @@
+"""Writes a run's MCAP file through foxglove-sdk (a Rust MCAP writer, fast enough for every 2 ms
+step): Foxglove ``JointStates`` (protobuf) for the joint channels so Foxglove shows them natively,
+JSON with JSON-Schema schemas for everything else.
+
+Channels (units SI; time stamps are simulated time):
+
+=========================  =====================  ===============================================
+topic                      schema                 content
+=========================  =====================  ===============================================
+/joint_states/desired      foxglove.JointStates   desired position (rad) and velocity (rad/s)
+/joint_states/actual       foxglove.JointStates   actual position, velocity, applied torque (N·m)
+/control                   cerebx.Control         controller torque, supervisor torque, error,
+                                                  end-effector and desired end-effector (m), delays
+                                                  sampled for this step's messages (r2c_ms, c2r_ms)
+/trial_metrics             cerebx.TrialMetrics    per-trial MAE per joint, velocity MAE, dtau
+/events                    cerebx.PlantEvent      plant events as they happen
+/spikes/<population>       cerebx.Spikes          neuron indices that fired in the step
+/weights                   cerebx.WeightSummary   per-trial plastic-weight statistics
+/task/cartesian_path       cerebx.CartesianPath   desired Cartesian path of the first trial
+=========================  =====================  ===============================================
+
+Metadata records ``config`` (the resolved config as JSON) and ``cerebx`` (version, overrides).
+The file is finished in ``close`` (called from ``finally``), so an exception or Ctrl-C still
+leaves a valid file.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import foxglove
+import numpy as np
+from foxglove.channels import JointStatesChannel
+from foxglove.mcap import MCAPCompression, MCAPWriteOptions
+from foxglove.messages import JointState, JointStates, Timestamp
+
+from cerebx import __version__
+
+_TIME = {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}}
+_NUMS = {"type": "array", "items": {"type": "number"}}
+
+SCHEMAS: dict[str, dict] = {
+    "cerebx.Control": {
+        "type": "object",
+        "properties": {"t": {"type": "number"}, "trial": {"type": "integer"}, "tau_controller": _NUMS,
+                       "tau_supervisor": _NUMS, "error": _NUMS, "ee": _NUMS, "ee_des": _NUMS,
+                       "r2c_ms": {"type": "number"}, "c2r_ms": {"type": "number"}},
+    },
+    "cerebx.TrialMetrics": {
+        "type": "object",
+        "properties": {"trial": {"type": "integer"}, "mae": {"type": "number"}, "mae_per_joint": _NUMS,
+                       "vel_mae": {"type": "number"}, "torque_variability_Nm_per_ms": {"type": "number"},
+                       "ee_error_m": {"type": ["number", "null"]}},
+    },
+    "cerebx.PlantEvent": {"type": "object", "properties": {"t": {"type": "number"}, "kind": {"type": "string"},
+                                                           "params": {"type": "object"}}},
+    "cerebx.Spikes": {"type": "object", "properties": {"t": {"type": "number"}, "indices": {
+        "type": "array", "items": {"type": "integer"}}}},
+    "cerebx.WeightSummary": {"type": "object", "properties": {"trial": {"type": "integer"}}},
+    "cerebx.CartesianPath": {"type": "object", "properties": {"x": _NUMS, "y": _NUMS, "z": _NUMS}},
+}
+
+_COMPRESSION = {"zstd": MCAPCompression.Zstd, "lz4": MCAPCompression.Lz4, "none": None}
+
+
+def _ns(t_s: float) -> int:
+    return int(round(t_s * 1e9))
+
+
+class Recorder:
+    """Owns the MCAP writer for one run. Channels are created lazily on first use."""
+
+    def __init__(self, path: Path, joint_names: tuple[str, ...] = (), chunk_size_kb: int = 256,
+                 compression: str = "zstd"):
+        self.path = Path(path)
+        self._ctx = foxglove.Context()  # one context per recording: nothing leaks between runs
+        opts = MCAPWriteOptions(compression=_COMPRESSION[compression], chunk_size=chunk_size_kb * 1024,
+                                compression_threads=0, profile="")
+        self._w = foxglove.open_mcap(self.path, allow_overwrite=True, context=self._ctx, writer_options=opts)
+        self._channels: dict[str, foxglove.Channel] = {}
+        self._joint_channels: dict[str, JointStatesChannel] = {}
+        self.joint_names = tuple(joint_names)
+        self.closed = False
+
+    def _channel(self, topic: str, schema: str) -> foxglove.Channel:
+        ch = self._channels.get(topic)
+        if ch is None:
+            ch = foxglove.Channel(
+                topic, message_encoding="json", context=self._ctx,
+                schema=foxglove.Schema(name=schema, encoding="jsonschema", data=json.dumps(SCHEMAS[schema]).encode()),
+            )
+            self._channels[topic] = ch
+        return ch
+
+    def write(self, topic: str, schema: str, t_s: float, msg: dict[str, Any]) -> None:
+        self._channel(topic, schema).log(json.dumps(msg, separators=(",", ":")).encode(), log_time=_ns(t_s))
+
+    def joint_states(self, topic: str, t_s: float, q: np.ndarray, qd: np.ndarray,
+                     effort: np.ndarray | None = None) -> None:
+        ch = self._joint_channels.get(topic)
+        if ch is None:
+            ch = self._joint_channels[topic] = JointStatesChannel(topic, context=self._ctx)
+        ns = _ns(t_s)
+        sec, nsec = divmod(ns, 1_000_000_000)
+        qs, qds = q.tolist(), qd.tolist()
+        es = effort.tolist() if effort is not None else [0.0] * len(qs)
+        joints = [JointState(name=n, position=a, velocity=b, effort=c)
+                  for n, a, b, c in zip(self.joint_names, qs, qds, es)]
+        ch.log(JointStates(timestamp=Timestamp(sec=sec, nsec=nsec), joints=joints), log_time=ns)
+
+    def spikes(self, topic: str, t_s: float, indices: np.ndarray) -> None:
+        self.write(topic, "cerebx.Spikes", t_s, {"t": t_s, "indices": np.asarray(indices).tolist()})
+
+    def metadata(self, name: str, data: dict[str, str]) -> None:
+        self._w.write_metadata(name, {k: str(v) for k, v in data.items()})
+
+    def close(self) -> None:
+        if not self.closed:
+            self.closed = True
+            self._w.close()

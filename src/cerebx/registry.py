@@ -1,0 +1,87 @@
+"""Named registries that map a config ``kind`` to its schema and builder.
+
+Built-in variants register here in code; third-party packages register through the
+``cerebx.plugins`` entry-point group (each entry point is a callable taking no arguments that
+registers its variants). Configuration only ever names a ``kind``: it cannot import anything.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+from typing import Any
+
+from pydantic import BaseModel
+
+
+@dataclass(frozen=True)
+class Entry:
+    kind: str
+    schema: type[BaseModel]
+    builder: str | Callable[..., Any]
+    doc: str
+
+    def resolve(self) -> Callable[..., Any]:
+        """The builder callable; a ``"module:attr"`` string is imported on first use."""
+        if callable(self.builder):
+            return self.builder
+        module, _, attr = self.builder.partition(":")
+        return getattr(importlib.import_module(module), attr)
+
+
+class Registry:
+    """Variants of one component group (``task``, ``plant``, ``controller``, ``delay``)."""
+
+    def __init__(self, group: str):
+        self.group = group
+        self._entries: dict[str, Entry] = {}
+
+    def register(self, schema: type[BaseModel], builder: str | Callable[..., Any]) -> type[BaseModel]:
+        """Register ``schema`` (whose ``kind`` field default names the variant) and its builder."""
+        kind = schema.model_fields["kind"].default
+        if not isinstance(kind, str):
+            raise TypeError(f"{schema.__name__}: the 'kind' field needs a string default")
+        if kind in self._entries and self._entries[kind].schema is not schema:
+            raise ValueError(f"{self.group} kind {kind!r} is already registered")
+        doc = (schema.__doc__ or "").strip().splitlines()[0] if schema.__doc__ else ""
+        self._entries[kind] = Entry(kind, schema, builder, doc)
+        return schema
+
+    def kinds(self) -> list[str]:
+        return sorted(self._entries)
+
+    def schemas(self) -> tuple[type[BaseModel], ...]:
+        return tuple(self._entries[k].schema for k in self.kinds())
+
+    def __contains__(self, kind: str) -> bool:
+        return kind in self._entries
+
+    def __getitem__(self, kind: str) -> Entry:
+        try:
+            return self._entries[kind]
+        except KeyError:
+            raise KeyError(f"unknown {self.group} kind {kind!r}; known: {', '.join(self.kinds())}") from None
+
+    def build(self, cfg: BaseModel, *args: Any, **kwargs: Any) -> Any:
+        return self[cfg.kind].resolve()(cfg, *args, **kwargs)  # type: ignore[attr-defined]
+
+
+tasks = Registry("task")
+plants = Registry("plant")
+controllers = Registry("controller")
+delays = Registry("delay")
+
+_plugins_loaded = False
+
+
+def load_plugins() -> None:
+    """Import the built-in variants, then every ``cerebx.plugins`` entry point (once)."""
+    global _plugins_loaded
+    if _plugins_loaded:
+        return
+    _plugins_loaded = True
+    importlib.import_module("cerebx.schema.builtin")
+    for ep in entry_points(group="cerebx.plugins"):
+        ep.load()()

@@ -1,0 +1,183 @@
+"""Controller schemas: baselines, the spiking cerebellum and its encoders/decoders, and the
+plant-side torque filter and watchdog supervisor that every controller may use."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import Field, model_validator
+
+from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
+
+
+class NoFilter(Strict):
+    """Apply the newest torque sample as it is."""
+
+    kind: Literal["none"] = "none"
+
+
+class MeanFilter(Strict):
+    """Mean of the last ``taps`` torque samples (thesis Eq. 2.18: 15 taps = 30 ms)."""
+
+    kind: Literal["mean"] = "mean"
+    taps: int = Field(15, gt=0)
+
+
+class FuturePastFilter(Strict):
+    """Mean over future and past stamped samples with a decaying safe stop (Eq. 3.6, facts §7)."""
+
+    kind: Literal["future_past"] = "future_past"
+    past_samples: int = Field(10, gt=0)
+    min_future_samples: int = Field(2, ge=0)
+    decay_per_step: float = Field(0.998, gt=0, le=1)
+
+
+TorqueFilter = Annotated[NoFilter | MeanFilter | FuturePastFilter, Field(discriminator="kind")]
+
+
+class Supervisor(Strict):
+    """Watchdog PD acting only outside the joint bounds (thesis §2.2.8, facts §4):
+    tau = kp (bound - q) - s kd qd, s ramping by ``ramp_per_step`` to 1 while outside."""
+
+    enabled: bool = True
+    kp: tuple[float, ...] = (20.0, 20.0, 20.0, 20.0, 3.0, 3.0)
+    kd: tuple[float, ...] = (5.0, 5.0, 5.0, 5.0, 1.0, 1.0)
+    ramp_per_step: float = Field(0.02, gt=0, le=1)
+    bounds: Literal["encoder", "plant"] = Field(
+        "encoder", description="'encoder': the MF position ranges (as the original); 'plant': joint limits"
+    )
+    margin_rad: NonNegFloat = 0.0
+
+
+class _ControllerCommon(Strict):
+    output_filter: TorqueFilter = NoFilter()
+    supervisor: Supervisor | None = None
+
+
+class PDController(_ControllerCommon):
+    """tau = kp (q_d - q) + kd (qd_d - qd), saturated at +-tau_max (facts §6)."""
+
+    kind: Literal["pd"] = "pd"
+    kp: tuple[float, ...] = (45.0, 50.0, 17.0, 50.0, 22.0, 27.0)
+    kd: tuple[float, ...] = (15.0, 5.0, 3.0, 4.0, 2.5, 3.0)
+    tau_max_Nm: tuple[PositiveFloat, ...] = (12.0, 19.5, 3.75, 10.5, 3.0, 3.75)
+
+    @model_validator(mode="after")
+    def _lengths(self) -> PDController:
+        if not len(self.kp) == len(self.kd) == len(self.tau_max_Nm):
+            raise ValueError("kp, kd and tau_max_Nm need the same number of joints")
+        return self
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.kp)
+
+
+class PositionController(_ControllerCommon):
+    """Stiff position servo with gravity compensation (stands in for Baxter's factory controller)."""
+
+    kind: Literal["position"] = "position"
+    kp: tuple[float, ...] = (700.0, 1000.0, 450.0, 550.0, 100.0, 90.0)
+    kd: tuple[float, ...] = (25.0, 40.0, 10.0, 12.0, 2.0, 2.0)
+    gravity_compensation: bool = True
+    tau_max_Nm: tuple[PositiveFloat, ...] = (50.0, 100.0, 50.0, 50.0, 15.0, 15.0)
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.kp)
+
+
+class GivenRanges(Strict):
+    """Encoder ranges per joint for each of the four MF signals (facts §3 launch-file tables)."""
+
+    kind: Literal["given"] = "given"
+    q_min: tuple[float, ...]
+    q_max: tuple[float, ...]
+    qd_des_min: tuple[float, ...]
+    qd_des_max: tuple[float, ...]
+    qd_min: tuple[float, ...]
+    qd_max: tuple[float, ...]
+
+    @model_validator(mode="after")
+    def _non_empty(self) -> GivenRanges:
+        for lo_name, hi_name in (("q_min", "q_max"), ("qd_des_min", "qd_des_max"), ("qd_min", "qd_max")):
+            lo, hi = getattr(self, lo_name), getattr(self, hi_name)
+            if len(lo) != len(hi):
+                raise ValueError(f"{lo_name} and {hi_name} need the same length")
+            bad = [j for j, (a, b) in enumerate(zip(lo, hi)) if not a < b]
+            if bad:
+                raise ValueError(f"{lo_name} must be below {hi_name} (empty range at joint {bad[0]})")
+        return self
+
+
+class TaskRanges(Strict):
+    """Encoder ranges from the task's desired trajectory, widened by ``margin`` of the span."""
+
+    kind: Literal["from_task"] = "from_task"
+    margin: NonNegFloat = 0.1
+    velocity_margin: NonNegFloat = 0.1
+
+
+class BoxEncoder(Strict):
+    """MF interval coding (Eq. 2.12-2.15): per signal, 10 fibres with box receptive fields;
+    the active fibre fires once per 2 ms step."""
+
+    kind: Literal["box"] = "box"
+    fibers_per_signal: int = Field(10, gt=1)
+    width_factor: PositiveFloat = Field(0.500000000001, description="half-width in units of the centre step")
+    ranges: Annotated[GivenRanges | TaskRanges, Field(discriminator="kind")] = TaskRanges()
+
+
+class CFEncoder(Strict):
+    """CF stochastic error coding (facts §3): agonist/antagonist split by error sign;
+    rate = r_min + (r_max - r_min)(tanh((|e| - c_k)/w) + 1)/2, Bernoulli per 2 ms, bursts."""
+
+    kind: Literal["tanh_bernoulli"] = "tanh_bernoulli"
+    rate_min_hz: NonNegFloat = 1.0
+    rate_max_hz: PositiveFloat = 10.0
+    center_min: NonNegFloat = 0.001
+    center_max: PositiveFloat = 0.01
+    max_burst: int = Field(6, ge=1)
+
+    @model_validator(mode="after")
+    def _ranges(self) -> CFEncoder:
+        if self.rate_min_hz >= self.rate_max_hz:
+            raise ValueError("rate_min_hz must be below rate_max_hz")
+        if self.center_min >= self.center_max:
+            raise ValueError("center_min must be below center_max")
+        return self
+
+
+class ErrorGains(Strict):
+    """Teaching error e = kpos (q_d - q) + kvel (qd_d - qd) (Eq. 2.1)."""
+
+    kpos: tuple[float, ...] = (1.5, 2.0, 3.0, 2.0, 2.0, 1.5)
+    kvel: tuple[float, ...] = (1.5, 1.0, 3.0, 1.0, 2.0, 1.5)
+
+
+class DCNDecoder(Strict):
+    """Torque = alpha_j (agonist - antagonist DCN spikes per 2 ms) (Eq. 2.16-2.17, 3.5)."""
+
+    alpha_Nm_per_spike: tuple[PositiveFloat, ...] = (0.75, 1.1, 0.375, 0.63, 0.078, 0.078)
+
+
+class SNNController(_ControllerCommon):
+    """The cerebellar spiking network (thesis §2.2.3-2.2.7, §3.2.2-3.2.4). The topology comes
+    from the top-level ``network`` group."""
+
+    kind: Literal["snn"] = "snn"
+    mf: BoxEncoder = BoxEncoder()
+    cf: CFEncoder = CFEncoder()
+    error: ErrorGains = ErrorGains()
+    decoder: DCNDecoder = DCNDecoder()
+    pathway_delay_ms: NonNegFloat = Field(50.0, description="afferent = efferent sensorimotor delay D")
+    plasticity: bool = True
+    parallel: bool = Field(True, description="use numba threads in the network kernels")
+    output_filter: TorqueFilter = MeanFilter()
+    supervisor: Supervisor | None = Supervisor()
+    record_spikes: list[str] = Field(default_factory=lambda: ["dcn"])
+    weight_summary_every_trials: int = Field(1, ge=0)
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.decoder.alpha_Nm_per_spike)

@@ -1,0 +1,84 @@
+"""Delay models for the robot-to-controller (R2C) and controller-to-robot (C2R) channels."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field, model_validator
+
+from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
+
+
+class NoDelay(Strict):
+    """Messages arrive at the step they are sent."""
+
+    kind: Literal["none"] = "none"
+
+
+class ConstantDelay(Strict):
+    """A fixed delay; ``total_ms`` split evenly unless r2c_ms/c2r_ms are given."""
+
+    kind: Literal["constant"] = "constant"
+    total_ms: NonNegFloat = 0.0
+    r2c_ms: NonNegFloat | None = None
+    c2r_ms: NonNegFloat | None = None
+
+    @model_validator(mode="after")
+    def _split(self) -> ConstantDelay:
+        if (self.r2c_ms is None) != (self.c2r_ms is None):
+            raise ValueError("give both r2c_ms and c2r_ms, or neither (then total_ms is split evenly)")
+        if self.r2c_ms is not None and abs(self.r2c_ms + self.c2r_ms - self.total_ms) > 1e-9:
+            raise ValueError(f"r2c_ms + c2r_ms ({self.r2c_ms + self.c2r_ms}) must equal total_ms ({self.total_ms})")
+        return self
+
+    def per_direction(self) -> tuple[float, float]:
+        if self.r2c_ms is None:
+            return self.total_ms / 2, self.total_ms / 2
+        return self.r2c_ms, self.c2r_ms  # type: ignore[return-value]
+
+
+class GammaParams(Strict):
+    """d = Gamma(shape, scale) + offset (ms), floored at 0; ``inverted``: 2*k*theta - Gamma + offset."""
+
+    shape: PositiveFloat
+    scale_ms: PositiveFloat
+    offset_ms: float = 0.0
+    inverted: bool = False
+
+
+class GammaDelay(Strict):
+    """A new gamma-distributed delay each step per direction, with the monotonic limiter (facts §7)."""
+
+    kind: Literal["gamma"] = "gamma"
+    r2c: GammaParams
+    c2r: GammaParams
+    monotonic: bool = Field(True, description="a delay may fall by at most one step per step")
+
+
+class TraceDelay(Strict):
+    """Replay a recorded series of per-step delays (ms) from a text/CSV file (one or two columns)."""
+
+    kind: Literal["trace"] = "trace"
+    path: str
+    loop: bool = True
+
+
+class PercentileDelay(Strict):
+    """Sample delays from a distribution given by (percentile, ms) points, linearly interpolated."""
+
+    kind: Literal["percentiles"] = "percentiles"
+    r2c_percentiles: list[tuple[float, NonNegFloat]]
+    c2r_percentiles: list[tuple[float, NonNegFloat]]
+
+    @model_validator(mode="after")
+    def _monotone(self) -> PercentileDelay:
+        for name in ("r2c_percentiles", "c2r_percentiles"):
+            pts = getattr(self, name)
+            ps = [p for p, _ in pts]
+            vs = [v for _, v in pts]
+            if len(pts) < 2 or ps[0] != 0 or ps[-1] != 100:
+                raise ValueError(f"{name} must start at percentile 0 and end at 100")
+            if any(b <= a for a, b in zip(ps, ps[1:])) or any(b < a for a, b in zip(vs, vs[1:])):
+                raise ValueError(f"{name}: percentiles must increase and delays must not decrease")
+        return self
+

@@ -1,0 +1,235 @@
+"""Flatten a :class:`~cerebx.schema.network.NetworkConfig` into the arrays the kernels use.
+
+All neurons share one global index space (populations concatenated in config order, input
+fibres included). Small projections (one-to-one, joint combinations) become CSR tables keyed
+by the global presynaptic index; all-to-all projections become dense float32 blocks
+``[n_pre, n_post]`` stored in one flat buffer, so a presynaptic spike adds one contiguous row.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cerebx.schema.network import AllToAll, JointCombinations, LIFNeuron, NetworkConfig, OneToOne
+
+RECEPTORS = {"ampa": 0, "nmda": 1, "gaba": 2}
+
+# Columns of the per-population parameter table (float64; kernels cast to float32 where hot).
+P_CM, P_GL, P_EL, P_EA, P_EG, P_DA, P_DAH, P_DN, P_DNH, P_DG, P_DGH, P_VTH, P_NREF, P_CLAMP, P_H = range(15)
+N_PAR = 15
+
+KIND_INPUT, KIND_LIF_AMPA, KIND_LIF_FULL = 0, 1, 2
+
+
+@dataclass
+class SparseProj:
+    name: str
+    pre_lo: int
+    n_pre: int
+    ptr: np.ndarray  # int64 [n_pre + 1]
+    post: np.ndarray  # int32 global post index
+    w: np.ndarray  # float32
+    receptor: int
+    delay: int  # in substeps
+    teaching: bool
+
+
+@dataclass
+class DenseProj:
+    name: str
+    pre_lo: int
+    n_pre: int
+    post_lo: int
+    n_post: int
+    w_off: int  # offset into Topology.dense_w
+    receptor: int
+    delay: int
+    plastic: int  # index into Topology.plastic, -1 if static
+
+
+@dataclass
+class PlasticRule:
+    proj: str
+    dense: int  # index of the DenseProj
+    teacher: int  # index of the SparseProj whose spikes trigger LTD (teacher must be sparse)
+    ltp: float
+    ltd: float
+    w_lo: float
+    w_hi: float
+    kernel: np.ndarray  # float32 k(m * dt) for m = 0 .. len-1
+
+
+@dataclass
+class Topology:
+    cfg: NetworkConfig
+    n_sub: int  # integration substeps per 2 ms control step
+    dt_ms: float
+    names: list[str]
+    lo: np.ndarray  # int64 first global index per population
+    hi: np.ndarray
+    kind: np.ndarray  # int64 KIND_* per population
+    par: np.ndarray  # float64 [n_pop, N_PAR]
+    sparse: list[SparseProj]
+    dense: list[DenseProj]
+    dense_w: np.ndarray  # float32 flat buffer of all dense blocks
+    plastic: list[PlasticRule]
+    max_delay: int
+    index: dict[str, int] = field(default_factory=dict)
+
+    @property
+    def n_neurons(self) -> int:
+        return int(self.hi[-1])
+
+    def slice(self, pop: str) -> slice:
+        i = self.index[pop]
+        return slice(int(self.lo[i]), int(self.hi[i]))
+
+    def dense_block(self, d: DenseProj) -> np.ndarray:
+        """View of one dense projection's weights as [n_pre, n_post]."""
+        return self.dense_w[d.w_off : d.w_off + d.n_pre * d.n_post].reshape(d.n_pre, d.n_post)
+
+
+def ltd_kernel_table(peak_ms: float, onset_ms: float, cutoff: float, dt_ms: float) -> np.ndarray:
+    """k(t) = (t'/tau) e^(1 - t'/tau), t' = t - onset, tau = peak - onset, zero before the onset,
+    sampled exactly at the integration grid m*dt and cut after the peak where k < cutoff."""
+    tau = peak_ms - onset_ms
+    # past the peak, x e^(1-x) falls monotonically; find where it drops below the cutoff
+    x = np.linspace(1.0, 200.0, 400_000)
+    x_cut = x[np.argmax(x * np.exp(1.0 - x) < cutoff)]
+    t_end = onset_ms + x_cut * tau
+    m = np.arange(int(np.ceil(t_end / dt_ms)) + 1)
+    tp = m * dt_ms - onset_ms
+    k = np.where(tp > 0, (tp / tau) * np.exp(1.0 - tp / tau), 0.0)
+    k[(m * dt_ms > peak_ms) & (k < cutoff)] = 0.0
+    return k.astype(np.float32)
+
+
+def structure_fingerprint(cfg: NetworkConfig) -> str:
+    """Hash of what shapes the state arrays (sizes, rules, receptors), not of weights or kernels,
+    so a learned state can be reloaded under a different learning-rule setting."""
+    shape = {
+        "dt_ms": cfg.dt_ms,
+        "pops": {k: [p.size, p.neuron.kind] for k, p in cfg.populations.items()},
+        "proj": {
+            k: [p.pre, p.post, p.rule.model_dump(), p.receptor, p.synapses, p.plasticity is not None]
+            for k, p in cfg.projections.items()
+        },
+    }
+    return hashlib.sha256(json.dumps(shape, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def _pairs(rule, n_pre: int, n_post: int) -> tuple[np.ndarray, np.ndarray]:
+    """(pre_local, post_local) synapse pairs of a sparse rule."""
+    if isinstance(rule, OneToOne):
+        i = np.arange(n_pre)
+        return i, i
+    r: JointCombinations = rule
+    F, S = r.fibers_per_signal, r.signals
+    per_joint = F**S
+    post = np.arange(n_post)
+    joint, rem = post // per_joint, post % per_joint
+    pres, posts = [], []
+    for k in range(S):
+        digit = (rem // F ** (S - 1 - k)) % F
+        pres.append(joint * S * F + k * F + digit)
+        posts.append(post)
+    return np.concatenate(pres), np.concatenate(posts)
+
+
+def build_topology(cfg: NetworkConfig) -> Topology:
+    """Lay out populations and build every projection (a few seconds for the thesis network)."""
+    dt = cfg.dt_ms
+    n_sub = int(round(2.0 / dt))
+    names = list(cfg.populations)
+    index = {n: i for i, n in enumerate(names)}
+    sizes = np.array([cfg.populations[n].size for n in names], dtype=np.int64)
+    hi = np.cumsum(sizes)
+    lo = hi - sizes
+
+    targeted: dict[str, set[int]] = {n: set() for n in names}
+    for p in cfg.projections.values():
+        if not p.teaching:
+            targeted[p.post].add(RECEPTORS[p.receptor])
+
+    kind = np.zeros(len(names), dtype=np.int64)
+    par = np.zeros((len(names), N_PAR))
+    for i, n in enumerate(names):
+        nrn = cfg.populations[n].neuron
+        if not isinstance(nrn, LIFNeuron):
+            kind[i] = KIND_INPUT
+            continue
+        kind[i] = KIND_LIF_AMPA if targeted[n] <= {RECEPTORS["ampa"]} else KIND_LIF_FULL
+        par[i, P_CM], par[i, P_GL], par[i, P_EL] = nrn.C_m_pF, nrn.g_L_nS, nrn.E_L_mV
+        par[i, P_EA], par[i, P_EG] = nrn.E_AMPA_mV, nrn.E_GABA_mV
+        for col, tau in ((P_DA, nrn.tau_AMPA_ms), (P_DN, nrn.tau_NMDA_ms), (P_DG, nrn.tau_GABA_ms)):
+            par[i, col] = np.exp(-dt / tau)
+            par[i, col + 1] = np.exp(-0.5 * dt / tau)
+        par[i, P_VTH] = nrn.V_thr_mV
+        par[i, P_NREF] = round(nrn.t_ref_ms / dt)
+        par[i, P_CLAMP] = 1.0 if nrn.clamp_at_rest else 0.0
+        par[i, P_H] = dt
+
+    sparse: list[SparseProj] = []
+    dense: list[DenseProj] = []
+    blocks: list[tuple[DenseProj, float]] = []
+    w_off = 0
+    for name, p in cfg.projections.items():
+        a, b = index[p.pre], index[p.post]
+        n_pre, n_post = int(sizes[a]), int(sizes[b])
+        delay = int(round(p.delay_ms / dt))
+        rec = RECEPTORS[p.receptor]
+        if isinstance(p.rule, AllToAll) and not p.teaching:
+            d = DenseProj(name, int(lo[a]), n_pre, int(lo[b]), n_post, w_off, rec, delay, -1)
+            dense.append(d)
+            blocks.append((d, p.weight_nS))
+            w_off += n_pre * n_post
+            continue
+        if isinstance(p.rule, AllToAll):
+            pre_l = np.repeat(np.arange(n_pre), n_post)
+            post_l = np.tile(np.arange(n_post), n_pre)
+        else:
+            pre_l, post_l = _pairs(p.rule, n_pre, n_post)
+        order = np.argsort(pre_l, kind="stable")
+        pre_l, post_l = pre_l[order], post_l[order]
+        ptr = np.zeros(n_pre + 1, dtype=np.int64)
+        np.cumsum(np.bincount(pre_l, minlength=n_pre), out=ptr[1:])
+        sparse.append(
+            SparseProj(
+                name, int(lo[a]), n_pre, ptr, (post_l + lo[b]).astype(np.int32),
+                np.full(len(post_l), p.weight_nS, dtype=np.float32), rec, delay, p.teaching,
+            )
+        )
+
+    dense_w = np.empty(w_off, dtype=np.float32)
+    for d, w in blocks:
+        dense_w[d.w_off : d.w_off + d.n_pre * d.n_post] = w
+
+    sparse_index = {s.name: i for i, s in enumerate(sparse)}
+    plastic: list[PlasticRule] = []
+    for di, d in enumerate(dense):
+        p = cfg.projections[d.name]
+        if p.plasticity is None:
+            continue
+        rule = p.plasticity
+        if rule.teacher not in sparse_index:
+            raise ValueError(f"projections.{d.name}.plasticity.teacher: {rule.teacher!r} must be a "
+                             "one_to_one or joint_combinations projection")
+        lo_w, hi_w = p.weight_range_nS
+        d.plastic = len(plastic)
+        plastic.append(
+            PlasticRule(
+                d.name, di, sparse_index[rule.teacher], rule.ltp_nS, rule.ltd_nS, lo_w, hi_w,
+                ltd_kernel_table(rule.kernel_peak_ms, rule.kernel_onset_ms, rule.kernel_cutoff, dt),
+            )
+        )
+    for name, p in cfg.projections.items():
+        if p.plasticity is not None and name not in {d.name for d in dense}:
+            raise ValueError(f"projections.{name}: plasticity is supported on all_to_all projections only")
+
+    max_delay = max([s.delay for s in sparse] + [d.delay for d in dense] + [1])
+    return Topology(cfg, n_sub, dt, names, lo, hi, kind, par, sparse, dense, dense_w, plastic,
+                    max_delay, index)

@@ -1,0 +1,1 @@
+"""Tasks: desired joint trajectories, one trial = one period."""

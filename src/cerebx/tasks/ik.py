@@ -1,0 +1,72 @@
+"""Damped least-squares inverse kinematics of a MuJoCo site, holding a fixed orientation."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+
+def rotation_error(r_cur: np.ndarray, r_des: np.ndarray) -> np.ndarray:
+    """Small-angle rotation vector taking ``r_cur`` to ``r_des`` (world frame, rad)."""
+    return 0.5 * (
+        np.cross(r_cur[:, 0], r_des[:, 0])
+        + np.cross(r_cur[:, 1], r_des[:, 1])
+        + np.cross(r_cur[:, 2], r_des[:, 2])
+    )
+
+
+def rotation_angle(r_a: np.ndarray, r_b: np.ndarray) -> float:
+    """Angle (rad) of the relative rotation between two rotation matrices."""
+    c = (np.trace(r_a.T @ r_b) - 1.0) / 2.0
+    return float(np.arccos(np.clip(c, -1.0, 1.0)))
+
+
+class SiteIK:
+    """Solves q so that a site reaches positions with one fixed orientation.
+
+    Uses its own MjData on ``model``; the first ``n`` joints (hinges, qpos = qvel index) are solved.
+    """
+
+    def __init__(self, model: mujoco.MjModel, site: str, n: int, lower: np.ndarray, upper: np.ndarray):
+        self.model = model
+        self.data = mujoco.MjData(model)
+        self.site = model.site(site).id
+        self.n = n
+        self.lower, self.upper = lower, upper
+        self._jac = np.zeros((6, model.nv))
+
+    def fk(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        d = self.data
+        d.qpos[: self.n] = q
+        mujoco.mj_kinematics(self.model, d)
+        return d.site_xpos[self.site].copy(), d.site_xmat[self.site].reshape(3, 3).copy()
+
+    def solve(
+        self,
+        q0: np.ndarray,
+        pos: np.ndarray,
+        rot: np.ndarray,
+        *,
+        tol: float = 1e-9,
+        damping: float = 1e-4,
+        max_iter: int = 100,
+    ) -> tuple[np.ndarray, float]:
+        """Newton iterations with damped least squares from ``q0``; returns (q, final error norm)."""
+        m, d, n = self.model, self.data, self.n
+        q = np.array(q0, dtype=float)
+        err = np.zeros(6)
+        norm = np.inf
+        for _ in range(max_iter):
+            d.qpos[:n] = q
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)
+            err[:3] = pos - d.site_xpos[self.site]
+            err[3:] = rotation_error(d.site_xmat[self.site].reshape(3, 3), rot)
+            norm = float(np.linalg.norm(err))
+            if norm < tol:
+                break
+            mujoco.mj_jacSite(m, d, self._jac[:3], self._jac[3:], self.site)
+            j = self._jac[:, :n]
+            dq = j.T @ np.linalg.solve(j @ j.T + damping**2 * np.eye(6), err)
+            q = np.clip(q + dq, self.lower, self.upper)
+        return q, norm

@@ -1,0 +1,32 @@
+"""Shared fixtures: configs are composed once through the real Hydra tree, then shortened."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+os.environ.setdefault("NUMBA_CACHE_DIR", str(ROOT / ".cache" / "numba"))
+os.environ.setdefault("CEREBX_CACHE", str(ROOT / ".cache" / "cerebx"))
+
+DEMO = ["+experiment=demo"]
+
+
+@pytest.fixture
+def load():
+    """Compose and validate a config from overrides (as `cerebx validate` does)."""
+    from cerebx.config import load as _load
+
+    def _do(overrides):
+        return _load(list(overrides))[0]
+
+    return _do
+
+
+@pytest.fixture
+def in_tmp(tmp_path, monkeypatch):
+    """Run with the working directory in a fresh temporary folder (runs/ lands there)."""
+    monkeypatch.chdir(tmp_path)
+    return tmp_path

@@ -1,0 +1,108 @@
+"""Every preset validates; invalid inputs give one readable line each and exit code 2."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from cerebx.cli import main
+
+CONF = Path(__file__).resolve().parents[1] / "conf"
+
+
+def _options(group: str) -> list[str]:
+    return sorted(p.stem for p in (CONF / group).glob("*.yaml"))
+
+
+def _plant_for(task: str) -> list[str]:
+    return ["plant=planar2", "controller=pd_planar2"] if task == "joint_sine" else []
+
+
+@pytest.mark.parametrize("task", _options("task"))
+def test_every_task_validates(load, task):
+    cfg = load([f"+task={task}", *_plant_for(task)])
+    assert cfg.task.kind == task or task.startswith(cfg.task.kind)
+
+
+@pytest.mark.parametrize("network", _options("network"))
+def test_every_network_validates(load, network):
+    cfg = load(["+task=circle", f"network={network}"])
+    assert cfg.network.n_neurons > 0
+
+
+@pytest.mark.parametrize("group", ["controller", "plant", "delay", "recording"])
+def test_every_option_validates(load, group):
+    for option in _options(group):
+        extra = []
+        if option.endswith("planar2") or option == "planar2":
+            extra = ["+task=joint_sine", "plant=planar2", "controller=pd_planar2"]
+        else:
+            extra = ["+task=circle"]
+        load([*extra, f"{group}={option}"])
+
+
+@pytest.mark.parametrize("experiment", _options("experiment"))
+def test_every_experiment_validates(load, experiment):
+    load([f"+experiment={experiment}"])
+
+
+def test_thesis_tables_are_encoded(load):
+    ch3 = load(["+task=circle", "network=thesis_ch3"]).network
+    assert ch3.n_neurons == 62_040
+    assert ch3.n_synapses == 36_386_400
+    assert ch3.projections["pf_pc"].weight_nS == 2.0
+    ch2 = load(["+task=circle", "network=thesis_ch2"]).network
+    assert ch2.projections["pf_pc"].weight_nS == 1.6
+    assert ch2.projections["pf_pc"].plasticity.kernel_peak_ms == 100.0
+
+
+INVALID = [
+    (["+task=circle", "controller=nope"], "controller: unknown option 'nope'"),
+    (["plant=planar2"], "task: no task chosen"),
+    (["+task=circle", "network.populations.gc.size=-5"], "network.populations.gc.size: Input should be greater than 0"),
+    (["+task=circle", "network.projections.pf_pc.synapses=35000000"],
+     "network.projections.pf_pc.synapses: declared 35,000,000 but rule all_to_all gives 36,000,000"),
+    (["+task=circle", "network.projections.pf_pc.weight_range_nS=[5.0,0.0]"],
+     "network.projections.pf_pc: weight_range_nS min (5.0) is greater than max (0.0)"),
+    (["+task=circle", "plant.physics_dt_ms=0.3"], "plant.physics_dt_ms: 0.3 ms does not divide the 2.0 ms control step"),
+    (["+task=circle", "+plant.colour=red"], "plant.colour: Extra inputs are not permitted"),
+    (["+task=circle", "network.projections.pf_pc.plasticity.kernel_peak_ms=100"],
+     "network.projections.pf_pc.plasticity: kernel_peak_ms (100.0) must be greater than kernel_onset_ms (120.0)"),
+    (["+task=circle", "network.populations.pc.microcomplexes=7"],
+     "network.populations.pc: microcomplexes (7) must divide the population size (600)"),
+    (["+task=square"], "task: unknown option 'square'"),
+    (["+task=circle", "controller.mf.fibers_per_signal=12"], "controller.mf.fibers_per_signal: not in the composed config"),
+    (["+task=circle", "controller.decoder.alpha_Nm_per_spike=[1,2]"],
+     "controller.decoder.alpha_Nm_per_spike: 2 values given but the plant has 6 joints"),
+    (["+task=circle", "+controller.mf.ranges={kind: given, q_min: [0,0,0,0,0,0], q_max: [1,1,1,1,1,0], "
+      "qd_des_min: [0,0,0,0,0,0], qd_des_max: [1,1,1,1,1,1], qd_min: [0,0,0,0,0,0], qd_max: [1,1,1,1,1,1]}"],
+     "controller.mf.ranges: q_min must be below q_max (empty range at joint 5)"),
+]
+
+
+@pytest.mark.parametrize(("overrides", "expected"), INVALID, ids=[e for _, e in INVALID])
+def test_invalid_input_one_line_exit_2(in_tmp, capsys, overrides, expected):
+    code = main(["validate", *overrides])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1, err
+    assert err[0].startswith(expected), err[0]
+    code = main(["run", *overrides])
+    assert code == 2
+    assert capsys.readouterr().err.strip().splitlines() == err
+    assert not (in_tmp / "runs").exists()
+
+
+def test_sweep_is_checked_before_any_job(in_tmp, capsys):
+    code = main(["run", "-m", "+experiment=demo", "plant.physics_dt_ms=0.5,0.3"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "plant.physics_dt_ms=0.3" in err and "does not divide" in err
+    assert not (in_tmp / "runs").exists()
+
+
+def test_config_cannot_import_code(load):
+    """A '_target_' or import path in config is just an unknown key, never executed."""
+    with pytest.raises(Exception, match="Extra inputs are not permitted"):
+        load(["+task=circle", "+controller._target_=os.system"])
