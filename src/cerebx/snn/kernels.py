@@ -48,7 +48,7 @@ def _lif_ampa(V, gA, ref, flag, chunk_n, lo, hi, p):
     h, half, sixth = f32(p[P_H]), f32(0.5), f32(1.0 / 6.0)
     gL, EL, EA, invC = f32(p[P_GL]), f32(p[P_EL]), f32(p[P_EA]), f32(1.0 / p[P_CM])
     dA, dAh, Vth, nref = f32(p[P_DA]), f32(p[P_DAH]), f32(p[P_VTH]), f32(p[P_NREF])
-    clamp = p[P_CLAMP] > 0.5
+    floor = EL if p[P_CLAMP] > 0.5 else f32(-1e30)
     zero, one, two = f32(0.0), f32(1.0), f32(2.0)
     n_chunks = (hi - lo + CHUNK - 1) // CHUNK
     for c in prange(n_chunks):
@@ -69,8 +69,7 @@ def _lif_ampa(V, gA, ref, flag, chunk_n, lo, hi, p):
             v4 = v + h * k3
             k4 = (gL * (EL - v4) + g1 * (EA - v4)) * invC
             vn = v + h * sixth * (k1 + two * k2 + two * k3 + k4)
-            if clamp:
-                vn = vn if vn > EL else EL
+            vn = vn if vn > floor else floor
             refr = r > zero
             s = (vn >= Vth) and not refr
             V[i] = EL if (refr or s) else vn
