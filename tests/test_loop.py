@@ -25,7 +25,7 @@ def _payload(run_dir: Path) -> list:
     """Every recorded message (topic, time, content) — what 'identical data' means."""
     out = []
     for topic, t, msg in read_messages(run_dir):
-        out.append((topic, t, msg if isinstance(msg, dict) else str(msg)))
+        out.append((topic, t, msg))
     return out
 
 
@@ -163,6 +163,6 @@ def test_inspect_truncated_file_one_line(tmp_path, capsys, load):
 def test_joint_states_are_foxglove_typed(load, tmp_path):
     run_experiment(load([*DEMO, "trials=1"]), tmp_path)
     topic, t, msg = next(read_messages(tmp_path, ["/joint_states/actual"]))
-    assert type(msg).__name__ == "JointStates"
-    assert [j.name for j in msg.joints] == ["shoulder", "elbow"]
-    assert np.isfinite(msg.joints[0].position)
+    assert [j["name"] for j in msg["joints"]] == ["shoulder", "elbow"]
+    assert np.isfinite(msg["joints"][0]["position"])
+    assert msg["timestamp"] == {"sec": t // 1_000_000_000, "nsec": t % 1_000_000_000}

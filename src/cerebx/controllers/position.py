@@ -10,7 +10,7 @@ from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 
 
 class PositionServo(Controller):
-    """tau = sat(kp (q_d - q) + kd (qd_d - qd) + g(q)).
+    """tau = sat(kp (q_d - q) + kd (v qd_d - qd) + g(q)), v = 1 with velocity feed-forward, else 0.
 
     g(q) comes from the plant's ``gravity_torque(q)`` (the MuJoCo model, including an attached payload,
     minus what the plant compensates itself); plants without that method get no feed-forward.
@@ -25,6 +25,7 @@ class PositionServo(Controller):
         self._tau_max = np.asarray(cfg.tau_max_Nm, dtype=float)
         plant = getattr(ctx, "plant", None) if ctx is not None else None
         gravity = getattr(plant, "gravity_torque", None)
+        self._qd_gain = 1.0 if cfg.velocity_feedforward else 0.0
         self._gravity = gravity if (cfg.gravity_compensation and callable(gravity)) else None
 
     def reset(self, rng: np.random.Generator) -> None:
@@ -34,10 +35,10 @@ class PositionServo(Controller):
         if inp.sensor is None:
             return TorqueMsg(stamp_s=inp.t_s, tau=np.zeros(self.n_joints))
         q, qd = inp.sensor.q, inp.sensor.qd
-        tau = self._kp * (inp.q_des - q) + self._kd * (inp.qd_des - qd)
+        tau = self._kp * (inp.q_des - q) + self._kd * (self._qd_gain * inp.qd_des - qd)
         if self._gravity is not None:
             tau += self._gravity(q)
-        np.clip(tau, -self._tau_max, self._tau_max, out=tau)
+        np.minimum(np.maximum(tau, -self._tau_max, out=tau), self._tau_max, out=tau)
         return TorqueMsg(stamp_s=inp.t_s, tau=tau)
 
     def describe(self) -> dict[str, Any]:

@@ -6,6 +6,7 @@ least stamp + d; a later message is never released before an earlier one (facts 
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
@@ -128,7 +129,7 @@ class DelayChannel:
     def send(self, msg: Any, tick: int) -> None:
         d = self.sampler.next_ms()
         self.last_delay_ms = d
-        release = tick + int(np.ceil(d / self.step_ms - 1e-9))
+        release = tick + math.ceil(d / self.step_ms - 1e-9)
         release = max(release, self._last_release)
         self._last_release = release
         self._queue.append((release, msg))

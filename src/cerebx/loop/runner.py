@@ -84,7 +84,7 @@ class ClosedLoop:
                 self._fire(e.action, self.tick * self.dt_s)
         if rec is not None and trial == 0 and ref.xyz is not None:
             rec.write("/task/cartesian_path", "cerebx.CartesianPath", 0.0,
-                      {"x": ref.xyz[:, 0].tolist(), "y": ref.xyz[:, 1].tolist(), "z": ref.xyz[:, 2].tolist()})
+                      {"x": ref.xyz[:, 0].copy(), "y": ref.xyz[:, 1].copy(), "z": ref.xyz[:, 2].copy()})
         sensor: SensorMsg | None = getattr(self, "_sensor", None)
         for i in range(ref.steps):
             tick = self.tick
@@ -117,15 +117,14 @@ class ClosedLoop:
                 if self.record_joints:
                     rec.joint_states("/joint_states/desired", t, q_des, qd_des)
                     rec.joint_states("/joint_states/actual", t, q, qd, applied)
-                msg = {"t": t, "trial": trial, "tau_controller": cmd.tau.tolist(),
-                       "error": (q_des - q).tolist(),
+                msg = {"t": t, "trial": trial, "tau_controller": cmd.tau, "error": q_des - q,
                        "r2c_ms": self.r2c.last_delay_ms, "c2r_ms": self.c2r.last_delay_ms}
                 if tau_sup is not None:
-                    msg["tau_supervisor"] = tau_sup.tolist()
+                    msg["tau_supervisor"] = tau_sup
                 if ee is not None:
-                    msg["ee"] = ee.tolist()
+                    msg["ee"] = ee
                 if ee_des is not None:
-                    msg["ee_des"] = ee_des.tolist()
+                    msg["ee_des"] = ee_des
                 rec.write("/control", "cerebx.Control", t, msg)
             plant.step()
             self.tick += 1

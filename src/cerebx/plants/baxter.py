@@ -314,7 +314,7 @@ class BaxterArm(Plant):
         return self.data.qpos[:6].copy(), self.data.qvel[:6].copy()
 
     def apply(self, tau: np.ndarray) -> np.ndarray:
-        np.clip(tau, -self._tau_max, self._tau_max, out=self._tau)
+        np.minimum(np.maximum(tau, -self._tau_max, out=self._tau), self._tau_max, out=self._tau)
         self.data.ctrl[:] = self._tau
         return self._tau.copy()
 

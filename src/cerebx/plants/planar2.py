@@ -73,7 +73,7 @@ class Planar2Arm(Plant):
         return self.data.qpos.copy(), self.data.qvel.copy()
 
     def apply(self, tau: np.ndarray) -> np.ndarray:
-        applied = np.clip(tau, -self._limit, self._limit)
+        applied = np.minimum(np.maximum(tau, -self._limit), self._limit)
         self.data.ctrl[:] = applied
         return applied
 

@@ -9,7 +9,6 @@ from typing import Any
 
 from mcap.decoder import DecoderFactory
 from mcap.reader import make_reader
-from mcap_protobuf.decoder import DecoderFactory as ProtobufDecoderFactory
 
 from cerebx.errors import CerebxError
 
@@ -28,7 +27,7 @@ def mcap_path(path: Path | str) -> Path:
 
 def _reader(fh):
     try:
-        return make_reader(fh, decoder_factories=[ProtobufDecoderFactory(), JsonDecoderFactory()])
+        return make_reader(fh, decoder_factories=[JsonDecoderFactory()])
     except Exception as err:  # mcap raises several types for bad files
         raise CerebxError(f"{fh.name}: not a readable MCAP file ({err})") from None
 

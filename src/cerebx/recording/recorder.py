@@ -1,6 +1,6 @@
 """Writes a run's MCAP file through foxglove-sdk (a Rust MCAP writer, fast enough for every 2 ms
-step): Foxglove ``JointStates`` (protobuf) for the joint channels so Foxglove shows them natively,
-JSON with JSON-Schema schemas for everything else.
+step). Every channel is JSON (encoded with orjson) with a JSON Schema; the joint channels use the
+well-known ``foxglove.JointStates`` schema so Foxglove shows them natively.
 
 Channels (units SI; time stamps are simulated time):
 
@@ -32,9 +32,8 @@ from typing import Any
 
 import foxglove
 import numpy as np
-from foxglove.channels import JointStatesChannel
+import orjson
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
-from foxglove.messages import JointState, JointStates, Timestamp
 
 from cerebx import __version__
 
@@ -42,6 +41,17 @@ _TIME = {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"
 _NUMS = {"type": "array", "items": {"type": "number"}}
 
 SCHEMAS: dict[str, dict] = {
+    "foxglove.JointStates": {
+        "title": "foxglove.JointStates",
+        "description": "Joint positions (rad), velocities (rad/s) and efforts (N·m)",
+        "type": "object",
+        "properties": {
+            "timestamp": _TIME,
+            "joints": {"type": "array", "items": {"type": "object", "properties": {
+                "name": {"type": "string"}, "position": {"type": "number"},
+                "velocity": {"type": "number"}, "effort": {"type": "number"}}}},
+        },
+    },
     "cerebx.Control": {
         "type": "object",
         "properties": {"t": {"type": "number"}, "trial": {"type": "integer"}, "tau_controller": _NUMS,
@@ -65,6 +75,9 @@ SCHEMAS: dict[str, dict] = {
 _COMPRESSION = {"zstd": MCAPCompression.Zstd, "lz4": MCAPCompression.Lz4, "none": None}
 
 
+_NUMPY = orjson.OPT_SERIALIZE_NUMPY
+
+
 def _ns(t_s: float) -> int:
     return int(round(t_s * 1e9))
 
@@ -80,7 +93,6 @@ class Recorder:
                                 compression_threads=0, profile="")
         self._w = foxglove.open_mcap(self.path, allow_overwrite=True, context=self._ctx, writer_options=opts)
         self._channels: dict[str, foxglove.Channel] = {}
-        self._joint_channels: dict[str, JointStatesChannel] = {}
         self.joint_names = tuple(joint_names)
         self.closed = False
 
@@ -95,23 +107,22 @@ class Recorder:
         return ch
 
     def write(self, topic: str, schema: str, t_s: float, msg: dict[str, Any]) -> None:
-        self._channel(topic, schema).log(json.dumps(msg, separators=(",", ":")).encode(), log_time=_ns(t_s))
+        """Log ``msg`` (numpy arrays allowed) on ``topic`` at simulated time ``t_s``."""
+        self._channel(topic, schema).log(orjson.dumps(msg, option=_NUMPY), log_time=_ns(t_s))
 
     def joint_states(self, topic: str, t_s: float, q: np.ndarray, qd: np.ndarray,
                      effort: np.ndarray | None = None) -> None:
-        ch = self._joint_channels.get(topic)
-        if ch is None:
-            ch = self._joint_channels[topic] = JointStatesChannel(topic, context=self._ctx)
         ns = _ns(t_s)
         sec, nsec = divmod(ns, 1_000_000_000)
         qs, qds = q.tolist(), qd.tolist()
         es = effort.tolist() if effort is not None else [0.0] * len(qs)
-        joints = [JointState(name=n, position=a, velocity=b, effort=c)
+        joints = [{"name": n, "position": a, "velocity": b, "effort": c}
                   for n, a, b, c in zip(self.joint_names, qs, qds, es)]
-        ch.log(JointStates(timestamp=Timestamp(sec=sec, nsec=nsec), joints=joints), log_time=ns)
+        self._channel(topic, "foxglove.JointStates").log(
+            orjson.dumps({"timestamp": {"sec": sec, "nsec": nsec}, "joints": joints}), log_time=ns)
 
     def spikes(self, topic: str, t_s: float, indices: np.ndarray) -> None:
-        self.write(topic, "cerebx.Spikes", t_s, {"t": t_s, "indices": np.asarray(indices).tolist()})
+        self.write(topic, "cerebx.Spikes", t_s, {"t": t_s, "indices": np.asarray(indices)})
 
     def metadata(self, name: str, data: dict[str, str]) -> None:
         self._w.write_metadata(name, {k: str(v) for k, v in data.items()})

@@ -80,6 +80,9 @@ class PositionController(_ControllerCommon):
     kp: tuple[float, ...] = (700.0, 1000.0, 450.0, 550.0, 100.0, 90.0)
     kd: tuple[float, ...] = (25.0, 40.0, 10.0, 12.0, 2.0, 2.0)
     gravity_compensation: bool = True
+    velocity_feedforward: bool = Field(
+        True, description="track the desired velocity; off = position-only commands (damping toward rest)"
+    )
     tau_max_Nm: tuple[PositiveFloat, ...] = (50.0, 100.0, 50.0, 50.0, 15.0, 15.0)
 
     @property
