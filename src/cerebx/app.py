@@ -28,7 +28,8 @@ def run_app(cfg: DictConfig) -> float | None:
         for line in err.problems:
             print(line, file=sys.stderr)
         raise SystemExit(2) from None
-    summary = run_experiment(exp, run_dir, plain, overrides=list(hc.overrides.task))
+    choices = {k: v for k, v in hc.runtime.choices.items() if not k.startswith("hydra") and v is not None}
+    summary = run_experiment(exp, run_dir, plain, overrides=list(hc.overrides.task), choices=choices)
     print_summary(summary, run_dir)
     if summary["status"] == "failed":
         raise SystemExit(1)

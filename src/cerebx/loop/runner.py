@@ -187,7 +187,7 @@ def _write_json_atomic(path: Path, data: dict) -> None:
 
 
 def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
-                   overrides: list[str] | None = None) -> dict:
+                   overrides: list[str] | None = None, choices: dict[str, str] | None = None) -> dict:
     """Run ``cfg`` into ``run_dir``: writes run.mcap, summary.json and the controller state."""
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
@@ -199,6 +199,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
         "seed": cfg.seed, "trials": cfg.trials, "trials_completed": 0, "mae_per_trial": [],
         "final_mae": None, "sim_seconds": 0.0, "wall_seconds": 0.0, "rt_factor": None,
         "version": __version__, "overrides": list(overrides or []), "started_at": started, "error": None,
+        "presets": dict(choices or {}),
     }
     rec = Recorder(run_dir / "run.mcap", chunk_size_kb=cfg.recording.chunk_size_kb,
                    compression=cfg.recording.compression)

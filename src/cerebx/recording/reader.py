@@ -13,6 +13,11 @@ from mcap.reader import make_reader
 from cerebx.errors import CerebxError
 
 
+def _short(err: Exception) -> str:
+    text = str(err).splitlines()[0] if str(err) else ""
+    return f"{type(err).__name__}: {text[:100]}" + ("…" if len(text) > 100 else "")
+
+
 class JsonDecoderFactory(DecoderFactory):
     """mcap ships no JSON decoder: JSON channels decode with json.loads."""
 
@@ -29,7 +34,7 @@ def _reader(fh):
     try:
         return make_reader(fh, decoder_factories=[JsonDecoderFactory()])
     except Exception as err:  # mcap raises several types for bad files
-        raise CerebxError(f"{fh.name}: not a readable MCAP file ({err})") from None
+        raise CerebxError(f"{fh.name}: not a readable MCAP file ({_short(err)})") from None
 
 
 def read_messages(path: Path | str, topics: list[str] | None = None) -> Iterator[tuple[str, int, Any]]:
@@ -45,7 +50,7 @@ def read_messages(path: Path | str, topics: list[str] | None = None) -> Iterator
         except CerebxError:
             raise
         except Exception as err:
-            raise CerebxError(f"{p}: damaged MCAP file ({type(err).__name__}: {err})") from None
+            raise CerebxError(f"{p}: damaged MCAP file ({_short(err)})") from None
 
 
 def channel_counts(path: Path | str) -> dict[str, int]:
@@ -59,7 +64,7 @@ def channel_counts(path: Path | str) -> dict[str, int]:
         except CerebxError:
             raise
         except Exception as err:
-            raise CerebxError(f"{p}: damaged MCAP file ({type(err).__name__}: {err})") from None
+            raise CerebxError(f"{p}: damaged MCAP file ({_short(err)})") from None
         if summary is None or summary.statistics is None:
             raise CerebxError(f"{p}: MCAP file has no summary (was the run killed?)")
         return {summary.channels[cid].topic: n for cid, n in sorted(summary.statistics.channel_message_counts.items())}
@@ -73,7 +78,7 @@ def read_metadata(path: Path | str) -> dict[str, dict[str, str]]:
         except CerebxError:
             raise
         except Exception as err:
-            raise CerebxError(f"{p}: damaged MCAP file ({type(err).__name__}: {err})") from None
+            raise CerebxError(f"{p}: damaged MCAP file ({_short(err)})") from None
 
 
 def read_summary(run_dir: Path | str) -> dict[str, Any]:

@@ -37,47 +37,43 @@ from cerebx.snn.topology import (
     P_VTH,
 )
 
-CHUNK = 1024
 G_FLOOR = np.float32(1e-12)  # conductances below this (nS) become exactly 0 (avoids denormals)
 
 
 @njit(cache=True, parallel=True, fastmath=True, error_model="numpy", boundscheck=False)
-def _lif_ampa(V, gA, ref, flag, chunk_n, lo, hi, p):
-    """Neurons with a single (AMPA) conductance: vectorisable RK4 substep over [lo, hi)."""
+def _lif_ampa(V, gA, ref, flag, p):
+    """Neurons with a single (AMPA) conductance: vectorised RK4 substep. Arguments are the
+    population's slices (a loop over an array's own length lets LLVM vectorise it)."""
     f32 = np.float32
     h, half, sixth = f32(p[P_H]), f32(0.5), f32(1.0 / 6.0)
     gL, EL, EA, invC = f32(p[P_GL]), f32(p[P_EL]), f32(p[P_EA]), f32(1.0 / p[P_CM])
     dA, dAh, Vth, nref = f32(p[P_DA]), f32(p[P_DAH]), f32(p[P_VTH]), f32(p[P_NREF])
     floor = EL if p[P_CLAMP] > 0.5 else f32(-1e30)
     zero, one, two = f32(0.0), f32(1.0), f32(2.0)
-    n_chunks = (hi - lo + CHUNK - 1) // CHUNK
-    for c in prange(n_chunks):
-        a = lo + c * CHUNK
-        b = min(a + CHUNK, hi)
-        cnt = 0
-        for i in range(a, b):
-            v = V[i]
-            g0 = gA[i]
-            r = ref[i]
-            gh = g0 * dAh
-            g1 = g0 * dA
-            k1 = (gL * (EL - v) + g0 * (EA - v)) * invC
-            v2 = v + half * h * k1
-            k2 = (gL * (EL - v2) + gh * (EA - v2)) * invC
-            v3 = v + half * h * k2
-            k3 = (gL * (EL - v3) + gh * (EA - v3)) * invC
-            v4 = v + h * k3
-            k4 = (gL * (EL - v4) + g1 * (EA - v4)) * invC
-            vn = v + h * sixth * (k1 + two * k2 + two * k3 + k4)
-            vn = vn if vn > floor else floor
-            refr = r > zero
-            s = (vn >= Vth) and not refr
-            V[i] = EL if (refr or s) else vn
-            ref[i] = nref if s else (r - one if refr else zero)
-            gA[i] = g1 if g1 > G_FLOOR else zero
-            flag[i] = np.uint8(1) if s else np.uint8(0)
-            cnt += 1 if s else 0
-        chunk_n[c] = cnt
+    cnt = 0
+    for i in prange(V.shape[0]):
+        v = V[i]
+        g0 = gA[i]
+        r = ref[i]
+        gh = g0 * dAh
+        g1 = g0 * dA
+        k1 = (gL * (EL - v) + g0 * (EA - v)) * invC
+        v2 = v + half * h * k1
+        k2 = (gL * (EL - v2) + gh * (EA - v2)) * invC
+        v3 = v + half * h * k2
+        k3 = (gL * (EL - v3) + gh * (EA - v3)) * invC
+        v4 = v + h * k3
+        k4 = (gL * (EL - v4) + g1 * (EA - v4)) * invC
+        vn = v + h * sixth * (k1 + two * k2 + two * k3 + k4)
+        vn = vn if vn > floor else floor
+        refr = r > zero
+        s = (vn >= Vth) and not refr
+        V[i] = EL if (refr or s) else vn
+        ref[i] = nref if s else (r - one if refr else zero)
+        gA[i] = g1 if g1 > G_FLOOR else zero
+        flag[i] = s
+        cnt += s
+    return cnt
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
@@ -86,64 +82,69 @@ def _dvdt(v, gA, gN, gG, gL, EL, EA, EG, invC):
     return (gL * (EL - v) + (gA + gN * mg) * (EA - v) + gG * (EG - v)) * invC
 
 
-@njit(cache=True, parallel=True, fastmath=True, error_model="numpy", boundscheck=False)
-def _lif_full(V, gA, gN, gG, ref, flag, chunk_n, lo, hi, p):
-    """Neurons with AMPA, NMDA (Mg block, Eq. 2.8) and GABA conductances: RK4 substep."""
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _lif_full(V, gA, gN, gG, ref, flag, p):
+    """Neurons with AMPA, NMDA (Mg block, Eq. 2.8) and GABA conductances: RK4 substep in float64."""
     h = p[P_H]
     gL, EL, EA, EG, invC = p[P_GL], p[P_EL], p[P_EA], p[P_EG], 1.0 / p[P_CM]
     Vth, nref = p[P_VTH], p[P_NREF]
     clamp = p[P_CLAMP] > 0.5
-    n_chunks = (hi - lo + CHUNK - 1) // CHUNK
-    for c in prange(n_chunks):
-        a = lo + c * CHUNK
-        b = min(a + CHUNK, hi)
-        cnt = 0
-        for i in range(a, b):
-            v = np.float64(V[i])
-            a0, n0, b0 = np.float64(gA[i]), np.float64(gN[i]), np.float64(gG[i])
-            ah, nh, bh = a0 * p[P_DAH], n0 * p[P_DNH], b0 * p[P_DGH]
-            a1, n1, b1 = a0 * p[P_DA], n0 * p[P_DN], b0 * p[P_DG]
-            k1 = _dvdt(v, a0, n0, b0, gL, EL, EA, EG, invC)
-            k2 = _dvdt(v + 0.5 * h * k1, ah, nh, bh, gL, EL, EA, EG, invC)
-            k3 = _dvdt(v + 0.5 * h * k2, ah, nh, bh, gL, EL, EA, EG, invC)
-            k4 = _dvdt(v + h * k3, a1, n1, b1, gL, EL, EA, EG, invC)
-            vn = v + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-            if clamp and vn < EL:
-                vn = EL
-            r = ref[i]
-            s = False
-            if r > 0:
-                vn = EL
-                ref[i] = r - 1
-            elif vn >= Vth:
-                s = True
-                vn = EL
-                ref[i] = nref
-            V[i] = vn
-            gA[i] = a1 if a1 > G_FLOOR else 0.0
-            gN[i] = n1 if n1 > G_FLOOR else 0.0
-            gG[i] = b1 if b1 > G_FLOOR else 0.0
-            flag[i] = 1 if s else 0
-            cnt += 1 if s else 0
-        chunk_n[c] = cnt
+    cnt = 0
+    for i in range(V.shape[0]):
+        v = np.float64(V[i])
+        a0, n0, b0 = np.float64(gA[i]), np.float64(gN[i]), np.float64(gG[i])
+        ah, nh, bh = a0 * p[P_DAH], n0 * p[P_DNH], b0 * p[P_DGH]
+        a1, n1, b1 = a0 * p[P_DA], n0 * p[P_DN], b0 * p[P_DG]
+        k1 = _dvdt(v, a0, n0, b0, gL, EL, EA, EG, invC)
+        k2 = _dvdt(v + 0.5 * h * k1, ah, nh, bh, gL, EL, EA, EG, invC)
+        k3 = _dvdt(v + 0.5 * h * k2, ah, nh, bh, gL, EL, EA, EG, invC)
+        k4 = _dvdt(v + h * k3, a1, n1, b1, gL, EL, EA, EG, invC)
+        vn = v + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        if clamp and vn < EL:
+            vn = EL
+        r = ref[i]
+        s = False
+        if r > 0:
+            vn = EL
+            ref[i] = r - 1
+        elif vn >= Vth:
+            s = True
+            vn = EL
+            ref[i] = nref
+        V[i] = vn
+        gA[i] = a1 if a1 > G_FLOOR else 0.0
+        gN[i] = n1 if n1 > G_FLOOR else 0.0
+        gG[i] = b1 if b1 > G_FLOOR else 0.0
+        flag[i] = s
+        cnt += s
+    return cnt
 
 
 @njit(cache=True, boundscheck=False)
-def _collect(flag, chunk_n, lo, hi, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp):
-    """Append the flagged neurons of [lo, hi) to the ring slot and the step's output list."""
-    n_chunks = (hi - lo + CHUNK - 1) // CHUNK
+def _collect(flag, lo, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp):
+    """Append the flagged neurons of a population (flag = its slice, lo = its first global index)
+    to the ring slot and the step's output list, scanning 8 flags per word."""
     m = ring_n[slot]
-    for c in range(n_chunks):
-        if chunk_n[c] == 0:
+    n = flag.shape[0]
+    n8 = n // 8
+    words = flag[: n8 * 8].view(np.uint64)
+    for wi in range(n8):
+        if words[wi] == 0:
             continue
-        a = lo + c * CHUNK
-        for i in range(a, min(a + CHUNK, hi)):
+        for i in range(wi * 8, wi * 8 + 8):
             if flag[i]:
-                ring_idx[slot, m] = i
+                ring_idx[slot, m] = lo + i
                 m += 1
-                out_idx[n_out] = i
+                out_idx[n_out] = lo + i
                 out_t[n_out] = stamp
                 n_out += 1
+    for i in range(n8 * 8, n):
+        if flag[i]:
+            ring_idx[slot, m] = lo + i
+            m += 1
+            out_idx[n_out] = lo + i
+            out_t[n_out] = stamp
+            n_out += 1
     ring_n[slot] = m
     return n_out
 
@@ -174,7 +175,7 @@ def _ltd(w, n_post, col, n_col, lo_w, ltd, kern, pf_t, pf_j, pf_head, t):
 
 
 @njit(cache=True, fastmath=True, boundscheck=False)
-def run_step(t0, n_sub, inputs, learn, V, g, ref, flag, chunk_n, pop_lo, pop_hi, pop_kind, pop_par,
+def run_step(t0, n_sub, inputs, learn, V, g, ref, flag, pop_lo, pop_hi, pop_kind, pop_par,
              ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w, de_i, dense_w,
              pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, out_idx, out_t):
     """Advance the network by one control step of ``n_sub`` substeps starting at substep t0.
@@ -266,8 +267,10 @@ def run_step(t0, n_sub, inputs, learn, V, g, ref, flag, chunk_n, pop_lo, pop_hi,
                 continue
             lo, hi = pop_lo[pi], pop_hi[pi]
             if kind == KIND_LIF_AMPA:
-                _lif_ampa(V, g[0], ref, flag, chunk_n, lo, hi, pop_par[pi])
+                cnt = _lif_ampa(V[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], pop_par[pi])
             else:
-                _lif_full(V, g[0], g[1], g[2], ref, flag, chunk_n, lo, hi, pop_par[pi])
-            n_out = _collect(flag, chunk_n, lo, hi, ring_idx, nxt, ring_n, out_idx, out_t, n_out, s + 1)
+                cnt = _lif_full(V[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi],
+                                pop_par[pi])
+            if cnt > 0:
+                n_out = _collect(flag[lo:hi], lo, ring_idx, nxt, ring_n, out_idx, out_t, n_out, s + 1)
     return n_out

@@ -41,7 +41,6 @@ class Network:
         self.g = np.zeros((3, n), dtype=np.float32)
         self.ref = np.zeros(n, dtype=np.float32)
         self.flag = np.zeros(n, dtype=np.uint8)
-        self.chunk_n = np.zeros(n // kernels.CHUNK + 2, dtype=np.int64)
         R = topo.max_delay + 2
         self.ring_idx = np.zeros((R, n), dtype=np.int32)
         self.ring_n = np.zeros(R, dtype=np.int64)
@@ -151,7 +150,7 @@ class Network:
         try:
             n = kernels.run_step(
                 self.t_sub, self.n_sub, inputs, self.learn, self.V, self.g, self.ref, self.flag,
-                self.chunk_n, self.pop_lo, self.pop_hi, self.pop_kind, self.pop_par,
+                self.pop_lo, self.pop_hi, self.pop_kind, self.pop_par,
                 self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
                 self.de_i, self.dense_w, self.pl_i, self.pl_f, self.kern, self.pf_t, self.pf_j,
                 self.pf_head, self.pf_lost, self.col_buf, self.out_idx, self.out_t,

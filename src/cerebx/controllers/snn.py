@@ -1,0 +1,215 @@
+"""The cerebellar spiking-network torque controller (thesis §2.2.3-2.2.7, §3.2.2-3.2.4).
+
+Pathway delay model (facts §7 "Spike timestamps"): the original stamps MF/CF spikes with the
+sample time + D and the DCN output with the network time + D. Here both are FIFOs of
+round(D / 2 ms) control steps: spikes encoded from the sample of step n enter the network at step
+n + k (afferent), and the torque the network decodes at step m is returned at step m + k
+(efferent), stamped with the step's own time. The CF error pairs the measured state with the
+desired state of the same sample time (the sensor message's stamp).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from collections import deque
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
+from cerebx.errors import StateMismatchError
+from cerebx.schema.controller import GivenRanges, SNNController
+from cerebx.snn.decoder import DCNDecoder
+from cerebx.snn.encoders import ClimbingEncoder, MossyEncoder
+from cerebx.snn.network import Network
+
+STEP_S = 0.002
+STATE_VERSION = 1
+
+
+def encoder_ranges(cfg: SNNController, n_joints: int, task: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi) of shape (n_joints, 4) for the MF signals q_d, q, qd_d, qd."""
+    r = cfg.mf.ranges
+    if isinstance(r, GivenRanges):
+        qlo, qhi = np.asarray(r.q_min), np.asarray(r.q_max)
+        lo = np.stack([qlo, qlo, np.asarray(r.qd_des_min), np.asarray(r.qd_min)], axis=1)
+        hi = np.stack([qhi, qhi, np.asarray(r.qd_des_max), np.asarray(r.qd_max)], axis=1)
+        return lo[:n_joints], hi[:n_joints]
+    if task is None:
+        raise ValueError("controller.mf.ranges: 'from_task' needs a task to derive the encoder ranges")
+    q_min, q_max, qd_min, qd_max = (np.asarray(a, dtype=float)[:n_joints] for a in task.envelope())
+
+    def widen(a, b, m):
+        span = np.maximum(b - a, 1e-3)
+        return a - m * span, b + m * span
+
+    qlo, qhi = widen(q_min, q_max, r.margin)
+    vlo, vhi = widen(qd_min, qd_max, r.velocity_margin)
+    return np.stack([qlo, qlo, vlo, vlo], axis=1), np.stack([qhi, qhi, vhi, vhi], axis=1)
+
+
+class SNNControllerImpl(Controller):
+    def __init__(self, cfg: SNNController, ctx: Any):
+        t0 = time.perf_counter()
+        self.cfg = cfg
+        self.net_cfg = ctx.cfg.network
+        self.net = Network(self.net_cfg, parallel=cfg.parallel)
+        self.net.learn = cfg.plasticity
+        io = self.net_cfg.io
+        self.sl_mf, self.sl_cf, self.sl_dcn = (self.net.index(p) for p in (io.mossy, io.climbing, io.output))
+        nj = cfg.n_joints
+        self.n_ctrl = nj
+        plant = getattr(ctx, "plant", None)
+        self.n_joints = plant.n_joints if plant is not None else nj
+        n_dcn = self.sl_dcn.stop - self.sl_dcn.start
+        n_cf = self.sl_cf.stop - self.sl_cf.start
+        if n_dcn % nj or n_cf % nj:
+            raise ValueError(f"network: {io.output} ({n_dcn}) and {io.climbing} ({n_cf}) must split "
+                             f"evenly into {nj} joints")
+        lo, hi = encoder_ranges(cfg, nj, getattr(ctx, "task", None))
+        self.mf = MossyEncoder(cfg.mf, lo, hi)
+        if self.mf.n_fibers != self.sl_mf.stop - self.sl_mf.start:
+            raise ValueError(f"network: {io.mossy} has {self.sl_mf.stop - self.sl_mf.start} fibres, the "
+                             f"encoder needs {self.mf.n_fibers} ({nj} joints x 4 signals x "
+                             f"{cfg.mf.fibers_per_signal})")
+        self._rng_seed = ctx.rng("controller.snn.cf")
+        self.cf = ClimbingEncoder(cfg.cf, nj, n_cf // nj, cfg.error.kpos, cfg.error.kvel, self._rng_seed)
+        self.decoder = DCNDecoder(cfg.decoder.alpha_Nm_per_spike, nj, n_dcn // nj)
+        self.k_delay = int(round(cfg.pathway_delay_ms / (STEP_S * 1000)))
+        self.recorder = None
+        self.record = {name: self.net.index(name) for name in cfg.record_spikes}
+        self.fingerprint = self.net.fingerprint
+        self.config_hash = hashlib.sha256(
+            json.dumps([self.net_cfg.model_dump(mode="json"), cfg.model_dump(mode="json")],
+                       sort_keys=True).encode()).hexdigest()[:16]
+        self._reset_loop_state()
+        self.build_s = time.perf_counter() - t0
+
+    # ------------------------------------------------------------------ loop
+    def _reset_loop_state(self) -> None:
+        self._in = deque([np.zeros(0, np.int32)] * self.k_delay)
+        self._out = deque([np.zeros(self.n_ctrl)] * self.k_delay)
+        self._des: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._dcn_spikes = 0
+        self._steps = 0
+        self.last_error = np.zeros(self.n_ctrl)
+
+    def reset(self, rng: np.random.Generator) -> None:
+        self.cf.rng = rng
+        self.cf.reset()
+        self.net.reset_state()
+        self._reset_loop_state()
+
+    def position_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The MF position-encoder ranges, which the original used as watchdog bounds."""
+        lo, hi = self.mf.lo[:, 1], self.mf.hi[:, 1]
+        if self.n_joints > self.n_ctrl:
+            pad = self.n_joints - self.n_ctrl
+            lo, hi = np.concatenate([lo, np.zeros(pad)]), np.concatenate([hi, np.zeros(pad)])
+        return lo.copy(), hi.copy()
+
+    def _desired_at(self, stamp_s: float, inp: ControlInput) -> tuple[np.ndarray, np.ndarray]:
+        return self._des.get(int(round(stamp_s / STEP_S)), (inp.q_des, inp.qd_des))
+
+    def step(self, inp: ControlInput) -> TorqueMsg:
+        self._des[inp.tick] = (inp.q_des, inp.qd_des)
+        self._des.pop(inp.tick - 2000, None)
+        s = inp.sensor
+        if s is None:
+            spikes_in = np.zeros(0, np.int32)
+        else:
+            q_des, qd_des = self._desired_at(s.stamp_s, inp)
+            mf = self.mf.active(q_des, s.q, qd_des, s.qd)
+            e = self.cf.error(q_des, s.q, qd_des, s.qd)
+            self.last_error = e
+            cf = self.cf.active(e)
+            spikes_in = np.concatenate([mf + self.sl_mf.start, cf + self.sl_cf.start]).astype(np.int32)
+        self._in.append(spikes_in)
+        spikes = self.net.step(self._in.popleft())
+        lo, hi = self.sl_dcn.start, self.sl_dcn.stop
+        dcn = spikes.idx[(spikes.idx >= lo) & (spikes.idx < hi)] - lo
+        self._dcn_spikes += dcn.size
+        self._steps += 1
+        self._out.append(self.decoder.torque(dcn))
+        tau_net = self._out.popleft()
+        if self.recorder is not None:
+            for name, sl in self.record.items():
+                sel = spikes.idx[(spikes.idx >= sl.start) & (spikes.idx < sl.stop)] - sl.start
+                self.recorder.spikes(f"/spikes/{name}", inp.t_s, sel)
+        tau = np.zeros(self.n_joints)
+        tau[: self.n_ctrl] = tau_net
+        return TorqueMsg(inp.t_s, tau)
+
+    # ------------------------------------------------------------------ reporting
+    def end_trial(self, trial: int) -> dict[str, float]:
+        out: dict[str, float] = {}
+        n_dcn = self.sl_dcn.stop - self.sl_dcn.start
+        if self._steps:
+            out["dcn_rate_hz"] = self._dcn_spikes / (n_dcn * self._steps * STEP_S)
+        self._dcn_spikes = self._steps = 0
+        every = self.cfg.weight_summary_every_trials
+        if every and trial % every == 0:
+            for name in self.net.plastic_projections:
+                w = self.net.weights(name)
+                out[f"w_{name}_mean"] = float(w.mean(dtype=np.float64))
+                out[f"w_{name}_std"] = float(w.std(dtype=np.float64))
+                out[f"w_{name}_min"] = float(w.min())
+                out[f"w_{name}_max"] = float(w.max())
+        lost = int(self.net.pf_lost.sum())
+        if lost:
+            out["ltd_pf_spikes_dropped"] = float(lost)
+        return out
+
+    def attach_recorder(self, recorder: Any) -> None:
+        self.recorder = recorder if hasattr(recorder, "spikes") else None
+
+    def describe(self) -> dict[str, Any]:
+        return {
+            "network": self.net_cfg.name,
+            "neurons": self.net.n_neurons,
+            "synapses": self.net.n_synapses,
+            "plastic_synapses": self.net.n_plastic,
+            "build_s": round(self.build_s, 3),
+            "pathway_delay_steps": self.k_delay,
+            "fingerprint": self.fingerprint,
+        }
+
+    # ------------------------------------------------------------------ state
+    def save_state(self, path: Path) -> None:
+        path = Path(path)
+        arrays = {f"net_{k}": v for k, v in self.net.state_arrays().items()}
+        arrays["cf_burst_left"] = self.cf.burst_left
+        arrays["out_fifo"] = np.array(list(self._out)).reshape(len(self._out), self.n_ctrl)
+        meta = {"version": STATE_VERSION, "fingerprint": self.fingerprint, "config": self.config_hash,
+                "network": self.net_cfg.name, "rng": self.cf.rng.bit_generator.state}
+        arrays["meta"] = np.array(json.dumps(meta))
+        tmp = path.with_name(path.name + ".tmp")
+        with open(tmp, "wb") as f:
+            np.savez(f, **arrays, in_fifo=np.array(json.dumps([a.tolist() for a in self._in])))
+        tmp.replace(path)
+
+    def load_state(self, path: Path) -> None:
+        path = Path(path)
+        try:
+            data = np.load(path, allow_pickle=False)
+            meta = json.loads(str(data["meta"]))
+        except Exception as exc:  # noqa: BLE001 - any unreadable file gets the same one-line message
+            raise StateMismatchError(f"{path}: not a readable cerebx SNN state ({type(exc).__name__})") from None
+        if meta.get("fingerprint") != self.fingerprint:
+            raise StateMismatchError(
+                f"{path}: saved from network {meta.get('network')!r} with a different structure "
+                f"(fingerprint {meta.get('fingerprint')}), this controller runs {self.net_cfg.name!r} "
+                f"({self.fingerprint})")
+        try:
+            self.net.load_arrays({k[4:]: data[k] for k in data.files if k.startswith("net_")})
+        except (KeyError, ValueError) as exc:
+            raise StateMismatchError(f"{path}: {exc}") from None
+        self.cf.burst_left[:] = data["cf_burst_left"]
+        self.cf.rng.bit_generator.state = meta["rng"]
+        fifo = json.loads(str(data["in_fifo"]))
+        if len(fifo) == self.k_delay:  # same pathway delay: resume exactly; otherwise start empty
+            self._in = deque(np.asarray(a, dtype=np.int32) for a in fifo)
+            self._out = deque(np.asarray(r, dtype=float) for r in data["out_fifo"])
