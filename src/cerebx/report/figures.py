@@ -44,12 +44,14 @@ def joint_tracking(run_dir: Path, s: dict, out: Path) -> Path:
     t_start = int((s["sim_seconds"] - period) * 1e9)
     series: dict[str, list] = {"/joint_states/desired": [], "/joint_states/actual": []}
     times: list[float] = []
+    names: list[str] = []
     for topic, t, msg in read_messages(run_dir, list(series)):
         if t < t_start:
             continue
         series[topic].append([j["position"] for j in msg["joints"]])
         if topic == "/joint_states/actual":
             times.append(t / 1e9)
+            names = names or [j["name"] for j in msg["joints"]]
     des, act = np.array(series["/joint_states/desired"]), np.array(series["/joint_states/actual"])
     n = min(len(des), len(act))
     if n == 0:
@@ -60,7 +62,7 @@ def joint_tracking(run_dir: Path, s: dict, out: Path) -> Path:
     for j, ax in enumerate(np.atleast_1d(axes)):
         ax.plot(tt, des[:, j], "k--", lw=1, label="desired")
         ax.plot(tt, act[:, j], "C0", lw=1.2, label="actual")
-        ax.set_title(f"joint {j + 1}", fontsize=9)
+        ax.set_title(names[j] if j < len(names) else f"joint {j + 1}", fontsize=9)
         ax.set_xlabel("t (s)", fontsize=8)
         ax.tick_params(labelsize=7)
     np.atleast_1d(axes)[0].set_ylabel("rad")

@@ -1,0 +1,80 @@
+"""Speed and memory of the spiking network alone (no plant), driven like the closed loop.
+
+A synthetic sinusoidal joint state (desired and a lagging "actual") feeds the MF box encoder
+and the CF error encoder every 2 ms, with plasticity on, so GC, PC, DCN activity, LTP and LTD
+all run as they would in an experiment.
+"""
+
+from __future__ import annotations
+
+import resource
+import time
+from typing import Any
+
+import numpy as np
+
+from cerebx.schema.controller import BoxEncoder, CFEncoder, ErrorGains
+from cerebx.schema.network import NetworkConfig
+from cerebx.snn.encoders import ClimbingEncoder, MossyEncoder
+from cerebx.snn.network import Network
+
+STEP_S = 0.002
+
+
+def peak_rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def bench_network(network_cfg: NetworkConfig, seconds: float = 3.0, warmup: float = 0.5,
+                  parallel: bool = False, seed: int = 0) -> dict[str, Any]:
+    """Build the network, run ``warmup`` then ``seconds`` of simulated time; report speed."""
+    t0 = time.perf_counter()
+    net = Network(network_cfg, parallel=parallel)
+    io = network_cfg.io
+    mf_sl, cf_sl = net.index(io.mossy), net.index(io.climbing)
+    n_mf, n_cf = mf_sl.stop - mf_sl.start, cf_sl.stop - cf_sl.start
+    F = 10 if n_mf % 40 == 0 and n_mf // 40 > 0 else 5
+    joints = n_mf // (4 * F)
+    mf = MossyEncoder(BoxEncoder(fibers_per_signal=F), -np.ones((joints, 4)), np.ones((joints, 4)))
+    gains = ErrorGains()
+    cf = ClimbingEncoder(CFEncoder(), joints, n_cf // joints, gains.kpos, gains.kvel,
+                         np.random.default_rng(seed))
+    phase = np.arange(joints)
+    net.step(np.zeros(0, np.int32))  # JIT compile / cache load counts as build
+    build_s = time.perf_counter() - t0
+
+    def drive(k: int) -> np.ndarray:
+        t = k * STEP_S
+        w = np.pi  # one 2 s period
+        q_des, qd_des = np.sin(w * t + phase), np.cos(w * t + phase)
+        q, qd = np.sin(w * (t - 0.05) + phase), np.cos(w * (t - 0.05) + phase)
+        e = cf.error(q_des, q, qd_des, qd)
+        return np.concatenate([mf.active(q_des, q, qd_des, qd) + mf_sl.start,
+                               cf.active(e) + cf_sl.start]).astype(np.int32)
+
+    n_warm, n_run = int(round(warmup / STEP_S)), int(round(seconds / STEP_S))
+    for k in range(n_warm):
+        net.step(drive(k))
+    counts: dict[str, int] = {name: 0 for name in net.topo.names}
+    bounds = [(name, net.index(name)) for name in net.topo.names]
+    t1 = time.perf_counter()
+    for k in range(n_warm, n_warm + n_run):
+        sp = net.step(drive(k))
+        for name, sl in bounds:
+            counts[name] += int(np.count_nonzero((sp.idx >= sl.start) & (sp.idx < sl.stop)))
+    wall = time.perf_counter() - t1
+    return {
+        "network": network_cfg.name,
+        "neurons": net.n_neurons,
+        "synapses": net.n_synapses,
+        "plastic_synapses": net.n_plastic,
+        "build_s": round(build_s, 3),
+        "sim_s": seconds,
+        "wall_s": round(wall, 3),
+        "rt_factor": round(seconds / wall, 2),
+        "parallel": parallel,
+        "rates_hz": {name: round(counts[name] / seconds / (sl.stop - sl.start), 2)
+                     for name, sl in bounds if net.topo.kind[net.topo.index[name]] != 0},
+        "ltd_pf_spikes_dropped": int(net.pf_lost.sum()),
+        "peak_rss_mb": round(peak_rss_mb(), 1),
+    }
