@@ -100,11 +100,11 @@ def test_lif_spike_times_match_fine_rk4(neuron, w, every):
 
 
 def test_dcn_with_nmda_and_gaba_matches_reference():
-    net = one_neuron_net(DCN, receptors=("ampa", "nmda", "gaba"), weights=(0.6, 0.3, 0.2))
+    net = one_neuron_net(DCN, receptors=("ampa", "nmda", "gaba"), weights=(2.0, 2.0, 0.3))
     n_steps = 60
     in_steps = {k: [0] for k in range(n_steps)}
     got = run_engine(net, in_steps, n_steps)
-    events = [(k * 2.0 + 1.0, r, w) for k in in_steps for r, w in ((0, 0.6), (1, 0.3), (2, 0.2))]
+    events = [(k * 2.0 + 1.0, r, w) for k in in_steps for r, w in ((0, 2.0), (1, 2.0), (2, 0.3))]
     ref_grid, _ = reference(DCN, events, n_steps * 2.0)
     assert len(got) > 3
     np.testing.assert_allclose(got, ref_grid, atol=1e-9)
@@ -138,7 +138,7 @@ def test_subthreshold_voltage_matches_reference():
 def test_spike_arrives_exactly_one_delay_later(delay_ms):
     """A fibre spike at t = 0 opens the conductance at exactly t = delay; a huge weight makes the
     neuron fire at the end of that substep."""
-    net = one_neuron_net(GC, weights=(50.0,), delay_ms=delay_ms)
+    net = one_neuron_net(GC, weights=(3.0,), delay_ms=delay_ms)
     got = run_engine(net, {0: [0]}, 4)
     assert got[0] == pytest.approx(delay_ms + 0.5)
     net2 = one_neuron_net(GC, weights=(0.3,), delay_ms=delay_ms)

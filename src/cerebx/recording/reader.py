@@ -37,12 +37,46 @@ def _reader(fh):
         raise CerebxError(f"{fh.name}: not a readable MCAP file ({_short(err)})") from None
 
 
+def _has_summary(fh) -> bool:
+    try:
+        return make_reader(fh).get_summary() is not None
+    except Exception:
+        return False
+    finally:
+        fh.seek(0)
+
+
+def _stream_messages(fh, topics: list[str] | None) -> Iterator[tuple[str, int, Any]]:
+    """Every complete message of a file without a summary (a run in progress or hard-killed)."""
+    from mcap.records import Channel, Message
+    from mcap.stream_reader import StreamReader
+
+    channels: dict[int, Channel] = {}
+    try:
+        for rec in StreamReader(fh, skip_magic=False).records:
+            if isinstance(rec, Channel):
+                channels[rec.id] = rec
+            elif isinstance(rec, Message):
+                ch = channels.get(rec.channel_id)
+                if ch is not None and (topics is None or ch.topic in topics) and ch.message_encoding == "json":
+                    yield ch.topic, rec.log_time, json.loads(rec.data)
+    except Exception:  # the incomplete tail: stop at the last complete record
+        return
+
+
 def read_messages(path: Path | str, topics: list[str] | None = None) -> Iterator[tuple[str, int, Any]]:
-    """Yield (topic, log_time_ns, decoded message) in log-time order."""
+    """Yield (topic, log_time_ns, decoded message) in log-time order.
+
+    A file without a summary section (a run still going, or one killed with SIGKILL) is read as a
+    stream up to its last complete record.
+    """
     p = mcap_path(path)
     if not p.exists():
         raise CerebxError(f"{p}: no such file")
     with open(p, "rb") as fh:
+        if not _has_summary(fh):
+            yield from _stream_messages(fh, topics)
+            return
         reader = _reader(fh)
         try:
             for _schema, channel, message, decoded in reader.iter_decoded_messages(topics=topics):

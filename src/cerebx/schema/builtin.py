@@ -6,6 +6,7 @@ from cerebx.schema import controller as c
 from cerebx.schema import delay as d
 from cerebx.schema import plant as p
 from cerebx.schema import task as t
+from cerebx.schema.ann import ANNController
 
 registry.tasks.register(t.JointSineTask, "cerebx.tasks.joint_sine:JointSine")
 registry.tasks.register(t.CircleTask, "cerebx.tasks.cartesian:build_cartesian_task")
@@ -20,6 +21,7 @@ registry.plants.register(p.BaxterConfig, "cerebx.plants.baxter:BaxterArm")
 registry.controllers.register(c.PDController, "cerebx.controllers.pd:PD")
 registry.controllers.register(c.PositionController, "cerebx.controllers.position:PositionServo")
 registry.controllers.register(c.SNNController, "cerebx.controllers.snn:SNNControllerImpl")
+registry.controllers.register(ANNController, "cerebx.controllers.ann:ANN")
 
 registry.delays.register(d.NoDelay, "cerebx.loop.delays:build_delay")
 registry.delays.register(d.ConstantDelay, "cerebx.loop.delays:build_delay")

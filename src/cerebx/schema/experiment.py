@@ -121,9 +121,28 @@ class _ExperimentBase(Strict):
         if getattr(task, "n_joints", n) != n:
             problems.append(f"task: has {task.n_joints} joints but plant {plant.kind} has {n}")
         problems += _per_joint_lengths(controller, "controller", n)
+        if controller.kind == "snn":
+            problems += _snn_fits_network(controller, self.network, n)
         if problems:
             raise ValueError("; ".join(problems))
         return self
+
+
+def _snn_fits_network(controller: Any, net: NetworkConfig, n_joints: int) -> list[str]:
+    """The encoders and decoder must match the population sizes they drive and read."""
+    out = []
+    pops, io = net.populations, net.io
+    mf = pops.get(io.mossy)
+    need = n_joints * 4 * controller.mf.fibers_per_signal
+    if mf is not None and mf.size != need:
+        out.append(f"controller.mf.fibers_per_signal: {controller.mf.fibers_per_signal} fibres x 4 signals x "
+                   f"{n_joints} joints = {need}, but network population {io.mossy!r} has {mf.size}")
+    for name in (io.climbing, io.output):
+        p = pops.get(name)
+        if p is not None and p.size % (2 * n_joints):
+            out.append(f"network.populations.{name}.size: {p.size} is not an agonist/antagonist pair per joint "
+                       f"({n_joints} joints)")
+    return out
 
 
 def _per_joint_lengths(model: BaseModel, path: str, n: int) -> list[str]:

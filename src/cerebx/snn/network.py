@@ -8,9 +8,9 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from cerebx.snn import kernels
-from cerebx.snn.topology import Topology, build_topology, structure_fingerprint
 from cerebx.schema.network import NetworkConfig
+from cerebx.snn import kernels
+from cerebx.snn.topology import build_topology, structure_fingerprint
 
 PF_RING = 1 << 16  # buffered PF arrivals per plastic projection (must cover the kernel window)
 
@@ -87,7 +87,7 @@ class Network:
     # ------------------------------------------------------------------ state
     def reset_state(self) -> None:
         """Neurons at rest, no conductances, nothing in flight; weights are kept."""
-        for pi, name in enumerate(self.topo.names):
+        for pi in range(len(self.topo.names)):
             self.V[self.pop_lo[pi] : self.pop_hi[pi]] = self.pop_par[pi, 2]
         self.g[:] = 0
         self.ref[:] = 0

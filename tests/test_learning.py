@@ -1,0 +1,31 @@
+"""The cerebellar controller learns: later trials track better than early ones (thesis Fig. 2.6 g)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cerebx.build import build_components
+from cerebx.loop.runner import ClosedLoop
+
+
+def test_snn_learning_reduces_error_on_small_network(load):
+    cfg = load(["+task=circle", "+experiment=small_snn", "trials=30", "seed=0"])
+    ctx = build_components(cfg)
+    loop = ClosedLoop(ctx, None)
+    loop.start()
+    mae = np.array([loop.run_trial(i).mae for i in range(30)])
+    early, late = mae[:5].mean(), mae[-5:].mean()
+    assert late < 0.8 * early, mae.round(3)
+    w = ctx.extras["controller"].end_trial(29)
+    assert 0.0 <= w["w_pf_pc_min"] <= w["w_pf_pc_max"] <= 5.0
+
+
+def test_plasticity_off_does_not_learn(load):
+    cfg = load(["+task=circle", "+experiment=small_snn", "trials=8", "controller.plasticity=false"])
+    ctx = build_components(cfg)
+    loop = ClosedLoop(ctx, None)
+    loop.start()
+    mae = np.array([loop.run_trial(i).mae for i in range(8)])
+    w = ctx.extras["controller"].end_trial(7)
+    assert w["w_pf_pc_min"] == w["w_pf_pc_max"] == 2.0
+    assert mae[-3:].mean() > 0.9 * mae[:3].mean()

@@ -1,0 +1,161 @@
+"""Topology, encoders, decoder and the SNN controller contract (small networks)."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from cerebx.build import BuildContext
+from cerebx.controllers.base import ControlInput, SensorMsg
+from cerebx.controllers.snn import SNNControllerImpl
+from cerebx.errors import StateMismatchError
+from cerebx.schema.controller import BoxEncoder, CFEncoder, GivenRanges, SNNController
+from cerebx.snn.decoder import DCNDecoder
+from cerebx.snn.encoders import ClimbingEncoder, MossyEncoder
+from cerebx.snn.presets import thesis_network
+from cerebx.snn.topology import build_topology
+
+
+def test_every_mf_combination_drives_exactly_one_gc_per_joint():
+    topo = build_topology(thesis_network())
+    mf_gc = next(s for s in topo.sparse if s.name == "mf_gc")
+    gc0 = topo.slice("gc").start
+    counts = np.zeros(60000, np.int64)
+    np.add.at(counts, mf_gc.post - gc0, 1)
+    assert (counts == 4).all()  # four MFs per GC
+    assert (np.diff(mf_gc.ptr) == 1000).all()  # 1000 GCs per MF
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        j = int(rng.integers(6))
+        bins = rng.integers(10, size=4)
+        hit = np.zeros(60000, np.int64)
+        for s, b in enumerate(bins):
+            m = 40 * j + 10 * s + b
+            hit[mf_gc.post[mf_gc.ptr[m]:mf_gc.ptr[m + 1]] - gc0] += 1
+        full = np.flatnonzero(hit == 4)
+        assert full.tolist() == [10000 * j + 1000 * bins[0] + 100 * bins[1] + 10 * bins[2] + bins[3]]
+
+
+def test_mossy_box_coding():
+    lo = np.array([[0.0, 0.0, -1.0, -2.0]])
+    hi = np.array([[0.9, 0.9, 1.0, 2.0]])
+    enc = MossyEncoder(BoxEncoder(), lo, hi)
+    # centres 0, 0.1, ..., 0.9 for positions; clipped outside
+    a = enc.active(np.array([0.31]), np.array([5.0]), np.array([-3.0]), np.array([0.1]))
+    assert a.tolist() == [3, 19, 20, 35]
+    mid = enc.active(np.array([0.35]), np.array([0.0]), np.array([-1.0]), np.array([-2.0]))
+    assert 3 in mid and 4 in mid  # exact midpoint: both boxes (width 0.500000000001 step)
+
+
+def test_cf_rates_stay_between_1_and_10_hz_and_split_by_sign():
+    enc = ClimbingEncoder(CFEncoder(), 1, 100, [1.0], [0.0], np.random.default_rng(0))
+    for e in np.linspace(-0.2, 0.2, 81):
+        r = enc.rates(np.array([e]))[0]
+        side = r[:50] if e > 0 else r[50:]
+        other = r[50:] if e > 0 else r[:50]
+        assert (side >= 1.0 - 1e-12).all() and (side <= 10.0 + 1e-12).all()
+        assert (other == 0).all()
+    assert enc.rates(np.array([0.5]))[0, :50] == pytest.approx(10.0, abs=1e-3)
+    assert enc.bursts(np.array([0.0055]))[0, 0] == 5  # floor(0.0055 / 0.001)
+    # empirical event rate of fibre 0 for a large error: ~10 Hz events (bursts of 6 spikes)
+    enc2 = ClimbingEncoder(CFEncoder(), 1, 100, [1.0], [0.0], np.random.default_rng(1))
+    n = sum(int((enc2.active(np.array([0.5])) == 0).sum()) for _ in range(50000))  # 100 s
+    assert 6 * 10 * 100 * 0.85 < n < 6 * 10 * 100 * 1.15
+
+
+def test_dcn_decoder_counts_agonist_minus_antagonist():
+    dec = DCNDecoder((0.75, 1.1), 2, 100)
+    idx = np.array([0, 1, 2, 49, 50, 99, 150, 151, 160])  # joint 0: 4 ag, 2 antag; joint 1: 0 ag, 3 antag
+    np.testing.assert_allclose(dec.torque(idx), [0.75 * 2, -1.1 * 3])
+    np.testing.assert_allclose(dec.torque(np.array([], np.int64)), [0, 0])
+
+
+class _Task:
+    def envelope(self):
+        z = np.zeros(6)
+        return z - 0.5, z + 0.5, z - 1.0, z + 1.0
+
+
+def make_ctrl(fibers=5, per_joint=10, **kw) -> SNNControllerImpl:
+    net = thesis_network(fibers=fibers, per_joint=per_joint)
+    kw.setdefault("mf", BoxEncoder(fibers_per_signal=fibers))
+    ccfg = SNNController(**kw)
+    cfg = SimpleNamespace(network=net, controller=ccfg, seed=3)
+    return SNNControllerImpl(ccfg, BuildContext(cfg=cfg, task=_Task()))
+
+
+def drive(ctrl, n, t0=0):
+    taus = []
+    for k in range(t0, t0 + n):
+        t = k * 0.002
+        q = np.sin(np.pi * t) * 0.3 * np.ones(6)
+        qd = np.cos(np.pi * t) * 0.3 * np.ones(6)
+        s = SensorMsg(t, q - 0.02, qd)
+        taus.append(ctrl.step(ControlInput(k, t, q, qd, s)).tau)
+    return np.array(taus)
+
+
+def test_controller_runs_and_reports():
+    ctrl = make_ctrl(pathway_delay_ms=10.0)
+    ctrl.reset(np.random.default_rng(0))
+    tau = drive(ctrl, 200)
+    assert tau.shape == (200, 6) and np.isfinite(tau).all()
+    assert (tau[:5] == 0).all()  # efferent FIFO: nothing before the pathway delay has passed
+    summ = ctrl.end_trial(0)
+    assert summ["dcn_rate_hz"] > 0 and 0 <= summ["w_pf_pc_min"] <= summ["w_pf_pc_max"] <= 5
+    d = ctrl.describe()
+    assert d["neurons"] == 120 + 60 + 3750 + 60 + 60
+    lo, hi = ctrl.position_bounds()
+    np.testing.assert_allclose(lo, -0.5 - 0.1)
+    np.testing.assert_allclose(hi, 0.5 + 0.1)
+
+
+def test_controller_records_spikes_when_recorder_has_spikes():
+    class Rec:
+        def __init__(self):
+            self.calls = []
+
+        def spikes(self, topic, t_s, idx):
+            self.calls.append((topic, t_s, len(idx)))
+
+    ctrl = make_ctrl()
+    rec = Rec()
+    ctrl.attach_recorder(rec)
+    drive(ctrl, 30)
+    assert {c[0] for c in rec.calls} == {"/spikes/dcn"} and len(rec.calls) == 30
+
+
+def test_save_load_roundtrip_and_mismatch(tmp_path):
+    a = make_ctrl()
+    a.reset(np.random.default_rng(0))
+    drive(a, 100)
+    p = tmp_path / "state.npz"
+    a.save_state(p)
+    b = make_ctrl()
+    b.load_state(p)
+    np.testing.assert_array_equal(a.net.weights("pf_pc"), b.net.weights("pf_pc"))
+    ta, tb = drive(a, 50, 100), drive(b, 50, 100)
+    np.testing.assert_array_equal(ta, tb)  # identical continuation (state, FIFOs, rng)
+    other = make_ctrl(fibers=4, per_joint=10)
+    with pytest.raises(StateMismatchError, match="different structure"):
+        other.load_state(p)
+    bad = tmp_path / "bad.npz"
+    bad.write_bytes(b"not a state")
+    with pytest.raises(StateMismatchError, match="not a readable"):
+        b.load_state(bad)
+
+
+def test_same_seed_same_torques():
+    a, b = make_ctrl(), make_ctrl()
+    a.reset(np.random.default_rng(7))
+    b.reset(np.random.default_rng(7))
+    np.testing.assert_array_equal(drive(a, 100), drive(b, 100))
+
+
+def test_given_ranges():
+    r = GivenRanges(q_min=(-1,) * 6, q_max=(1,) * 6, qd_des_min=(-2,) * 6, qd_des_max=(2,) * 6,
+                    qd_min=(-3,) * 6, qd_max=(3,) * 6)
+    ctrl = make_ctrl(mf=BoxEncoder(fibers_per_signal=5, ranges=r))
+    assert ctrl.mf.lo[0].tolist() == [-1, -1, -2, -3]

@@ -1,0 +1,97 @@
+"""PF-PC kernel STDP (facts §2): LTP per PF spike, LTD at CF spikes weighted by the kernel."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cerebx.schema.network import NetworkConfig
+from cerebx.snn.network import Network
+from cerebx.snn.presets import PC
+from cerebx.snn.topology import ltd_kernel_table
+
+W0, LTP, LTD = 2.0, 0.002, -0.0008
+
+
+def plastic_net(n_pf=4, n_pc=3, ltp=LTP, ltd=LTD, w_range=(0.0, 5.0), peak=150.0, onset=120.0) -> Network:
+    cfg = {
+        "name": "stdp", "dt_ms": 0.5,
+        "populations": {"pf": {"size": n_pf, "neuron": {"kind": "input"}},
+                        "cf": {"size": n_pc, "neuron": {"kind": "input"}},
+                        "pc": {"size": n_pc, "neuron": PC}},
+        "projections": {
+            "pf_pc": {"pre": "pf", "post": "pc", "rule": {"kind": "all_to_all"}, "receptor": "ampa",
+                      "synapses": n_pf * n_pc, "weight_nS": W0, "weight_range_nS": list(w_range),
+                      "plasticity": {"kind": "kernel_stdp", "ltp_nS": ltp, "ltd_nS": ltd,
+                                     "kernel_peak_ms": peak, "kernel_onset_ms": onset, "teacher": "cf_pc"}},
+            "cf_pc": {"pre": "cf", "post": "pc", "rule": {"kind": "one_to_one"}, "receptor": "ampa",
+                      "synapses": n_pc, "weight_nS": 0.0, "teaching": True},
+        },
+        "io": {"mossy": "pf", "climbing": "cf", "output": "pc", "purkinje": ["pc"], "granule": "pf"},
+    }
+    return Network(NetworkConfig.model_validate(cfg), parallel=False)
+
+
+def run(net: Network, schedule: dict[int, list[tuple[str, int]]], n_steps: int) -> None:
+    for k in range(n_steps):
+        idx = [net.index(pop).start + i for pop, i in schedule.get(k, [])]
+        net.step(np.array(idx, dtype=np.int32))
+
+
+def test_kernel_table_shape():
+    k = ltd_kernel_table(150.0, 120.0, 0.01, 0.5)
+    assert k[240] == 0.0 and k[241] > 0  # zero up to the onset (120 ms)
+    assert k[300] == pytest.approx(1.0)  # peak
+    assert k.argmax() == 300
+    assert 0.34 < len(k) * 0.5 / 1000 < 0.36  # window about 0.35 s (facts §2)
+
+
+def test_pf_then_cf_at_kernel_peak_changes_weight_by_beta_plus_alpha():
+    net = plastic_net()
+    # PF 1 at t=0; CF to PC 2 at t=150 ms: both arrive one delay later, 150 ms apart (k = 1)
+    run(net, {0: [("pf", 1)], 75: [("cf", 2)]}, 80)
+    w = net.weights("pf_pc")
+    assert w[1, 2] == pytest.approx(W0 + LTP + LTD, abs=1e-6)
+    assert w[1, 0] == pytest.approx(W0 + LTP, abs=1e-6)  # no CF on PC 0: LTP only
+    assert w[0, 2] == pytest.approx(W0, abs=1e-6)  # silent PF untouched
+
+
+@pytest.mark.parametrize("cf_step", [2, 60, 250])
+def test_cf_outside_the_kernel_window_gives_no_ltd(cf_step):
+    """CF 4 ms (before onset), 120 ms (at onset, k = 0) or 500 ms (past the cutoff) after the PF."""
+    net = plastic_net()
+    run(net, {0: [("pf", 1)], cf_step: [("cf", 2)]}, cf_step + 5)
+    assert net.weights("pf_pc")[1, 2] == pytest.approx(W0 + LTP, abs=1e-6)
+
+
+def test_each_pf_spike_adds_alpha_to_every_pc():
+    net = plastic_net()
+    run(net, {k: [("pf", 3)] for k in range(0, 20, 2)}, 22)
+    np.testing.assert_allclose(net.weights("pf_pc")[3], W0 + 10 * LTP, atol=1e-5)
+
+
+def test_ltd_sums_over_buffered_pf_spikes():
+    net = plastic_net()
+    peak = ltd_kernel_table(150.0, 120.0, 0.01, 0.5)
+    # two PF spikes 150 ms and 130 ms before the CF arrival
+    run(net, {0: [("pf", 0)], 10: [("pf", 0)], 75: [("cf", 1)]}, 80)
+    want = W0 + 2 * LTP + LTD * (peak[300] + peak[260])
+    assert net.weights("pf_pc")[0, 1] == pytest.approx(want, abs=1e-6)
+
+
+def test_weights_stay_in_range():
+    net = plastic_net(ltp=0.5, ltd=-3.0, w_range=(0.5, 3.0))
+    rng = np.random.default_rng(1)
+    sched = {k: [("pf", int(j)) for j in rng.choice(4, 2, replace=False)]
+             + ([("cf", int(rng.integers(3)))] if k % 7 == 0 else []) for k in range(300)}
+    run(net, sched, 300)
+    w = net.weights("pf_pc")
+    assert w.min() >= 0.5 and w.max() <= 3.0
+    assert (w == 0.5).any() or (w == 3.0).any()
+
+
+def test_plasticity_off_freezes_weights():
+    net = plastic_net()
+    net.learn = False
+    run(net, {0: [("pf", 1)], 75: [("cf", 2)]}, 80)
+    np.testing.assert_array_equal(net.weights("pf_pc"), W0)
