@@ -15,8 +15,14 @@ from cerebx.schema.ann import ANNController
 from cerebx.schema.controller import GivenRanges
 
 NJ = 6
-RANGES = GivenRanges(q_min=(-1.0,) * NJ, q_max=(1.0,) * NJ, qd_des_min=(-2.0,) * NJ, qd_des_max=(2.0,) * NJ,
-                     qd_min=(-2.0,) * NJ, qd_max=(2.0,) * NJ)
+RANGES = GivenRanges(
+    q_min=(-1.0,) * NJ,
+    q_max=(1.0,) * NJ,
+    qd_des_min=(-2.0,) * NJ,
+    qd_des_max=(2.0,) * NJ,
+    qd_min=(-2.0,) * NJ,
+    qd_max=(2.0,) * NJ,
+)
 
 
 def _ann(**kw) -> ANN:
@@ -97,7 +103,11 @@ def test_weights_stay_in_bounds():
     ann = _ann(ltd=0.5, ltp=0.5)
     rng = np.random.default_rng(0)
     for _ in range(200):
-        ann.step(_inp(rng.uniform(-1, 1, NJ), rng.uniform(-1, 1, NJ), rng.uniform(-2, 2, NJ), rng.uniform(-2, 2, NJ)))
+        ann.step(
+            _inp(
+                rng.uniform(-1, 1, NJ), rng.uniform(-1, 1, NJ), rng.uniform(-2, 2, NJ), rng.uniform(-2, 2, NJ)
+            )
+        )
     assert ann.w.min() >= 0.0 and ann.w.max() <= 1.5 * 0.0125 + 1e-15
     assert ann.w.min() == 0.0 and ann.w.max() == pytest.approx(1.5 * 0.0125)
 

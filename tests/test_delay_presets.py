@@ -29,8 +29,15 @@ DOCUMENTED = {
     "wifi_cloud": (12.49, 2.26, 29.39, 2.51, 41.88, 3.38),
     "trace": (13.16, 1.36, 29.92, 1.43, 43.08, 2.44),
 }
-THESIS_ROUND_TRIP_MS = {"gamma15": 15, "gamma25": 25, "gamma35": 35, "gamma45": 45, "gamma55": 55,
-                        "gamma65": 65, "gamma78": 78}
+THESIS_ROUND_TRIP_MS = {
+    "gamma15": 15,
+    "gamma25": 25,
+    "gamma35": 35,
+    "gamma45": 45,
+    "gamma55": 55,
+    "gamma65": 65,
+    "gamma78": 78,
+}
 
 
 @pytest.fixture(autouse=True)
@@ -44,7 +51,10 @@ def _model(load, name: str, seed: int = 0):
 
 
 def _samples(model, n: int = 10_000) -> tuple[np.ndarray, np.ndarray]:
-    return (np.array([model.r2c.next_ms() for _ in range(n)]), np.array([model.c2r.next_ms() for _ in range(n)]))
+    return (
+        np.array([model.r2c.next_ms() for _ in range(n)]),
+        np.array([model.c2r.next_ms() for _ in range(n)]),
+    )
 
 
 def test_every_preset_is_covered():

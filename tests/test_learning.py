@@ -16,8 +16,8 @@ def test_snn_learning_reduces_error_on_small_network(load):
     mae = np.array([loop.run_trial(i).mae for i in range(30)])
     early, late = mae[:5].mean(), mae[-5:].mean()
     assert late < 0.8 * early, mae.round(3)
-    w = ctx.extras["controller"].end_trial(29)
-    assert 0.0 <= w["w_pf_pc_min"] <= w["w_pf_pc_max"] <= 5.0
+    w = ctx.extras["controller"].net.weights("pf_pc")
+    assert 0.0 <= w.min() < w.max() <= 5.0
 
 
 def test_plasticity_off_does_not_learn(load):
@@ -26,6 +26,6 @@ def test_plasticity_off_does_not_learn(load):
     loop = ClosedLoop(ctx, None)
     loop.start()
     mae = np.array([loop.run_trial(i).mae for i in range(8)])
-    w = ctx.extras["controller"].end_trial(7)
-    assert w["w_pf_pc_min"] == w["w_pf_pc_max"] == 2.0
+    w = ctx.extras["controller"].net.weights("pf_pc")
+    assert w.min() == w.max() == 2.0
     assert mae[-3:].mean() > 0.9 * mae[:3].mean()

@@ -23,12 +23,13 @@ commands:
   inspect RUN_DIR|FILE.mcap                            a run's summary and its MCAP channels
   bench [--seconds S] [--networks a,b]                 speed of plant, network and closed loop (JSON)
   report [RUN_DIR ...]                                 build reports/ from run logs
+  tune [--out PATH] OVERRIDES...                       Ziegler-Nichols PD gains on the simulated plant
 
 groups: task (required, +task=), controller (snn), plant (baxter), delay (none),
         network (thesis_ch3), experiment (presets: +experiment=NAME)
 """
 
-COMMANDS = ("run", "validate", "inspect", "bench", "report")
+COMMANDS = ("run", "validate", "inspect", "bench", "report", "tune")
 _PASS_THROUGH = ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i", "--resolve",
                  "--package", "-p", "-sc", "--shell-completion", "--config-dir", "-cd",
                  "--config-name", "-cn", "--config-path", "-cp", "--experimental-rerun")
@@ -97,7 +98,7 @@ def _inspect(args: list[str]) -> int:
 
 
 def _bench(args: list[str]) -> int:
-    from cerebx.bench import main as bench_main
+    from cerebx.bench_cli import main as bench_main
 
     print(json.dumps(bench_main(args), indent=2))
     return 0
@@ -107,6 +108,12 @@ def _report(args: list[str]) -> int:
     from cerebx.report.build import main as report_main
 
     return report_main(args)
+
+
+def _tune(args: list[str]) -> int:
+    from cerebx.tuning import main as tune_main
+
+    return tune_main(args)
 
 
 def _completion(argv: list[str]) -> int:
@@ -138,7 +145,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"cerebx {__version__}")
         return 0
     cmd, rest = argv[0], argv[1:]
-    handlers = {"run": _run, "validate": _validate, "inspect": _inspect, "bench": _bench, "report": _report}
+    handlers = {"run": _run, "validate": _validate, "inspect": _inspect, "bench": _bench, "report": _report,
+                "tune": _tune}
     if cmd not in handlers:
         return _fail([f"{cmd}: unknown command (choose from {', '.join(COMMANDS)})"])
     try:

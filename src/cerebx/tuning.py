@@ -72,7 +72,7 @@ def envelope(x: np.ndarray, dt_s: float = STEP_S, floor: float = 1e-5) -> Oscill
     cross = np.flatnonzero(s[1:] != s[:-1]) + 1
     if len(cross) < 3:
         return Oscillation(np.zeros(0), np.zeros(0))
-    peaks = np.array([np.abs(x[a:b]).max() for a, b in zip(cross[:-1], cross[1:])])
+    peaks = np.array([np.abs(x[a:b]).max() for a, b in zip(cross[:-1], cross[1:], strict=True)])
     keep = peaks > floor
     return Oscillation(peaks[keep], np.diff(cross)[keep] * dt_s)
 
@@ -86,8 +86,15 @@ class _Rig:
         self.hold_kp, self.hold_kd = hold_kp, hold_kd
         self._delay = ctx.extras["delay"]
 
-    def simulate(self, q0: np.ndarray, target: np.ndarray, tau_ff: np.ndarray, kp: np.ndarray, kd: np.ndarray,
-                 steps: int) -> tuple[np.ndarray, np.ndarray]:
+    def simulate(
+        self,
+        q0: np.ndarray,
+        target: np.ndarray,
+        tau_ff: np.ndarray,
+        kp: np.ndarray,
+        kd: np.ndarray,
+        steps: int,
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Run ``steps`` ticks of tau = tau_ff + kp (target - q) - kd qd from rest at ``q0``.
 
         Returns the true joint positions (steps, n) and the last applied torque.
@@ -124,8 +131,9 @@ class _Rig:
             raise CerebxError("tune: the hold PD cannot keep the arm still; give stiffer controller gains")
         return qs[-1].copy(), tau.copy()
 
-    def p_test(self, j: int, k: float, q_star: np.ndarray, tau_ff: np.ndarray, step_rad: float,
-               seconds: float) -> Oscillation:
+    def p_test(
+        self, j: int, k: float, q_star: np.ndarray, tau_ff: np.ndarray, step_rad: float, seconds: float
+    ) -> Oscillation:
         kp, kd = self.hold_kp.copy(), self.hold_kd.copy()
         kp[j], kd[j] = k, 0.0
         target = q_star.copy()
@@ -138,9 +146,19 @@ class _Rig:
         return envelope(x[skip:], floor=1e-3 * step_rad)
 
 
-def ultimate_gain(rig: _Rig, j: int, q_star: np.ndarray, tau_ff: np.ndarray, *, k_start: float = 1.0,
-                  k_max: float = 1e5, rel_tol: float = 0.03, step_rad: float = 0.002, seconds: float = 2.0,
-                  sustained: float = 0.97) -> tuple[float, float]:
+def ultimate_gain(
+    rig: _Rig,
+    j: int,
+    q_star: np.ndarray,
+    tau_ff: np.ndarray,
+    *,
+    k_start: float = 1.0,
+    k_max: float = 1e5,
+    rel_tol: float = 0.03,
+    step_rad: float = 0.002,
+    seconds: float = 2.0,
+    sustained: float = 0.97,
+) -> tuple[float, float]:
     """(K_u, T_u) of joint ``j``: the smallest P gain whose oscillation envelope does not decay."""
 
     def grows(k: float) -> tuple[bool, Oscillation]:
@@ -166,9 +184,16 @@ def ultimate_gain(rig: _Rig, j: int, q_star: np.ndarray, tau_ff: np.ndarray, *, 
     return hi, osc_hi.period_s
 
 
-def tune_pd(overrides: list[str], *, out: str | Path | None = DEFAULT_OUT, joints: list[int] | None = None,
-            step_rad: float = 0.002, seconds: float = 2.0, tau_max_Nm: list[float] | None = None,
-            posture: str = "task_mean") -> tuple[list[JointTuning], Any]:
+def tune_pd(
+    overrides: list[str],
+    *,
+    out: str | Path | None = DEFAULT_OUT,
+    joints: list[int] | None = None,
+    step_rad: float = 0.002,
+    seconds: float = 2.0,
+    tau_max_Nm: list[float] | None = None,
+    posture: str = "task_mean",
+) -> tuple[list[JointTuning], Any]:
     """Ziegler-Nichols PD gains for the plant composed from ``overrides``.
 
     The composed controller must be a PD: its gains hold the joints not under test and its
@@ -180,8 +205,10 @@ def tune_pd(overrides: list[str], *, out: str | Path | None = DEFAULT_OUT, joint
 
     cfg, _ = load(list(overrides))
     if not isinstance(cfg.controller, PDController):
-        raise CerebxError(f"tune: the hold controller must be a PD (got controller.kind={cfg.controller.kind!r}); "
-                          "add controller=pd or controller=pd_planar2")
+        raise CerebxError(
+            f"tune: the hold controller must be a PD (got controller.kind={cfg.controller.kind!r}); "
+            "add controller=pd or controller=pd_planar2"
+        )
     ctx = build_components(cfg)
     n = ctx.plant.n_joints
     hold = cfg.controller
@@ -202,18 +229,23 @@ def tune_pd(overrides: list[str], *, out: str | Path | None = DEFAULT_OUT, joint
         kd[j] = kp[j] * t_u / 8.0
         results.append(JointTuning(names[j], k_u, t_u, kp[j], kd[j]))
     tau_max = tuple(tau_max_Nm) if tau_max_Nm is not None else tuple(hold.tau_max_Nm[:n])
-    tuned = PDController(kp=tuple(round(v, 3) for v in kp), kd=tuple(round(v, 4) for v in kd), tau_max_Nm=tau_max)
+    tuned = PDController(
+        kp=tuple(round(v, 3) for v in kp), kd=tuple(round(v, 4) for v in kd), tau_max_Nm=tau_max
+    )
     if out is not None:
         write_preset(Path(out), tuned, results, overrides, q_star)
     return results, tuned
 
 
-def write_preset(path: Path, pd: Any, results: list[JointTuning], overrides: list[str], posture: np.ndarray) -> None:
+def write_preset(
+    path: Path, pd: Any, results: list[JointTuning], overrides: list[str], posture: np.ndarray
+) -> None:
     """Write a ``controller`` preset whose header records K_u and T_u per joint and the date."""
     lines = [
         "# PD gains from Ziegler-Nichols tuning on the simulated plant (cerebx.tuning.tune_pd,",
         f"# {datetime.date.today().isoformat()}). Overrides: {' '.join(overrides) or '(none)'}.",
-        f"# Posture (rad): [{', '.join(f'{v:.3f}' for v in posture)}]; ZN PD rule: kp = 0.8 K_u, kd = kp T_u / 8.",
+        f"# Settled posture under the hold PD (rad): [{', '.join(f'{v:.3f}' for v in posture)}].",
+        "# ZN PD rule: kp = 0.8 K_u, kd = kp T_u / 8.",
         "# joint   K_u (Nm/rad)   T_u (s)     kp        kd",
     ]
     lines += [f"# {r.joint:<7} {r.k_u:12.2f} {r.t_u:9.4f} {r.kp:9.2f} {r.kd:9.4f}" for r in results]
@@ -231,7 +263,7 @@ def write_preset(path: Path, pd: Any, results: list[JointTuning], overrides: lis
 
 
 def main(args: list[str] | None = None) -> int:
-    """``cerebx tune [--out PATH] [--joints 0,1] OVERRIDES...``: print K_u, T_u and the gains, write a preset."""
+    """``cerebx tune [--out PATH] [--joints 0,1] OVERRIDES...``: print K_u, T_u, gains; write a preset."""
     p = argparse.ArgumentParser(prog="cerebx tune", description=__doc__.splitlines()[0])
     p.add_argument("overrides", nargs="*", help="Hydra overrides, e.g. +task=circle controller=pd")
     p.add_argument("--out", default=str(DEFAULT_OUT), help="preset to write ('-' = do not write)")
@@ -243,8 +275,9 @@ def main(args: list[str] | None = None) -> int:
     joints = [int(x) for x in a.joints.split(",")] if a.joints else None
     out = None if a.out == "-" else a.out
     try:
-        results, _ = tune_pd(a.overrides, out=out, joints=joints, step_rad=a.step_rad, seconds=a.seconds,
-                             posture=a.posture)
+        results, _ = tune_pd(
+            a.overrides, out=out, joints=joints, step_rad=a.step_rad, seconds=a.seconds, posture=a.posture
+        )
     except CerebxError as err:
         print(f"error: {err}")
         return 2

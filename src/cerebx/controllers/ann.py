@@ -33,12 +33,16 @@ HISTORY_STEPS = 4096
 STATE_VERSION = 1
 
 
-def mf_ranges(ranges: GivenRanges | TaskRanges, n_joints: int, task: Any = None) -> tuple[np.ndarray, np.ndarray]:
+def mf_ranges(
+    ranges: GivenRanges | TaskRanges, n_joints: int, task: Any = None
+) -> tuple[np.ndarray, np.ndarray]:
     """(lo, hi), each (n_joints, 4), for the MF signals q_d, q, qd_d, qd."""
     if isinstance(ranges, GivenRanges):
         r = ranges
         if len(r.q_min) < n_joints or len(r.qd_min) < n_joints or len(r.qd_des_min) < n_joints:
-            raise ValueError(f"controller.ranges: given ranges cover fewer than the {n_joints} controlled joints")
+            raise ValueError(
+                f"controller.ranges: given ranges cover fewer than the {n_joints} controlled joints"
+            )
         qlo, qhi = np.asarray(r.q_min, float), np.asarray(r.q_max, float)
         lo = np.stack([qlo, qlo, np.asarray(r.qd_des_min, float), np.asarray(r.qd_min, float)], axis=1)
         hi = np.stack([qhi, qhi, np.asarray(r.qd_des_max, float), np.asarray(r.qd_max, float)], axis=1)
@@ -78,7 +82,9 @@ class ANN(Controller):
         self.w_max = cfg.w_max_factor * self.w_init
         self.pc_joint = np.repeat(np.arange(nj), 2)  # PC/IO/DCN order: ag0, an0, ag1, an1, ...
         self._rows = np.arange(2 * nj)[:, None]
-        self.config_hash = hashlib.sha256(json.dumps(cfg.model_dump(mode="json"), sort_keys=True).encode()).hexdigest()[:16]
+        self.config_hash = hashlib.sha256(
+            json.dumps(cfg.model_dump(mode="json"), sort_keys=True).encode()
+        ).hexdigest()[:16]
         self.w = np.full((2 * nj, nj * self.states_per_joint), self.w_init)
         self.reset(np.random.default_rng(0))
 
@@ -107,7 +113,10 @@ class ANN(Controller):
         b = np.floor((x - self.lo) / (self.hi - self.lo) * self.n_bins)
         b = np.clip(b, 0, self.n_bins - 1).astype(np.int64)
         base = b @ self.strides
-        cells = base[:, None, None] + (self._bin_values[None, None, :] - b[:, :, None]) * self.strides[None, :, None]
+        cells = (
+            base[:, None, None]
+            + (self._bin_values[None, None, :] - b[:, :, None]) * self.strides[None, :, None]
+        )
         cells = cells.reshape(self.n_ctrl, -1) + self._joint_offset[:, None]
         if self.cfg.joint0_overwrite:
             k = min(5, self.n_ctrl - 1)
@@ -121,7 +130,11 @@ class ANN(Controller):
 
     def _remember_desired(self, inp: ControlInput) -> None:
         i = inp.tick % HISTORY_STEPS
-        self._q_hist[i], self._qd_hist[i], self._hist_tick[i] = inp.q_des[: self.n_ctrl], inp.qd_des[: self.n_ctrl], inp.tick
+        self._q_hist[i], self._qd_hist[i], self._hist_tick[i] = (
+            inp.q_des[: self.n_ctrl],
+            inp.qd_des[: self.n_ctrl],
+            inp.tick,
+        )
 
     def _desired_at(self, stamp_s: float, inp: ControlInput) -> tuple[np.ndarray, np.ndarray]:
         tick = int(round(stamp_s / STEP_S))
@@ -158,8 +171,13 @@ class ANN(Controller):
         return TorqueMsg(inp.t_s, tau)
 
     def end_trial(self, trial: int) -> dict[str, float]:
-        out = {"w_mean": float(self.w.mean()), "w_min": float(self.w.min()), "w_max": float(self.w.max()),
-               "w_at_floor_frac": float(np.mean(self.w <= 0.0)), "w_at_ceiling_frac": float(np.mean(self.w >= self.w_max))}
+        out = {
+            "w_mean": float(self.w.mean()),
+            "w_min": float(self.w.min()),
+            "w_max": float(self.w.max()),
+            "w_at_floor_frac": float(np.mean(self.w <= 0.0)),
+            "w_at_ceiling_frac": float(np.mean(self.w >= self.w_max)),
+        }
         if self._steps:
             out["controller_mae_rad"] = float(self._abs_error_sum.mean() / self._steps)
         self._abs_error_sum[:] = 0.0
@@ -167,14 +185,25 @@ class ANN(Controller):
         return out
 
     def describe(self) -> dict[str, Any]:
-        return {"granule_cells": int(self.w.shape[1]), "active_per_joint": 4 * self.n_bins,
-                "purkinje_cells": int(self.w.shape[0]), "w_init": self.w_init, "w_max": self.w_max,
-                "pc_input": self.cfg.pc_input,
-                "joint0_overwrite": self.cfg.joint0_overwrite, "gain_Nm": list(self.cfg.gain_Nm)}
+        return {
+            "granule_cells": int(self.w.shape[1]),
+            "active_per_joint": 4 * self.n_bins,
+            "purkinje_cells": int(self.w.shape[0]),
+            "w_init": self.w_init,
+            "w_max": self.w_max,
+            "pc_input": self.cfg.pc_input,
+            "joint0_overwrite": self.cfg.joint0_overwrite,
+            "gain_Nm": list(self.cfg.gain_Nm),
+        }
 
     def save_state(self, path: Path) -> None:
         path = Path(path)
-        meta = {"version": STATE_VERSION, "kind": "ann", "config": self.config_hash, "shape": list(self.w.shape)}
+        meta = {
+            "version": STATE_VERSION,
+            "kind": "ann",
+            "config": self.config_hash,
+            "shape": list(self.w.shape),
+        }
         tmp = path.with_name(path.name + ".tmp")
         with open(tmp, "wb") as f:
             np.savez(f, w=self.w, meta=np.array(json.dumps(meta)))
@@ -187,8 +216,12 @@ class ANN(Controller):
             meta = json.loads(str(data["meta"]))
             w = data["w"]
         except Exception as exc:  # noqa: BLE001 - any unreadable file gets the same one-line message
-            raise StateMismatchError(f"{path}: not a readable cerebx ANN state ({type(exc).__name__})") from None
+            raise StateMismatchError(
+                f"{path}: not a readable cerebx ANN state ({type(exc).__name__})"
+            ) from None
         if meta.get("kind") != "ann" or tuple(w.shape) != self.w.shape:
-            raise StateMismatchError(f"{path}: ANN state of shape {tuple(w.shape)} does not fit this controller "
-                                     f"({self.w.shape}; bins and joints must match)")
+            raise StateMismatchError(
+                f"{path}: ANN state of shape {tuple(w.shape)} does not fit this controller "
+                f"({self.w.shape}; bins and joints must match)"
+            )
         self.w[...] = w

@@ -36,7 +36,9 @@ class ANNController(_ControllerCommon):
     ltp: NonNegFloat = Field(2.5e-6, description="PF-PC potentiation rate")
     ltd: NonNegFloat = Field(2.0e-5, description="PF-PC depression rate")
     w_init: PositiveFloat | None = Field(None, description="initial PF-PC weight; None = 0.2 / (4 bins)")
-    w_max_factor: PositiveFloat = Field(1.5, description="w_max = w_max_factor * w_init; weights live in [0, w_max]")
+    w_max_factor: PositiveFloat = Field(
+        1.5, description="w_max = w_max_factor * w_init; weights live in [0, w_max]"
+    )
     mf_rate: NonNegFloat = Field(1.0, description="baseline MF activity (normalised rate)")
     w_mf_dcn: NonNegFloat = 1.0
     w_pc_dcn: NonNegFloat = Field(1.0, description="PC-DCN inhibition magnitude (the weight is -w_pc_dcn)")
@@ -44,8 +46,8 @@ class ANNController(_ControllerCommon):
     plasticity: bool = True
     pc_input: Literal["all_joints", "own_joint"] = Field(
         "all_joints",
-        description="granule cells each PC sums: 'all_joints' as the original code (and Eq. 3.10, PC = f(PF)), "
-        "'own_joint' only its joint's 4n cells (then |PC| <= 0.3 and the learned torque is weak)",
+        description="granule cells each PC sums: 'all_joints' as the original code (and Eq. 3.10, "
+        "PC = f(PF)); 'own_joint' only its joint's 4n cells (then PC <= 0.3 and the learned torque is weak)",
     )
     joint0_overwrite: bool = Field(
         False,
@@ -57,8 +59,10 @@ class ANNController(_ControllerCommon):
     def _lengths(self) -> ANNController:
         n = len(self.gain_Nm)
         if not len(self.k_pos) == len(self.k_vel) == n:
-            raise ValueError(f"k_pos ({len(self.k_pos)}), k_vel ({len(self.k_vel)}) and gain_Nm ({n}) "
-                             "need one value per joint")
+            raise ValueError(
+                f"k_pos ({len(self.k_pos)}), k_vel ({len(self.k_vel)}) and gain_Nm ({n}) "
+                "need one value per joint"
+            )
         return self
 
     @property

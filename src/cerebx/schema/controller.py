@@ -179,7 +179,9 @@ class SNNController(_ControllerCommon):
     output_filter: TorqueFilter = MeanFilter()
     supervisor: Supervisor | None = Supervisor()
     record_spikes: list[str] = Field(default_factory=lambda: ["dcn"])
-    weight_summary_every_trials: int = Field(1, ge=0)
+    weight_summary_every_trials: int = Field(
+        10, ge=0, description="plastic-weight statistics every n trials (a pass over all weights); 0 = never"
+    )
 
     @property
     def n_joints(self) -> int:

@@ -14,6 +14,25 @@ from pydantic import Field, model_validator
 from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
 
 
+class Integration(Strict):
+    """How a LIF population's membrane equation is integrated. Conductances always decay exactly
+    (g <- g e^(-h/tau)); the integrator sees the exact conductance at its stage times."""
+
+    method: Literal["rk4", "rk2", "euler"] = Field(
+        "rk4", description="rk4: classical Runge-Kutta; rk2: Heun (explicit trapezoid, EDLUT RK2); "
+        "euler: forward Euler"
+    )
+    dt_ms: PositiveFloat | None = Field(
+        None, description="integration step (ms); a multiple of the network dt_ms that divides 2 ms. "
+        "None = the network dt_ms. Spikes are emitted, and input arriving between two steps takes "
+        "effect (with its exactly decayed conductance), at the step boundaries"
+    )
+    bifixed_substeps: int = Field(
+        1, ge=1, description="EDLUT Bifixed: a step that starts with V above (E_L + V_thr)/2 is "
+        "integrated as this many equal sub-steps (1 = off)"
+    )
+
+
 class LIFNeuron(Strict):
     """Conductance-based leaky integrate-and-fire neuron (thesis Eq. 2.2-2.8, Table 2.2)."""
 
@@ -30,6 +49,10 @@ class LIFNeuron(Strict):
     t_ref_ms: NonNegFloat = Field(description="refractory period (V held at E_L)")
     clamp_at_rest: bool = Field(
         False, description="clamp V >= E_L (EDLUT models 1_1 used for GC and PC do this)"
+    )
+    integration: Integration = Field(
+        default_factory=Integration,
+        description="integration method and step (default: RK4 at the network dt_ms)",
     )
 
     @model_validator(mode="after")

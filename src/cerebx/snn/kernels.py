@@ -1,15 +1,34 @@
 """numba kernels: one call advances the whole network by one 2 ms control step.
 
-Integration (thesis Eq. 2.2-2.8): conductances decay exactly (g <- g e^(-dt/tau)); the membrane
-equation is integrated with classical RK4 over each dt substep, feeding RK4 the exact
-conductance at the start, middle and end of the substep (and the NMDA Mg block at the stage
-voltage). A spike is emitted when V >= V_thr at the end of a substep; V is then reset to E_L and
-held there for t_ref. Synaptic events arrive at substep boundaries, exactly ``delay`` substeps
-after the presynaptic spike.
+Time grid: the network dt (``NetworkConfig.dt_ms``, 0.5 ms) is the substep; synaptic events arrive
+at substep boundaries, exactly ``delay`` substeps after the presynaptic spike. Spike times are
+integers in substeps (t = 0 is the start of the run). Spikes produced while integrating the
+substep t carry time t + 1 and live in ring slot (t + 1) % R until every projection has read them.
 
-Spike times are integers in substeps (t = 0 is the start of the run). Spikes produced while
-integrating substep t carry time t + 1 and live in ring slot (t + 1) % R until every projection
-has read them.
+Integration (thesis Eq. 2.2-2.8): conductances decay exactly (g <- g e^(-h/tau)). Each LIF
+population has its own step h = ratio * dt and method (``LIFNeuron.integration``: RK4, RK2 = Heun,
+or Euler; default RK4 at dt). A population integrated with ratio > 1 advances at the end of the
+substeps t with (t + 1) % ratio == 0; input that arrives in the middle of one of its steps takes
+effect at the next step boundary with its conductance decayed exactly over the time in between.
+A spike is emitted when V >= V_thr at the end of a step; V is then reset to E_L and held there
+for t_ref (rounded to whole steps).
+
+State is stored as u = V - E_L (float32). For populations with only AMPA input the step is
+u' = P(g0) u + Q(g0) with P, Q polynomials of degree <= 4 in the conductance at the step start
+(exactly the RK stages with the exact stage conductances; ``topology.step_polynomials``), so the
+update is a few FMAs per neuron and vectorises. EDLUT's Bifixed refinement (a step that starts
+with V above (E_L + V_thr)/2 is done as n equal sub-steps) is a second coefficient set.
+Populations with NMDA/GABA input (DCN) run the RK stages with the Mg block from a table (linear
+interpolation on a 0.05 mV grid, max abs error < 2e-7 against the exact expression).
+
+Resting neurons are skipped exactly: a neuron with u == 0, g == 0 and not refractory stays so
+until input arrives (every RK stage is exactly 0). Large AMPA-only populations ("compact") keep
+their non-resting neurons packed in the front of the population's slice of u/g/ref, with
+``cid`` (compact position -> global index) and ``slot`` (global index -> compact position, -1 at
+rest); delivered input activates a resting neuron by appending it, and neurons that came back
+to rest are dropped by a stable compaction at the end of a step. Conductances below 1e-12 nS and
+|u| below 1e-6 mV become exactly 0 (V itself is only resolved to 7.6e-6 mV in float32 near -65
+mV), so a neuron returns to rest a few tens of ms after its last input.
 """
 
 from __future__ import annotations
@@ -18,12 +37,19 @@ import numpy as np
 from numba import njit, prange
 
 from cerebx.snn.topology import (
+    I_COMPACT,
+    I_KIND,
+    I_LO,
+    I_NFINE,
+    I_RATIO,
     KIND_INPUT,
     KIND_LIF_AMPA,
     P_CLAMP,
     P_CM,
+    P_D1A,
     P_DA,
     P_DAH,
+    P_DFA,
     P_DG,
     P_DGH,
     P_DN,
@@ -33,98 +59,163 @@ from cerebx.snn.topology import (
     P_EL,
     P_GL,
     P_H,
+    P_METHOD,
     P_NREF,
+    P_UFINE,
     P_VTH,
 )
 
 G_FLOOR = np.float32(1e-12)  # conductances below this (nS) become exactly 0 (avoids denormals)
+U_FLOOR = np.float32(1e-6)  # |V - E_L| below this (mV) becomes exactly 0 (neuron back at rest)
+PAR_MIN = 4096  # neurons below which a population is integrated serially even when parallel
+
+# NMDA Mg block g_inf(V) = 1 / (1 + e^(-0.062 V) 1.2/3.57), V in mV: table + linear interpolation
+MG_LO, MG_STEP, MG_N = -130.0, 0.05, 3201
 
 
-@njit(cache=True, parallel=True, fastmath=True, error_model="numpy", boundscheck=False)
-def _lif_ampa(V, gA, ref, flag, p):
-    """Neurons with a single (AMPA) conductance: vectorised RK4 substep. Arguments are the
-    population's slices (a loop over an array's own length lets LLVM vectorise it)."""
+def mg_table() -> np.ndarray:
+    v = MG_LO + MG_STEP * np.arange(MG_N)
+    return (1.0 / (1.0 + np.exp(-0.062 * v) * (1.2 / 3.57))).astype(np.float32)
+
+
+# --------------------------------------------------------------------------- AMPA-only populations
+def _lif_poly_impl(u, g, ref, flag, c, dwin, dfine, nfine, ufine, uth, nref, clamp):
+    """One step of an AMPA-only population (arguments are its slices). c: float32 [2, 2, N_COEF]
+    coefficients of P and Q (lowest order first) for the step and the bifixed sub-step.
+    Returns (spikes, neurons at rest after the step)."""
     f32 = np.float32
-    h, half, sixth = f32(p[P_H]), f32(0.5), f32(1.0 / 6.0)
-    gL, EL, EA, invC = f32(p[P_GL]), f32(p[P_EL]), f32(p[P_EA]), f32(1.0 / p[P_CM])
-    dA, dAh, Vth, nref = f32(p[P_DA]), f32(p[P_DAH]), f32(p[P_VTH]), f32(p[P_NREF])
-    floor = EL if p[P_CLAMP] > 0.5 else f32(-1e30)
-    zero, one, two = f32(0.0), f32(1.0), f32(2.0)
+    p0, p1, p2, p3, p4 = c[0, 0, 0], c[0, 0, 1], c[0, 0, 2], c[0, 0, 3], c[0, 0, 4]
+    q0, q1, q2, q3, q4 = c[0, 1, 0], c[0, 1, 1], c[0, 1, 2], c[0, 1, 3], c[0, 1, 4]
+    r0, r1, r2, r3, r4 = c[1, 0, 0], c[1, 0, 1], c[1, 0, 2], c[1, 0, 3], c[1, 0, 4]
+    s0, s1, s2, s3, s4 = c[1, 1, 0], c[1, 1, 1], c[1, 1, 2], c[1, 1, 3], c[1, 1, 4]
+    lo_u = f32(0.0) if clamp else f32(-3.0e38)
+    zero, one = f32(0.0), f32(1.0)
     cnt = 0
-    for i in prange(V.shape[0]):
-        v = V[i]
-        g0 = gA[i]
+    nrest = 0
+    for i in prange(u.shape[0]):
+        x = u[i]
+        g0 = g[i]
         r = ref[i]
-        gh = g0 * dAh
-        g1 = g0 * dA
-        k1 = (gL * (EL - v) + g0 * (EA - v)) * invC
-        v2 = v + half * h * k1
-        k2 = (gL * (EL - v2) + gh * (EA - v2)) * invC
-        v3 = v + half * h * k2
-        k3 = (gL * (EL - v3) + gh * (EA - v3)) * invC
-        v4 = v + h * k3
-        k4 = (gL * (EL - v4) + g1 * (EA - v4)) * invC
-        vn = v + h * sixth * (k1 + two * k2 + two * k3 + k4)
-        vn = vn if vn > floor else floor
+        P = p0 + g0 * (p1 + g0 * (p2 + g0 * (p3 + g0 * p4)))
+        Q = q0 + g0 * (q1 + g0 * (q2 + g0 * (q3 + g0 * q4)))
+        un = P * x + Q
+        if nfine > 1:  # loop-invariant: unswitched by LLVM
+            xf = x
+            gf = g0
+            for _ in range(nfine):
+                Pf = r0 + gf * (r1 + gf * (r2 + gf * (r3 + gf * r4)))
+                Qf = s0 + gf * (s1 + gf * (s2 + gf * (s3 + gf * s4)))
+                xf = Pf * xf + Qf
+                gf = gf * dfine
+            un = xf if x > ufine else un
+        un = un if un > lo_u else lo_u
+        un = un if abs(un) >= U_FLOOR else zero
         refr = r > zero
-        s = (vn >= Vth) and not refr
-        V[i] = EL if (refr or s) else vn
-        ref[i] = nref if s else (r - one if refr else zero)
-        gA[i] = g1 if g1 > G_FLOOR else zero
+        s = (un >= uth) and not refr
+        un = zero if (refr or s) else un
+        rn = nref if s else (r - one if refr else zero)
+        g1 = g0 * dwin
+        g1 = g1 if g1 > G_FLOOR else zero
+        u[i] = un
+        ref[i] = rn
+        g[i] = g1
         flag[i] = s
         cnt += s
-    return cnt
+        nrest += (un == zero) and (g1 == zero) and (rn == zero)
+    return cnt, nrest
+
+
+_lif_poly = njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)(_lif_poly_impl)
+_lif_poly_par = njit(cache=True, parallel=True, fastmath=True, error_model="numpy",
+                     boundscheck=False)(_lif_poly_impl)
+
+
+# --------------------------------------------------------------------------- AMPA + NMDA + GABA
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _mg(v, lut):
+    x = (v - np.float32(MG_LO)) * np.float32(1.0 / MG_STEP)
+    if x >= np.float32(0.0) and x < np.float32(MG_N - 1):
+        k = int(x)
+        f = x - np.float32(k)
+        a = lut[k]
+        return a + f * (lut[k + 1] - a)
+    return np.float32(1.0) / (np.float32(1.0) + np.exp(np.float32(-0.062) * v) * np.float32(1.2 / 3.57))
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _dvdt(v, gA, gN, gG, gL, EL, EA, EG, invC):
-    mg = 1.0 / (1.0 + np.exp(-0.062 * v) * (1.2 / 3.57))
-    return (gL * (EL - v) + (gA + gN * mg) * (EA - v) + gG * (EG - v)) * invC
+def _du(x, a, n, b, gL, EL, EAL, EGL, invC, lut):
+    mg = _mg(EL + x, lut)
+    return (-gL * x + (a + n * mg) * (EAL - x) + b * (EGL - x)) * invC
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
-def _lif_full(V, gA, gN, gG, ref, flag, p):
-    """Neurons with AMPA, NMDA (Mg block, Eq. 2.8) and GABA conductances: RK4 substep in float64."""
-    h = p[P_H]
-    gL, EL, EA, EG, invC = p[P_GL], p[P_EL], p[P_EA], p[P_EG], 1.0 / p[P_CM]
-    Vth, nref = p[P_VTH], p[P_NREF]
-    clamp = p[P_CLAMP] > 0.5
+def _lif_full(u, gA, gN, gG, ref, flag, p, lut):
+    """One step of a population with AMPA, NMDA (Mg block, Eq. 2.8) and GABA conductances (float32)."""
+    f32 = np.float32
+    h = f32(p[P_H])
+    gL, EL, invC = f32(p[P_GL]), f32(p[P_EL]), f32(1.0 / p[P_CM])
+    EAL, EGL = f32(p[P_EA] - p[P_EL]), f32(p[P_EG] - p[P_EL])
+    dA, dAh, dN, dNh, dG, dGh = f32(p[P_DA]), f32(p[P_DAH]), f32(p[P_DN]), f32(p[P_DNH]), f32(p[P_DG]), f32(p[P_DGH])
+    uth, nref = f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF])
+    method = int(p[P_METHOD])
+    lo_u = f32(0.0) if p[P_CLAMP] > 0.5 else f32(-3.0e38)
+    half, sixth, two, zero, one = f32(0.5), f32(1.0 / 6.0), f32(2.0), f32(0.0), f32(1.0)
     cnt = 0
-    for i in range(V.shape[0]):
-        v = np.float64(V[i])
-        a0, n0, b0 = np.float64(gA[i]), np.float64(gN[i]), np.float64(gG[i])
-        ah, nh, bh = a0 * p[P_DAH], n0 * p[P_DNH], b0 * p[P_DGH]
-        a1, n1, b1 = a0 * p[P_DA], n0 * p[P_DN], b0 * p[P_DG]
-        k1 = _dvdt(v, a0, n0, b0, gL, EL, EA, EG, invC)
-        k2 = _dvdt(v + 0.5 * h * k1, ah, nh, bh, gL, EL, EA, EG, invC)
-        k3 = _dvdt(v + 0.5 * h * k2, ah, nh, bh, gL, EL, EA, EG, invC)
-        k4 = _dvdt(v + h * k3, a1, n1, b1, gL, EL, EA, EG, invC)
-        vn = v + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-        if clamp and vn < EL:
-            vn = EL
+    for i in range(u.shape[0]):
+        x = u[i]
+        a0, n0, b0 = gA[i], gN[i], gG[i]
+        a1, n1, b1 = a0 * dA, n0 * dN, b0 * dG
+        k1 = _du(x, a0, n0, b0, gL, EL, EAL, EGL, invC, lut)
+        if method == 2:
+            ah, nh, bh = a0 * dAh, n0 * dNh, b0 * dGh
+            k2 = _du(x + half * h * k1, ah, nh, bh, gL, EL, EAL, EGL, invC, lut)
+            k3 = _du(x + half * h * k2, ah, nh, bh, gL, EL, EAL, EGL, invC, lut)
+            k4 = _du(x + h * k3, a1, n1, b1, gL, EL, EAL, EGL, invC, lut)
+            un = x + h * sixth * (k1 + two * k2 + two * k3 + k4)
+        elif method == 1:
+            k2 = _du(x + h * k1, a1, n1, b1, gL, EL, EAL, EGL, invC, lut)
+            un = x + h * half * (k1 + k2)
+        else:
+            un = x + h * k1
+        un = un if un > lo_u else lo_u
+        un = un if abs(un) >= U_FLOOR else zero
         r = ref[i]
-        s = False
-        if r > 0:
-            vn = EL
-            ref[i] = r - 1
-        elif vn >= Vth:
-            s = True
-            vn = EL
-            ref[i] = nref
-        V[i] = vn
-        gA[i] = a1 if a1 > G_FLOOR else 0.0
-        gN[i] = n1 if n1 > G_FLOOR else 0.0
-        gG[i] = b1 if b1 > G_FLOOR else 0.0
+        refr = r > zero
+        s = (un >= uth) and not refr
+        u[i] = zero if (refr or s) else un
+        ref[i] = nref if s else (r - one if refr else zero)
+        gA[i] = a1 if a1 > G_FLOOR else zero
+        gN[i] = n1 if n1 > G_FLOOR else zero
+        gG[i] = b1 if b1 > G_FLOOR else zero
         flag[i] = s
         cnt += s
     return cnt
 
 
+# --------------------------------------------------------------------------- bookkeeping
+@njit(cache=True, boundscheck=False, inline="always")
+def _slot(i, pi, lo, slot, cid, n_act, u, g, ref):
+    """Compact position of global neuron i of population pi; activates it if it is at rest."""
+    k = slot[i]
+    if k < 0:
+        k = lo + n_act[pi]
+        n_act[pi] += 1
+        slot[i] = k
+        cid[k] = i
+        u[k] = 0.0
+        g[0, k] = 0.0
+        g[1, k] = 0.0
+        g[2, k] = 0.0
+        ref[k] = 0.0
+    return k
+
+
 @njit(cache=True, boundscheck=False)
-def _collect(flag, lo, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp):
-    """Append the flagged neurons of a population (flag = its slice, lo = its first global index)
-    to the ring slot and the step's output list, scanning 8 flags per word."""
-    m = ring_n[slot]
+def _collect(flag, ids, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp, sort):
+    """Append the flagged neurons (flag/ids: a population's compact slice) to the ring slot and
+    the step's output, 8 flags per word; with ``sort`` the appended block is put in index order."""
+    m0 = m = ring_n[slot]
+    o0 = n_out
     n = flag.shape[0]
     n8 = n // 8
     words = flag[: n8 * 8].view(np.uint64)
@@ -133,30 +224,61 @@ def _collect(flag, lo, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp):
             continue
         for i in range(wi * 8, wi * 8 + 8):
             if flag[i]:
-                ring_idx[slot, m] = lo + i
+                ring_idx[slot, m] = ids[i]
                 m += 1
-                out_idx[n_out] = lo + i
+                out_idx[n_out] = ids[i]
                 out_t[n_out] = stamp
                 n_out += 1
     for i in range(n8 * 8, n):
         if flag[i]:
-            ring_idx[slot, m] = lo + i
+            ring_idx[slot, m] = ids[i]
             m += 1
-            out_idx[n_out] = lo + i
+            out_idx[n_out] = ids[i]
             out_t[n_out] = stamp
             n_out += 1
+    if sort:  # few spikes per step: insertion sort
+        for a in range(m0 + 1, m):
+            v = ring_idx[slot, a]
+            b = a - 1
+            while b >= m0 and ring_idx[slot, b] > v:
+                ring_idx[slot, b + 1] = ring_idx[slot, b]
+                b -= 1
+            ring_idx[slot, b + 1] = v
+        for a in range(o0, n_out):
+            out_idx[a] = ring_idx[slot, m0 + a - o0]
     ring_n[slot] = m
     return n_out
 
 
+@njit(cache=True, boundscheck=False)
+def _compact(lo, na, u, g, ref, cid, slot):
+    """Drop the neurons at rest from a compact AMPA-only population (stable); returns the new count."""
+    j = lo
+    for k in range(lo, lo + na):
+        if u[k] == 0.0 and g[0, k] == 0.0 and ref[k] == 0.0:
+            slot[cid[k]] = -1
+        else:
+            if j != k:
+                u[j] = u[k]
+                g[0, j] = g[0, k]
+                ref[j] = ref[k]
+                cid[j] = cid[k]
+                slot[cid[j]] = j
+            j += 1
+    return j - lo
+
+
 @njit(cache=True, fastmath=True, boundscheck=False)
-def _ltd(w, n_post, col, n_col, lo_w, ltd, kern, pf_t, pf_j, pf_head, t):
-    """LTD for CF arrivals at time t on the PCs in col[:n_col]: for every buffered PF arrival
-    (t_pf, j) with k(t - t_pf) > 0, w[j, i] += ltd * k, clipped at lo_w."""
+def _ltd(w, n_post, col, n_col, lo_w, ltd, kern, pf_t, pf_j, pf_head, t, acc, acc_j):
+    """LTD for CF arrivals at time t on the PCs in col[:n_col]: every buffered PF arrival (t_pf, j)
+    adds ltd * k(t - t_pf) to w[j, i], clipped at lo_w. The kernel values are first summed per PF
+    (float64), so each touched weight is updated once (LTD terms are all <= 0, so clipping the sum
+    equals clipping after every term)."""
     cap = pf_t.shape[0]
     klen = kern.shape[0]
     h = pf_head
     stop = max(0, pf_head - cap)
+    nj = 0
     while h > stop:
         h -= 1
         e = h % cap
@@ -166,18 +288,26 @@ def _ltd(w, n_post, col, n_col, lo_w, ltd, kern, pf_t, pf_j, pf_head, t):
         kv = kern[m]
         if kv == 0.0:
             continue
-        dw = np.float32(ltd * kv)
-        base = pf_j[e] * n_post
+        j = pf_j[e]
+        if acc[j] == 0.0:
+            acc_j[nj] = j
+            nj += 1
+        acc[j] += kv
+    for a in range(nj):
+        j = acc_j[a]
+        dw = np.float32(ltd * acc[j])
+        acc[j] = 0.0
+        base = j * n_post
         for q in range(n_col):
             k = base + col[q]
             x = w[k] + dw
             w[k] = x if x > lo_w else lo_w
 
 
-@njit(cache=True, fastmath=True, boundscheck=False)
-def run_step(t0, n_sub, inputs, learn, V, g, ref, flag, pop_lo, pop_hi, pop_kind, pop_par,
-             ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w, de_i, dense_w,
-             pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, out_idx, out_t):
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
+def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n_rest,
+             pop_i, pop_par, poly, mg_lut, ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w, de_i, dense_w,
+             pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, acc, acc_j, out_idx, out_t):
     """Advance the network by one control step of ``n_sub`` substeps starting at substep t0.
 
     ``inputs`` are global indices of input fibres spiking at t0. Returns the number of spikes
@@ -197,43 +327,72 @@ def run_step(t0, n_sub, inputs, learn, V, g, ref, flag, pop_lo, pop_hi, pop_kind
         for p in range(sp_i.shape[0]):
             if sp_i[p, 5] != 0:
                 continue
-            pre_lo, n_pre, off, rec, delay = sp_i[p, 0], sp_i[p, 1], sp_i[p, 2], sp_i[p, 3], sp_i[p, 4]
-            if t - delay < 0:
+            pre_lo, n_pre, off, rec, delay, pp = sp_i[p, 0], sp_i[p, 1], sp_i[p, 2], sp_i[p, 3], sp_i[p, 4], sp_i[p, 6]
+            ratio = pop_i[pp, I_RATIO]
+            if t % ratio != 0:
                 continue
-            sl = (t - delay) % R
-            for k in range(ring_n[sl]):
-                j = ring_idx[sl, k] - pre_lo
-                if j < 0 or j >= n_pre:
+            plo = pop_i[pp, I_LO]
+            dec = pop_par[pp, P_D1A + rec]
+            scale = 1.0
+            for a in range(ratio):  # arrivals since the population's previous step boundary
+                ta = t - a
+                sc = np.float32(scale)
+                scale *= dec
+                if ta - delay < 0:
                     continue
-                for q in range(sp_ptr[off + j], sp_ptr[off + j + 1]):
-                    g[rec, sp_post[q]] += sp_w[q]
+                sl = (ta - delay) % R
+                for k in range(ring_n[sl]):
+                    j = ring_idx[sl, k] - pre_lo
+                    if j < 0 or j >= n_pre:
+                        continue
+                    for q in range(sp_ptr[off + j], sp_ptr[off + j + 1]):
+                        kq = _slot(sp_post[q], pp, plo, slot, cid, n_act, u, g, ref)
+                        g[rec, kq] += sp_w[q] * sc
         # dense (all-to-all) projections: a spike adds its weight row; plastic rows get LTP
         for d in range(de_i.shape[0]):
             pre_lo, n_pre, post_lo, n_post = de_i[d, 0], de_i[d, 1], de_i[d, 2], de_i[d, 3]
-            w_off, rec, delay, pl = de_i[d, 4], de_i[d, 5], de_i[d, 6], de_i[d, 7]
-            if t - delay < 0:
+            w_off, rec, delay, pl, pp = de_i[d, 4], de_i[d, 5], de_i[d, 6], de_i[d, 7], de_i[d, 8]
+            ratio = pop_i[pp, I_RATIO]
+            if t % ratio != 0:
                 continue
-            sl = (t - delay) % R
-            for k in range(ring_n[sl]):
-                j = ring_idx[sl, k] - pre_lo
-                if j < 0 or j >= n_pre:
+            compact = pop_i[pp, I_COMPACT] != 0
+            dec = pop_par[pp, P_D1A + rec]
+            scale = 1.0
+            for a in range(ratio):
+                ta = t - a
+                sc = np.float32(scale)
+                scale *= dec
+                if ta - delay < 0:
                     continue
-                row = w_off + j * n_post
-                for q in range(n_post):
-                    g[rec, post_lo + q] += dense_w[row + q]
-                if pl >= 0 and learn:
-                    ltp, hi_w = np.float32(pl_f[pl, 0]), np.float32(pl_f[pl, 3])
-                    for q in range(n_post):
-                        x = dense_w[row + q] + ltp
-                        dense_w[row + q] = x if x < hi_w else hi_w
-                if pl >= 0:
-                    cap = pf_t.shape[1]
-                    e = pf_head[pl] % cap
-                    if pf_head[pl] >= cap and t - pf_t[pl, e] < pl_i[pl, 3]:
-                        pf_lost[pl] += 1
-                    pf_t[pl, e] = t
-                    pf_j[pl, e] = j
-                    pf_head[pl] += 1
+                sl = (ta - delay) % R
+                for k in range(ring_n[sl]):
+                    j = ring_idx[sl, k] - pre_lo
+                    if j < 0 or j >= n_pre:
+                        continue
+                    row = w_off + j * n_post
+                    if compact:
+                        for q in range(n_post):
+                            kq = _slot(post_lo + q, pp, post_lo, slot, cid, n_act, u, g, ref)
+                            g[rec, kq] += dense_w[row + q] * sc
+                    elif a == 0:
+                        for q in range(n_post):
+                            g[rec, post_lo + q] += dense_w[row + q]
+                    else:
+                        for q in range(n_post):
+                            g[rec, post_lo + q] += dense_w[row + q] * sc
+                    if pl >= 0 and learn:
+                        ltp, hi_w = np.float32(pl_f[pl, 0]), np.float32(pl_f[pl, 3])
+                        for q in range(n_post):
+                            x = dense_w[row + q] + ltp
+                            dense_w[row + q] = x if x < hi_w else hi_w
+                    if pl >= 0:
+                        cap = pf_t.shape[1]
+                        e = pf_head[pl] % cap
+                        if pf_head[pl] >= cap and t - pf_t[pl, e] < pl_i[pl, 3]:
+                            pf_lost[pl] += 1
+                        pf_t[pl, e] = ta
+                        pf_j[pl, e] = j
+                        pf_head[pl] += 1
         # LTD: teacher (CF) spikes arriving now at PCs of each plastic projection
         if learn:
             for pl in range(pl_i.shape[0]):
@@ -257,20 +416,38 @@ def run_step(t0, n_sub, inputs, learn, V, g, ref, flag, pop_lo, pop_hi, pop_kind
                     k_off, k_len = pl_i[pl, 2], pl_i[pl, 3]
                     _ltd(dense_w[w_off : w_off + de_i[d, 1] * n_post], n_post, col_buf, n_col,
                          np.float32(pl_f[pl, 2]), pl_f[pl, 1], kern[k_off : k_off + k_len],
-                         pf_t[pl], pf_j[pl], pf_head[pl], t)
-        # integrate every LIF population over [t, t+1); spikes are stamped t + 1
+                         pf_t[pl], pf_j[pl], pf_head[pl], t, acc, acc_j)
+        # integrate the LIF populations whose step ends at t + 1; spikes are stamped t + 1
         nxt = (t + 1) % R
         ring_n[nxt] = 0
-        for pi in range(pop_lo.shape[0]):
-            kind = pop_kind[pi]
-            if kind == KIND_INPUT:
+        for pi in range(pop_i.shape[0]):
+            kind = pop_i[pi, I_KIND]
+            if kind == KIND_INPUT or (t + 1) % pop_i[pi, I_RATIO] != 0:
                 continue
-            lo, hi = pop_lo[pi], pop_hi[pi]
+            lo = pop_i[pi, I_LO]
+            na = n_act[pi]
+            if na == 0:
+                continue
+            hi = lo + na
+            pp = pop_par[pi]
             if kind == KIND_LIF_AMPA:
-                cnt = _lif_ampa(V[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], pop_par[pi])
+                args = (u[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], poly[pi], np.float32(pp[P_DA]),
+                        np.float32(pp[P_DFA]), pop_i[pi, I_NFINE], np.float32(pp[P_UFINE]),
+                        np.float32(pp[P_VTH] - pp[P_EL]), np.float32(pp[P_NREF]), pp[P_CLAMP] > 0.5)
+                if par and na >= PAR_MIN:
+                    cnt, nr = _lif_poly_par(*args)
+                else:
+                    cnt, nr = _lif_poly(*args)
+                n_rest[pi] = nr
             else:
-                cnt = _lif_full(V[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi],
-                                pop_par[pi])
+                cnt = _lif_full(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi],
+                                pp, mg_lut)
             if cnt > 0:
-                n_out = _collect(flag[lo:hi], lo, ring_idx, nxt, ring_n, out_idx, out_t, n_out, s + 1)
+                n_out = _collect(flag[lo:hi], cid[lo:hi], ring_idx, nxt, ring_n, out_idx, out_t, n_out,
+                                 s + 1, pop_i[pi, I_COMPACT] != 0)
+    # drop neurons that came back to rest (only worth a pass when enough of them did)
+    for pi in range(pop_i.shape[0]):
+        if pop_i[pi, I_COMPACT] != 0 and n_rest[pi] > 0 and 16 * n_rest[pi] >= n_act[pi]:
+            n_act[pi] = _compact(pop_i[pi, I_LO], n_act[pi], u, g, ref, cid, slot)
+            n_rest[pi] = 0
     return n_out

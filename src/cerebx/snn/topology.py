@@ -19,10 +19,58 @@ from cerebx.schema.network import AllToAll, JointCombinations, LIFNeuron, Networ
 RECEPTORS = {"ampa": 0, "nmda": 1, "gaba": 2}
 
 # Columns of the per-population parameter table (float64; kernels cast to float32 where hot).
-P_CM, P_GL, P_EL, P_EA, P_EG, P_DA, P_DAH, P_DN, P_DNH, P_DG, P_DGH, P_VTH, P_NREF, P_CLAMP, P_H = range(15)
-N_PAR = 15
+# P_DA/P_DAH etc. are the conductance decays over one integration step h of the population and
+# over h/2; P_D1A etc. over one network dt (used to decay input that arrives between two steps of a
+# population integrated with a longer step); P_DFA over one bifixed sub-step.
+(P_CM, P_GL, P_EL, P_EA, P_EG, P_DA, P_DAH, P_DN, P_DNH, P_DG, P_DGH, P_VTH, P_NREF, P_CLAMP, P_H,
+ P_D1A, P_D1N, P_D1G, P_DFA, P_UFINE, P_METHOD) = range(21)
+N_PAR = 21
 
 KIND_INPUT, KIND_LIF_AMPA, KIND_LIF_FULL = 0, 1, 2
+METHODS = {"euler": 0, "rk2": 1, "rk4": 2}
+
+# Columns of the per-population integer table.
+I_LO, I_HI, I_KIND, I_RATIO, I_COMPACT, I_NFINE = range(6)
+N_IPAR = 6
+N_COEF = 5  # polynomial coefficients (degree <= 4 in g) of a one-step update of an AMPA-only LIF
+
+
+def step_polynomials(method: str, h: float, C: float, gL: float, E: float, d: float, dh: float):
+    """One integration step of C du/dt = -gL u + g(t) (E - u), u = V - E_L, g(t) = g0 e^(-t/tau),
+    with the stage conductances g0, g0*dh (h/2), g0*d (h) exact, is u' = P(g0) u + Q(g0): the
+    stage values are linear in u with coefficients polynomial in g0. Returns the coefficient arrays
+    (lowest order first, length N_COEF) of P and Q, computed exactly in float64."""
+    from numpy.polynomial import Polynomial as Pn
+
+    gp = Pn([0.0, 1.0])
+    one, zero = Pn([1.0]), Pn([0.0])
+
+    def f(x, gs):  # x = (A, B): the stage state A u + B
+        a = (gL + gs) / C
+        return (-a * x[0], -a * x[1] + gs * (E / C))
+
+    def lin(x, k, s):
+        return (x[0] + s * k[0], x[1] + s * k[1])
+
+    u0 = (one, zero)
+    if method == "euler":
+        out = lin(u0, f(u0, gp), h)
+    elif method == "rk2":  # Heun: slopes at the start and at the Euler-predicted end
+        k1 = f(u0, gp)
+        k2 = f(lin(u0, k1, h), gp * d)
+        out = (u0[0] + h / 2 * (k1[0] + k2[0]), u0[1] + h / 2 * (k1[1] + k2[1]))
+    else:
+        k1 = f(u0, gp)
+        k2 = f(lin(u0, k1, h / 2), gp * dh)
+        k3 = f(lin(u0, k2, h / 2), gp * dh)
+        k4 = f(lin(u0, k3, h), gp * d)
+        out = (u0[0] + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]),
+               u0[1] + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]))
+    res = np.zeros((2, N_COEF))
+    for r, poly in enumerate(out):
+        c = poly.coef
+        res[r, : len(c)] = c
+    return res
 
 
 @dataclass
@@ -73,6 +121,8 @@ class Topology:
     hi: np.ndarray
     kind: np.ndarray  # int64 KIND_* per population
     par: np.ndarray  # float64 [n_pop, N_PAR]
+    ipar: np.ndarray  # int64 [n_pop, N_IPAR]
+    poly: np.ndarray  # float32 [n_pop, 2 (step, bifixed sub-step), 2 (P, Q), N_COEF]
     sparse: list[SparseProj]
     dense: list[DenseProj]
     dense_w: np.ndarray  # float32 flat buffer of all dense blocks
@@ -157,21 +207,44 @@ def build_topology(cfg: NetworkConfig) -> Topology:
 
     kind = np.zeros(len(names), dtype=np.int64)
     par = np.zeros((len(names), N_PAR))
+    ipar = np.zeros((len(names), N_IPAR), dtype=np.int64)
+    poly = np.zeros((len(names), 2, 2, N_COEF), dtype=np.float32)
+    ipar[:, I_LO], ipar[:, I_HI], ipar[:, I_RATIO], ipar[:, I_NFINE] = lo, hi, 1, 1
     for i, n in enumerate(names):
         nrn = cfg.populations[n].neuron
         if not isinstance(nrn, LIFNeuron):
             kind[i] = KIND_INPUT
             continue
         kind[i] = KIND_LIF_AMPA if targeted[n] <= {RECEPTORS["ampa"]} else KIND_LIF_FULL
+        integ = nrn.integration
+        h = integ.dt_ms if integ.dt_ms is not None else dt
+        ratio = int(round(h / dt))
+        if abs(h / dt - ratio) > 1e-9 or ratio < 1 or n_sub % ratio:
+            raise ValueError(f"populations.{n}.neuron.integration.dt_ms: {h} must be a multiple of the "
+                             f"network dt_ms ({dt}) that divides 2 ms")
+        h = ratio * dt
+        ipar[i, I_KIND], ipar[i, I_RATIO], ipar[i, I_NFINE] = kind[i], ratio, integ.bifixed_substeps
         par[i, P_CM], par[i, P_GL], par[i, P_EL] = nrn.C_m_pF, nrn.g_L_nS, nrn.E_L_mV
         par[i, P_EA], par[i, P_EG] = nrn.E_AMPA_mV, nrn.E_GABA_mV
         for col, tau in ((P_DA, nrn.tau_AMPA_ms), (P_DN, nrn.tau_NMDA_ms), (P_DG, nrn.tau_GABA_ms)):
-            par[i, col] = np.exp(-dt / tau)
-            par[i, col + 1] = np.exp(-0.5 * dt / tau)
+            par[i, col] = np.exp(-h / tau)
+            par[i, col + 1] = np.exp(-0.5 * h / tau)
+        par[i, P_D1A], par[i, P_D1N], par[i, P_D1G] = (np.exp(-dt / tau) for tau in
+                                                       (nrn.tau_AMPA_ms, nrn.tau_NMDA_ms, nrn.tau_GABA_ms))
+        hf = h / integ.bifixed_substeps
+        par[i, P_DFA] = np.exp(-hf / nrn.tau_AMPA_ms)
+        par[i, P_UFINE] = 0.5 * (nrn.V_thr_mV - nrn.E_L_mV) if integ.bifixed_substeps > 1 else np.inf
+        par[i, P_METHOD] = METHODS[integ.method]
         par[i, P_VTH] = nrn.V_thr_mV
-        par[i, P_NREF] = round(nrn.t_ref_ms / dt)
+        par[i, P_NREF] = round(nrn.t_ref_ms / h)
         par[i, P_CLAMP] = 1.0 if nrn.clamp_at_rest else 0.0
-        par[i, P_H] = dt
+        par[i, P_H] = h
+        E = nrn.E_AMPA_mV - nrn.E_L_mV
+        tau = nrn.tau_AMPA_ms
+        poly[i, 0] = step_polynomials(integ.method, h, nrn.C_m_pF, nrn.g_L_nS, E, np.exp(-h / tau),
+                                      np.exp(-0.5 * h / tau))
+        poly[i, 1] = step_polynomials(integ.method, hf, nrn.C_m_pF, nrn.g_L_nS, E, np.exp(-hf / tau),
+                                      np.exp(-0.5 * hf / tau))
 
     sparse: list[SparseProj] = []
     dense: list[DenseProj] = []
@@ -231,5 +304,5 @@ def build_topology(cfg: NetworkConfig) -> Topology:
             raise ValueError(f"projections.{name}: plasticity is supported on all_to_all projections only")
 
     max_delay = max([s.delay for s in sparse] + [d.delay for d in dense] + [1])
-    return Topology(cfg, n_sub, dt, names, lo, hi, kind, par, sparse, dense, dense_w, plastic,
+    return Topology(cfg, n_sub, dt, names, lo, hi, kind, par, ipar, poly, sparse, dense, dense_w, plastic,
                     max_delay, index)

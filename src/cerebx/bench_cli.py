@@ -1,0 +1,69 @@
+"""``cerebx bench``: speed of the plant with PD, of each network alone, and of the closed loop.
+
+Each network is measured in a fresh subprocess so build time (numba cache warm) and peak RSS
+belong to that network alone. Output is JSON. Numbers are simulated seconds per wall second.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from typing import Any
+
+DEFAULT_NETWORKS = ("thesis_ch3", "multikernel")
+
+
+def _one_network(name: str, seconds: float, warmup: float, parallel: bool) -> dict[str, Any]:
+    """Network alone, then the closed loop with the MuJoCo Baxter (circle task, plasticity on)."""
+    t0 = time.perf_counter()
+    from cerebx.bench import bench_network, peak_rss_mb
+    from cerebx.config import load
+    from cerebx.loop.timing import closed_loop_rt
+
+    import_s = time.perf_counter() - t0
+    exp, _ = load(["+task=circle", f"network={name}"])
+    out = bench_network(exp.network, seconds=seconds, warmup=warmup, parallel=parallel)
+    out["import_s"] = round(import_s, 3)
+    loop = closed_loop_rt(["+task=circle", f"network={name}", f"controller.parallel={str(parallel).lower()}"],
+                          seconds=seconds, warmup_s=warmup)
+    out["closed_loop"] = {k: loop[k] for k in ("build_s", "rt_factor", "us_per_step")}
+    out["peak_rss_mb"] = round(peak_rss_mb(), 1)
+    return out
+
+
+def _plant_pd(seconds: float) -> dict[str, Any]:
+    from cerebx.loop.timing import closed_loop_rt
+
+    rows = {}
+    for label, extra in (("baxter_pd", []), ("baxter_pd_physics_1ms", ["plant.physics_dt_ms=1.0"]),
+                         ("baxter_sea_pd", ["plant=baxter_sea"])):
+        r = closed_loop_rt(["+task=circle", "controller=pd", *extra], seconds=seconds, warmup_s=1.0)
+        rows[label] = {"rt_factor": r["rt_factor"], "us_per_step": r["us_per_step"]}
+    return rows
+
+
+def main(argv: list[str]) -> dict[str, Any]:
+    ap = argparse.ArgumentParser(prog="cerebx bench", description=__doc__)
+    ap.add_argument("--seconds", type=float, default=4.0, help="simulated seconds timed per measurement")
+    ap.add_argument("--warmup", type=float, default=1.0, help="simulated seconds before timing starts")
+    ap.add_argument("--networks", default=",".join(DEFAULT_NETWORKS), help="comma-separated network presets")
+    ap.add_argument("--serial", action="store_true", help="one thread in the network kernels")
+    ap.add_argument("--one", help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.one:
+        return _one_network(args.one, args.seconds, args.warmup, not args.serial)
+    import os
+
+    report: dict[str, Any] = {"cpus": os.cpu_count(), "plant_pd": _plant_pd(args.seconds), "networks": {}}
+    for name in filter(None, args.networks.split(",")):
+        cmd = [sys.executable, "-m", "cerebx.cli", "bench", "--one", name, "--seconds", str(args.seconds),
+               "--warmup", str(args.warmup)] + (["--serial"] if args.serial else [])
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        if proc.returncode != 0:
+            report["networks"][name] = {"error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}
+        else:
+            report["networks"][name] = json.loads(proc.stdout)
+    return report
