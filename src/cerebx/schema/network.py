@@ -28,8 +28,8 @@ class Integration(Strict):
         "effect (with its exactly decayed conductance), at the step boundaries"
     )
     bifixed_substeps: int = Field(
-        1, ge=1, description="EDLUT Bifixed: a step that starts with V above (E_L + V_thr)/2 is "
-        "integrated as this many equal sub-steps (1 = off)"
+        1, ge=1, description="EDLUT Bifixed: a step that starts with V above (E_L + V_thr)/2 (or whose "
+        "one-step estimate ends above it) is integrated as this many equal sub-steps (1 = off)"
     )
 
 

@@ -17,9 +17,12 @@ State is stored as u = V - E_L (float32). For populations with only AMPA input t
 u' = P(g0) u + Q(g0) with P, Q polynomials of degree <= 4 in the conductance at the step start
 (exactly the RK stages with the exact stage conductances; ``topology.step_polynomials``), so the
 update is a few FMAs per neuron and vectorises. EDLUT's Bifixed refinement (a step that starts
-with V above (E_L + V_thr)/2 is done as n equal sub-steps) is a second coefficient set.
-Populations with NMDA/GABA input (DCN) run the RK stages with the Mg block from a table (linear
-interpolation on a 0.05 mV grid, max abs error < 2e-7 against the exact expression).
+with V above (E_L + V_thr)/2 is done as n equal sub-steps) is a second coefficient set; here a
+step is also refined when its one-step estimate ends above (E_L + V_thr)/2, so a fast rise from
+below the midpoint is not integrated with the coarse step alone (both pairs are evaluated for
+every neuron anyway, so this costs nothing).
+Populations with NMDA/GABA input (DCN) run the RK stages in float32 with a branch-free Mg block
+(max abs error 1e-6 against the exact expression), so that loop vectorises too.
 
 Resting neurons are skipped exactly: a neuron with u == 0, g == 0 and not refractory stays so
 until input arrives (every RK stage is exactly 0). Large AMPA-only populations ("compact") keep
@@ -49,7 +52,6 @@ from cerebx.snn.topology import (
     P_D1A,
     P_DA,
     P_DAH,
-    P_DFA,
     P_DG,
     P_DGH,
     P_DN,
@@ -67,90 +69,135 @@ from cerebx.snn.topology import (
 
 G_FLOOR = np.float32(1e-12)  # conductances below this (nS) become exactly 0 (avoids denormals)
 U_FLOOR = np.float32(1e-6)  # |V - E_L| below this (mV) becomes exactly 0 (neuron back at rest)
+COMPACT_FRACTION = 8  # compact a population when at least 1/8 of its listed neurons are at rest
 PAR_MIN = 4096  # neurons below which a population is integrated serially even when parallel
 
-# NMDA Mg block g_inf(V) = 1 / (1 + e^(-0.062 V) 1.2/3.57), V in mV: table + linear interpolation
-MG_LO, MG_STEP, MG_N = -130.0, 0.05, 3201
+MG_LN = float(np.log(1.2 / 3.57))  # NMDA Mg block g_inf(V) = 1 / (1 + e^(-0.062 V + MG_LN)), V in mV
 
 
-def mg_table() -> np.ndarray:
-    v = MG_LO + MG_STEP * np.arange(MG_N)
-    return (1.0 / (1.0 + np.exp(-0.062 * v) * (1.2 / 3.57))).astype(np.float32)
+def mg_block(v: np.ndarray) -> np.ndarray:
+    """The kernel's Mg block (float32), for tests."""
+    return _mg_vec(np.ascontiguousarray(v, dtype=np.float32))
 
 
 # --------------------------------------------------------------------------- AMPA-only populations
-def _lif_poly_impl(u, g, ref, flag, c, dwin, dfine, nfine, ufine, uth, nref, clamp):
-    """One step of an AMPA-only population (arguments are its slices). c: float32 [2, 2, N_COEF]
-    coefficients of P and Q (lowest order first) for the step and the bifixed sub-step.
-    Returns (spikes, neurons at rest after the step)."""
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _spikes(u, ref, flag, uth, nref):
+    """Threshold, reset and refractory bookkeeping after u holds the integrated values; returns the
+    spike count (a float accumulator: integer reductions of booleans defeat the vectoriser)."""
+    zero, one = np.float32(0.0), np.float32(1.0)
+    cnt = zero
+    for i in range(u.shape[0]):
+        un = u[i]
+        r = ref[i]
+        spk = (un >= uth) & (r <= zero)
+        u[i] = zero if (r > zero) | spk else un
+        ref[i] = nref if spk else max(r - one, zero)
+        flag[i] = np.uint8(spk)
+        cnt += one if spk else zero
+    return int(cnt)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _decay(g, d):
+    """g <- g d in place, values below G_FLOOR flushed to 0."""
+    zero = np.float32(0.0)
+    for i in range(g.shape[0]):
+        x = g[i] * d
+        g[i] = x if x > G_FLOOR else zero
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _lif_poly(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp):
+    """One step of an AMPA-only population (arguments are its slices): u' = P(g0) u + Q(g0), or,
+    when ``fine`` and the step starts above ufine or its one-step estimate ends above it, the
+    bifixed pair (the n sub-steps composed). c: float32 [2, 2, N_COEF] coefficients (lowest
+    order first) of (P, Q) for the step and for the bifixed sub-steps composed.
+    Returns (spikes, neurons at rest after the step). Written as passes that each store to one or
+    two arrays and have no branches, so LLVM vectorises them (with more arrays stored in one loop
+    it gives up on the runtime alias checks)."""
     f32 = np.float32
     p0, p1, p2, p3, p4 = c[0, 0, 0], c[0, 0, 1], c[0, 0, 2], c[0, 0, 3], c[0, 0, 4]
     q0, q1, q2, q3, q4 = c[0, 1, 0], c[0, 1, 1], c[0, 1, 2], c[0, 1, 3], c[0, 1, 4]
-    r0, r1, r2, r3, r4 = c[1, 0, 0], c[1, 0, 1], c[1, 0, 2], c[1, 0, 3], c[1, 0, 4]
-    s0, s1, s2, s3, s4 = c[1, 1, 0], c[1, 1, 1], c[1, 1, 2], c[1, 1, 3], c[1, 1, 4]
+    r0, r1, r2, r3, r4, r5, r6 = c[1, 0, 0], c[1, 0, 1], c[1, 0, 2], c[1, 0, 3], c[1, 0, 4], c[1, 0, 5], c[1, 0, 6]
+    s0, s1, s2, s3, s4, s5, s6 = c[1, 1, 0], c[1, 1, 1], c[1, 1, 2], c[1, 1, 3], c[1, 1, 4], c[1, 1, 5], c[1, 1, 6]
     lo_u = f32(0.0) if clamp else f32(-3.0e38)
     zero, one = f32(0.0), f32(1.0)
+    n = u.shape[0]
+    if fine:
+        for i in range(n):
+            x = u[i]
+            g0 = g[i]
+            un = (p0 + g0 * (p1 + g0 * (p2 + g0 * (p3 + g0 * p4)))) * x + (
+                q0 + g0 * (q1 + g0 * (q2 + g0 * (q3 + g0 * q4))))
+            uf = (r0 + g0 * (r1 + g0 * (r2 + g0 * (r3 + g0 * (r4 + g0 * (r5 + g0 * r6)))))) * x + (
+                s0 + g0 * (s1 + g0 * (s2 + g0 * (s3 + g0 * (s4 + g0 * (s5 + g0 * s6))))))
+            un = uf if (x > ufine) | (un > ufine) else un
+            un = max(un, lo_u)
+            u[i] = un if abs(un) >= U_FLOOR else zero
+    else:
+        for i in range(n):
+            x = u[i]
+            g0 = g[i]
+            un = (p0 + g0 * (p1 + g0 * (p2 + g0 * (p3 + g0 * p4)))) * x + (
+                q0 + g0 * (q1 + g0 * (q2 + g0 * (q3 + g0 * q4))))
+            un = max(un, lo_u)
+            u[i] = un if abs(un) >= U_FLOOR else zero
+    cnt = _spikes(u, ref, flag, uth, nref)
+    nrest = zero
+    for i in range(n):  # conductance decay, and count the neurons now exactly at rest
+        x = g[i] * dwin
+        x = x if x > G_FLOOR else zero
+        g[i] = x
+        nrest += one if (abs(u[i]) + x + ref[i]) == zero else zero
+    return cnt, int(nrest)
+
+
+@njit(cache=True, parallel=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _lif_poly_par(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nch):
+    """:func:`_lif_poly` on numba threads: ``nch`` contiguous chunks."""
+    n = u.shape[0]
     cnt = 0
     nrest = 0
-    for i in prange(u.shape[0]):
-        x = u[i]
-        g0 = g[i]
-        r = ref[i]
-        P = p0 + g0 * (p1 + g0 * (p2 + g0 * (p3 + g0 * p4)))
-        Q = q0 + g0 * (q1 + g0 * (q2 + g0 * (q3 + g0 * q4)))
-        un = P * x + Q
-        if nfine > 1:  # loop-invariant: unswitched by LLVM
-            xf = x
-            gf = g0
-            for _ in range(nfine):
-                Pf = r0 + gf * (r1 + gf * (r2 + gf * (r3 + gf * r4)))
-                Qf = s0 + gf * (s1 + gf * (s2 + gf * (s3 + gf * s4)))
-                xf = Pf * xf + Qf
-                gf = gf * dfine
-            un = xf if x > ufine else un
-        un = un if un > lo_u else lo_u
-        un = un if abs(un) >= U_FLOOR else zero
-        refr = r > zero
-        s = (un >= uth) and not refr
-        un = zero if (refr or s) else un
-        rn = nref if s else (r - one if refr else zero)
-        g1 = g0 * dwin
-        g1 = g1 if g1 > G_FLOOR else zero
-        u[i] = un
-        ref[i] = rn
-        g[i] = g1
-        flag[i] = s
-        cnt += s
-        nrest += (un == zero) and (g1 == zero) and (rn == zero)
+    for ch in prange(nch):
+        a = ch * n // nch
+        b = (ch + 1) * n // nch
+        c1, r1 = _lif_poly(u[a:b], g[a:b], ref[a:b], flag[a:b], c, dwin, fine, ufine, uth, nref, clamp)
+        cnt += c1
+        nrest += r1
     return cnt, nrest
-
-
-_lif_poly = njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)(_lif_poly_impl)
-_lif_poly_par = njit(cache=True, parallel=True, fastmath=True, error_model="numpy",
-                     boundscheck=False)(_lif_poly_impl)
 
 
 # --------------------------------------------------------------------------- AMPA + NMDA + GABA
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _mg(v, lut):
-    x = (v - np.float32(MG_LO)) * np.float32(1.0 / MG_STEP)
-    if x >= np.float32(0.0) and x < np.float32(MG_N - 1):
-        k = int(x)
-        f = x - np.float32(k)
-        a = lut[k]
-        return a + f * (lut[k + 1] - a)
-    return np.float32(1.0) / (np.float32(1.0) + np.exp(np.float32(-0.062) * v) * np.float32(1.2 / 3.57))
+def _mg(v):
+    """Mg block 1 / (1 + e^(-0.062 v) 1.2/3.57) at v (mV), branch-free so the loop vectorises:
+    e^y = (e^(y/64))^64 with a degree-5 Taylor polynomial for e^(y/64), v clamped to [-150, 50] mV
+    (the DCN voltage stays within [E_GABA, E_AMPA]). Max abs error 1e-6 (float32 rounding of
+    the six squarings; see tests)."""
+    f32 = np.float32
+    v = min(max(v, f32(-150.0)), f32(50.0))
+    y = (f32(-0.062) * v + f32(MG_LN)) * f32(1.0 / 64.0)
+    e = f32(1.0) + y * (f32(1.0) + y * (f32(0.5) + y * (f32(1.0 / 6.0) + y * (f32(1.0 / 24.0) + y * f32(1.0 / 120.0)))))
+    e = e * e
+    e = e * e
+    e = e * e
+    e = e * e
+    e = e * e
+    e = e * e
+    return f32(1.0) / (f32(1.0) + e)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _du(x, a, n, b, gL, EL, EAL, EGL, invC, lut):
-    mg = _mg(EL + x, lut)
+def _du(x, a, n, b, gL, EL, EAL, EGL, invC):
+    mg = _mg(EL + x)
     return (-gL * x + (a + n * mg) * (EAL - x) + b * (EGL - x)) * invC
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
-def _lif_full(u, gA, gN, gG, ref, flag, p, lut):
-    """One step of a population with AMPA, NMDA (Mg block, Eq. 2.8) and GABA conductances (float32)."""
+def _lif_full(u, gA, gN, gG, ref, flag, p):
+    """One step of a population with AMPA, NMDA (Mg block, Eq. 2.8) and GABA conductances
+    (float32; vectorised passes as in :func:`_lif_poly`)."""
     f32 = np.float32
     h = f32(p[P_H])
     gL, EL, invC = f32(p[P_GL]), f32(p[P_EL]), f32(1.0 / p[P_CM])
@@ -159,57 +206,48 @@ def _lif_full(u, gA, gN, gG, ref, flag, p, lut):
     uth, nref = f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF])
     method = int(p[P_METHOD])
     lo_u = f32(0.0) if p[P_CLAMP] > 0.5 else f32(-3.0e38)
-    half, sixth, two, zero, one = f32(0.5), f32(1.0 / 6.0), f32(2.0), f32(0.0), f32(1.0)
-    cnt = 0
-    for i in range(u.shape[0]):
-        x = u[i]
-        a0, n0, b0 = gA[i], gN[i], gG[i]
-        a1, n1, b1 = a0 * dA, n0 * dN, b0 * dG
-        k1 = _du(x, a0, n0, b0, gL, EL, EAL, EGL, invC, lut)
-        if method == 2:
-            ah, nh, bh = a0 * dAh, n0 * dNh, b0 * dGh
-            k2 = _du(x + half * h * k1, ah, nh, bh, gL, EL, EAL, EGL, invC, lut)
-            k3 = _du(x + half * h * k2, ah, nh, bh, gL, EL, EAL, EGL, invC, lut)
-            k4 = _du(x + h * k3, a1, n1, b1, gL, EL, EAL, EGL, invC, lut)
-            un = x + h * sixth * (k1 + two * k2 + two * k3 + k4)
-        elif method == 1:
-            k2 = _du(x + h * k1, a1, n1, b1, gL, EL, EAL, EGL, invC, lut)
-            un = x + h * half * (k1 + k2)
-        else:
-            un = x + h * k1
-        un = un if un > lo_u else lo_u
-        un = un if abs(un) >= U_FLOOR else zero
-        r = ref[i]
-        refr = r > zero
-        s = (un >= uth) and not refr
-        u[i] = zero if (refr or s) else un
-        ref[i] = nref if s else (r - one if refr else zero)
-        gA[i] = a1 if a1 > G_FLOOR else zero
-        gN[i] = n1 if n1 > G_FLOOR else zero
-        gG[i] = b1 if b1 > G_FLOOR else zero
-        flag[i] = s
-        cnt += s
+    half, sixth, two, zero = f32(0.5), f32(1.0 / 6.0), f32(2.0), f32(0.0)
+    hh = half * h
+    n = u.shape[0]
+    if method == 2:
+        for i in range(n):
+            x = u[i]
+            a0, n0, b0 = gA[i], gN[i], gG[i]
+            k1 = _du(x, a0, n0, b0, gL, EL, EAL, EGL, invC)
+            k2 = _du(x + hh * k1, a0 * dAh, n0 * dNh, b0 * dGh, gL, EL, EAL, EGL, invC)
+            k3 = _du(x + hh * k2, a0 * dAh, n0 * dNh, b0 * dGh, gL, EL, EAL, EGL, invC)
+            k4 = _du(x + h * k3, a0 * dA, n0 * dN, b0 * dG, gL, EL, EAL, EGL, invC)
+            un = max(x + h * sixth * (k1 + two * k2 + two * k3 + k4), lo_u)
+            u[i] = un if abs(un) >= U_FLOOR else zero
+    elif method == 1:
+        for i in range(n):
+            x = u[i]
+            a0, n0, b0 = gA[i], gN[i], gG[i]
+            k1 = _du(x, a0, n0, b0, gL, EL, EAL, EGL, invC)
+            k2 = _du(x + h * k1, a0 * dA, n0 * dN, b0 * dG, gL, EL, EAL, EGL, invC)
+            un = max(x + hh * (k1 + k2), lo_u)
+            u[i] = un if abs(un) >= U_FLOOR else zero
+    else:
+        for i in range(n):
+            x = u[i]
+            un = max(x + h * _du(x, gA[i], gN[i], gG[i], gL, EL, EAL, EGL, invC), lo_u)
+            u[i] = un if abs(un) >= U_FLOOR else zero
+    cnt = _spikes(u, ref, flag, uth, nref)
+    _decay(gA, dA)
+    _decay(gN, dN)
+    _decay(gG, dG)
     return cnt
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _mg_vec(v):
+    out = np.empty_like(v)
+    for i in range(v.shape[0]):
+        out[i] = _mg(v[i])
+    return out
+
+
 # --------------------------------------------------------------------------- bookkeeping
-@njit(cache=True, boundscheck=False, inline="always")
-def _slot(i, pi, lo, slot, cid, n_act, u, g, ref):
-    """Compact position of global neuron i of population pi; activates it if it is at rest."""
-    k = slot[i]
-    if k < 0:
-        k = lo + n_act[pi]
-        n_act[pi] += 1
-        slot[i] = k
-        cid[k] = i
-        u[k] = 0.0
-        g[0, k] = 0.0
-        g[1, k] = 0.0
-        g[2, k] = 0.0
-        ref[k] = 0.0
-    return k
-
-
 @njit(cache=True, boundscheck=False)
 def _collect(flag, ids, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp, sort):
     """Append the flagged neurons (flag/ids: a population's compact slice) to the ring slot and
@@ -306,7 +344,7 @@ def _ltd(w, n_post, col, n_col, lo_w, ltd, kern, pf_t, pf_j, pf_head, t, acc, ac
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
 def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n_rest,
-             pop_i, pop_par, poly, mg_lut, ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w, de_i, dense_w,
+             pop_i, pop_par, poly, ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w, de_i, dense_w,
              pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, acc, acc_j, out_idx, out_t):
     """Advance the network by one control step of ``n_sub`` substeps starting at substep t0.
 
@@ -346,7 +384,18 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
                     if j < 0 or j >= n_pre:
                         continue
                     for q in range(sp_ptr[off + j], sp_ptr[off + j + 1]):
-                        kq = _slot(sp_post[q], pp, plo, slot, cid, n_act, u, g, ref)
+                        i = sp_post[q]
+                        kq = slot[i]
+                        if kq < 0:  # activate a resting neuron (written out: a helper call
+                            kq = plo + n_act[pp]  # here costs refcount traffic per synapse)
+                            n_act[pp] += 1
+                            slot[i] = kq
+                            cid[kq] = i
+                            u[kq] = 0.0
+                            g[0, kq] = 0.0
+                            g[1, kq] = 0.0
+                            g[2, kq] = 0.0
+                            ref[kq] = 0.0
                         g[rec, kq] += sp_w[q] * sc
         # dense (all-to-all) projections: a spike adds its weight row; plastic rows get LTP
         for d in range(de_i.shape[0]):
@@ -372,7 +421,18 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
                     row = w_off + j * n_post
                     if compact:
                         for q in range(n_post):
-                            kq = _slot(post_lo + q, pp, post_lo, slot, cid, n_act, u, g, ref)
+                            i = post_lo + q
+                            kq = slot[i]
+                            if kq < 0:
+                                kq = post_lo + n_act[pp]
+                                n_act[pp] += 1
+                                slot[i] = kq
+                                cid[kq] = i
+                                u[kq] = 0.0
+                                g[0, kq] = 0.0
+                                g[1, kq] = 0.0
+                                g[2, kq] = 0.0
+                                ref[kq] = 0.0
                             g[rec, kq] += dense_w[row + q] * sc
                     elif a == 0:
                         for q in range(n_post):
@@ -432,22 +492,22 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
             pp = pop_par[pi]
             if kind == KIND_LIF_AMPA:
                 args = (u[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], poly[pi], np.float32(pp[P_DA]),
-                        np.float32(pp[P_DFA]), pop_i[pi, I_NFINE], np.float32(pp[P_UFINE]),
+                        pop_i[pi, I_NFINE] > 1, np.float32(pp[P_UFINE]),
                         np.float32(pp[P_VTH] - pp[P_EL]), np.float32(pp[P_NREF]), pp[P_CLAMP] > 0.5)
-                if par and na >= PAR_MIN:
-                    cnt, nr = _lif_poly_par(*args)
+                if par > 1 and na >= PAR_MIN:
+                    cnt, nr = _lif_poly_par(*args, par)
                 else:
                     cnt, nr = _lif_poly(*args)
                 n_rest[pi] = nr
             else:
-                cnt = _lif_full(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi],
-                                pp, mg_lut)
+                cnt = _lif_full(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp)
             if cnt > 0:
                 n_out = _collect(flag[lo:hi], cid[lo:hi], ring_idx, nxt, ring_n, out_idx, out_t, n_out,
                                  s + 1, pop_i[pi, I_COMPACT] != 0)
-    # drop neurons that came back to rest (only worth a pass when enough of them did)
+    # drop neurons that came back to rest (only worth a pass when enough of them did; until then
+    # they are integrated as exact no-ops)
     for pi in range(pop_i.shape[0]):
-        if pop_i[pi, I_COMPACT] != 0 and n_rest[pi] > 0 and 16 * n_rest[pi] >= n_act[pi]:
+        if pop_i[pi, I_COMPACT] != 0 and n_rest[pi] > 0 and COMPACT_FRACTION * n_rest[pi] >= n_act[pi]:
             n_act[pi] = _compact(pop_i[pi, I_LO], n_act[pi], u, g, ref, cid, slot)
             n_rest[pi] = 0
     return n_out

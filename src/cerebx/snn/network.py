@@ -10,8 +10,10 @@ import numpy as np
 
 from cerebx.schema.network import NetworkConfig
 from cerebx.snn import kernels
-from cerebx.snn.topology import build_topology, structure_fingerprint
+from cerebx.snn.topology import (I_COMPACT, I_RATIO, KIND_INPUT, KIND_LIF_AMPA, P_EL, build_topology,
+                                 structure_fingerprint)
 
+COMPACT_MIN = 4096  # AMPA-only populations this large integrate only their non-resting neurons
 PF_RING = 1 << 16  # buffered PF arrivals per plastic projection (must cover the kernel window)
 
 
@@ -25,34 +27,54 @@ class StepSpikes:
 
 
 class Network:
-    """Flat-array spiking network (see :mod:`cerebx.snn.kernels` for the numerics)."""
+    """Flat-array spiking network (see :mod:`cerebx.snn.kernels` for the numerics).
+
+    ``parallel``: integrate the large populations with numba threads (omp); otherwise everything
+    runs on the calling thread. ``compact_min``: AMPA-only populations at least this large keep
+    only their non-resting neurons in the integration loop (exact; see kernels).
+    ``V``, ``g`` and ``ref`` are assembled from the kernel state on access (read-only views of
+    the state; use :meth:`load_arrays` to set it).
+    """
 
     STATE_KEYS = ("V", "g", "ref", "ring_idx", "ring_n", "pf_t", "pf_j", "pf_head", "pf_lost", "dense_w")
 
-    def __init__(self, cfg: NetworkConfig, parallel: bool = True, pf_ring: int = PF_RING):
+    def __init__(self, cfg: NetworkConfig, parallel: bool = True, pf_ring: int = PF_RING,
+                 compact_min: int = COMPACT_MIN):
         t_start = time.perf_counter()
         self.cfg = cfg
         self.parallel = parallel
+        self.n_threads = numba.get_num_threads() if parallel else 1
         self.topo = topo = build_topology(cfg)
         self.n_sub = topo.n_sub
         self.fingerprint = structure_fingerprint(cfg)
         n = topo.n_neurons
-        self.V = np.zeros(n, dtype=np.float32)
-        self.g = np.zeros((3, n), dtype=np.float32)
-        self.ref = np.zeros(n, dtype=np.float32)
+        self.u = np.zeros(n, dtype=np.float32)
+        self._g = np.zeros((3, n), dtype=np.float32)
+        self._ref = np.zeros(n, dtype=np.float32)
         self.flag = np.zeros(n, dtype=np.uint8)
-        R = topo.max_delay + 2
+        self.cid = np.arange(n, dtype=np.int32)
+        self.slot = np.arange(n, dtype=np.int32)
+        self.n_act = np.zeros(len(topo.names), dtype=np.int64)
+        self.n_rest = np.zeros(len(topo.names), dtype=np.int64)
+        R = topo.max_delay + int(topo.ipar[:, I_RATIO].max()) + 1
         self.ring_idx = np.zeros((R, n), dtype=np.int32)
         self.ring_n = np.zeros(R, dtype=np.int64)
 
         self.pop_lo, self.pop_hi, self.pop_kind = topo.lo, topo.hi, topo.kind
         self.pop_par = topo.par
+        self.pop_i = topo.ipar.copy()
+        sizes = self.pop_hi - self.pop_lo
+        self.pop_i[:, I_COMPACT] = (topo.kind == KIND_LIF_AMPA) & (sizes >= compact_min)
+        self.poly = topo.poly
+        self.el = np.repeat(topo.par[:, P_EL], sizes).astype(np.float32)
         sp = topo.sparse
         ptr_parts, off = [], 0
-        sp_i = np.zeros((len(sp), 6), dtype=np.int64)
+        sp_i = np.zeros((len(sp), 7), dtype=np.int64)
         syn_base = 0
+        pop_of = {int(lo): k for k, lo in enumerate(self.pop_lo)}
         for k, s in enumerate(sp):
-            sp_i[k] = (s.pre_lo, s.n_pre, off, s.receptor, s.delay, int(s.teaching))
+            post_pop = int(np.searchsorted(self.pop_hi, s.post[0], side="right")) if len(s.post) else 0
+            sp_i[k] = (s.pre_lo, s.n_pre, off, s.receptor, s.delay, int(s.teaching), post_pop)
             ptr_parts.append(s.ptr + syn_base)
             off += len(s.ptr)
             syn_base += len(s.post)
@@ -61,8 +83,8 @@ class Network:
         self.sp_post = np.concatenate([s.post for s in sp]) if sp else np.zeros(0, np.int32)
         self.sp_w = np.concatenate([s.w for s in sp]) if sp else np.zeros(0, np.float32)
         self.de_i = np.array(
-            [(d.pre_lo, d.n_pre, d.post_lo, d.n_post, d.w_off, d.receptor, d.delay, d.plastic)
-             for d in topo.dense], dtype=np.int64).reshape(-1, 8)
+            [(d.pre_lo, d.n_pre, d.post_lo, d.n_post, d.w_off, d.receptor, d.delay, d.plastic, pop_of[d.post_lo])
+             for d in topo.dense], dtype=np.int64).reshape(-1, 9)
         self.dense_w = topo.dense_w
         pl = topo.plastic
         k_off = np.cumsum([0] + [len(r.kernel) for r in pl])
@@ -77,6 +99,8 @@ class Network:
         self.pf_lost = np.zeros(len(pl), dtype=np.int64)
         self.kernel_window_sub = longest
         self.col_buf = np.zeros(n, dtype=np.int64)
+        self.acc = np.zeros(n, dtype=np.float64)
+        self.acc_j = np.zeros(n, dtype=np.int64)
         self.out_idx = np.zeros(n * self.n_sub, dtype=np.int32)
         self.out_t = np.zeros(n * self.n_sub, dtype=np.int32)
         self.learn = True
@@ -85,32 +109,82 @@ class Network:
         self.build_s = time.perf_counter() - t_start
 
     # ------------------------------------------------------------------ state
+    def _set_neurons(self, V: np.ndarray, g: np.ndarray, ref: np.ndarray) -> None:
+        """Kernel state from full per-neuron arrays: compact populations keep their non-resting
+        neurons, in index order."""
+        n = len(self.u)
+        self.u[:] = (V - self.el).astype(np.float32)
+        self._g[:] = g
+        self._ref[:] = ref
+        self.cid[:] = np.arange(n, dtype=np.int32)
+        self.slot[:] = self.cid
+        self.n_rest[:] = 0
+        for pi in range(len(self.pop_lo)):
+            lo, hi = int(self.pop_lo[pi]), int(self.pop_hi[pi])
+            self.n_act[pi] = 0 if self.pop_kind[pi] == KIND_INPUT else hi - lo
+            if not self.pop_i[pi, I_COMPACT]:
+                continue
+            u, gg, r = self.u[lo:hi].copy(), self._g[:, lo:hi].copy(), self._ref[lo:hi].copy()
+            live = np.flatnonzero((u != 0) | (gg != 0).any(axis=0) | (r != 0))
+            na = len(live)
+            self.n_act[pi] = na
+            self.slot[lo:hi] = -1
+            self.slot[lo + live] = lo + np.arange(na, dtype=np.int32)
+            self.cid[lo : lo + na] = lo + live
+            self.u[lo : lo + na], self._g[:, lo : lo + na], self._ref[lo : lo + na] = u[live], gg[:, live], r[live]
+            self.u[lo + na : hi], self._g[:, lo + na : hi], self._ref[lo + na : hi] = 0, 0, 0
+
+    def _neurons(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Full per-neuron (V, g, ref) assembled from the kernel state."""
+        V, g, ref = self.el.copy(), np.zeros_like(self._g), np.zeros_like(self._ref)
+        for pi in range(len(self.pop_lo)):
+            lo = int(self.pop_lo[pi])
+            na = int(self.n_act[pi])
+            idx = self.cid[lo : lo + na]
+            V[idx] = self.el[idx] + self.u[lo : lo + na]
+            g[:, idx] = self._g[:, lo : lo + na]
+            ref[idx] = self._ref[lo : lo + na]
+        return V, g, ref
+
+    @property
+    def V(self) -> np.ndarray:
+        return self._neurons()[0]
+
+    @property
+    def g(self) -> np.ndarray:
+        return self._neurons()[1]
+
+    @property
+    def ref(self) -> np.ndarray:
+        return self._neurons()[2]
+
     def reset_state(self) -> None:
         """Neurons at rest, no conductances, nothing in flight; weights are kept."""
-        for pi in range(len(self.topo.names)):
-            self.V[self.pop_lo[pi] : self.pop_hi[pi]] = self.pop_par[pi, 2]
-        self.g[:] = 0
-        self.ref[:] = 0
+        self._set_neurons(self.el, np.zeros_like(self._g), np.zeros_like(self._ref))
         self.ring_n[:] = 0
         self.pf_head[:] = 0
         self.pf_lost[:] = 0
         self.t_sub = 0
 
     def state_arrays(self) -> dict[str, np.ndarray]:
-        d = {k: getattr(self, k) for k in self.STATE_KEYS}
+        V, g, ref = self._neurons()
+        d = {"V": V, "g": g, "ref": ref}
+        d.update({k: getattr(self, k) for k in self.STATE_KEYS if k not in d})
         d["t_sub"] = np.array(self.t_sub, dtype=np.int64)
         return d
 
     def load_arrays(self, arrays: dict[str, np.ndarray]) -> None:
+        cur = self.state_arrays()
         for k in self.STATE_KEYS:
-            dst = getattr(self, k)
-            src = arrays[k]
+            dst, src = cur[k], arrays[k]
             if src.shape != dst.shape or src.dtype != dst.dtype:
                 raise ValueError(f"state array {k}: saved {src.shape} {src.dtype}, "
                                  f"network needs {dst.shape} {dst.dtype}")
-            dst[...] = src
+        for k in self.STATE_KEYS:
+            if k not in ("V", "g", "ref"):
+                getattr(self, k)[...] = arrays[k]
+        self._set_neurons(arrays["V"], arrays["g"], arrays["ref"])
         self.t_sub = int(arrays["t_sub"])
-
     # ------------------------------------------------------------------ access
     def index(self, pop: str) -> slice:
         return self.topo.slice(pop)
@@ -143,20 +217,12 @@ class Network:
         """One 2 ms step; ``inputs`` are global indices of input fibres spiking at its start
         (each fibre at most once)."""
         inputs = np.ascontiguousarray(inputs, dtype=np.int32)
-        prev = None
-        if not self.parallel:
-            prev = numba.get_num_threads()
-            numba.set_num_threads(1)
-        try:
-            n = kernels.run_step(
-                self.t_sub, self.n_sub, inputs, self.learn, self.V, self.g, self.ref, self.flag,
-                self.pop_lo, self.pop_hi, self.pop_kind, self.pop_par,
-                self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
-                self.de_i, self.dense_w, self.pl_i, self.pl_f, self.kern, self.pf_t, self.pf_j,
-                self.pf_head, self.pf_lost, self.col_buf, self.out_idx, self.out_t,
-            )
-        finally:
-            if prev is not None:
-                numba.set_num_threads(prev)
+        n = kernels.run_step(
+            self.t_sub, self.n_sub, inputs, self.learn, self.n_threads, self.u, self._g, self._ref,
+            self.flag, self.cid, self.slot, self.n_act, self.n_rest, self.pop_i, self.pop_par, self.poly,
+            self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
+            self.de_i, self.dense_w, self.pl_i, self.pl_f, self.kern, self.pf_t, self.pf_j,
+            self.pf_head, self.pf_lost, self.col_buf, self.acc, self.acc_j, self.out_idx, self.out_t,
+        )
         self.t_sub += self.n_sub
         return StepSpikes(self.out_idx[:n], self.out_t[:n])

@@ -32,14 +32,18 @@ METHODS = {"euler": 0, "rk2": 1, "rk4": 2}
 # Columns of the per-population integer table.
 I_LO, I_HI, I_KIND, I_RATIO, I_COMPACT, I_NFINE = range(6)
 N_IPAR = 6
-N_COEF = 5  # polynomial coefficients (degree <= 4 in g) of a one-step update of an AMPA-only LIF
+N_COEF = 7  # polynomial coefficients (degree <= 6 in g) of a one-step update of an AMPA-only LIF
+ORDER = {"euler": 1, "rk2": 2, "rk4": 4}  # degree in g0 of one step of each method
 
 
-def step_polynomials(method: str, h: float, C: float, gL: float, E: float, d: float, dh: float):
+def step_polynomials(method: str, h: float, C: float, gL: float, E: float, d: float, dh: float,
+                     n: int = 1):
     """One integration step of C du/dt = -gL u + g(t) (E - u), u = V - E_L, g(t) = g0 e^(-t/tau),
     with the stage conductances g0, g0*dh (h/2), g0*d (h) exact, is u' = P(g0) u + Q(g0): the
     stage values are linear in u with coefficients polynomial in g0. Returns the coefficient arrays
-    (lowest order first, length N_COEF) of P and Q, computed exactly in float64."""
+    (lowest order first, length N_COEF) of P and Q, computed exactly in float64. With n > 1 the
+    step is n sub-steps of h/n (d, dh are then the decays over h/n and h/2n), composed into one
+    pair: P = prod_k P1(g0 d^k), Q accordingly."""
     from numpy.polynomial import Polynomial as Pn
 
     gp = Pn([0.0, 1.0])
@@ -66,8 +70,12 @@ def step_polynomials(method: str, h: float, C: float, gL: float, E: float, d: fl
         k4 = f(lin(u0, k3, h), gp * d)
         out = (u0[0] + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]),
                u0[1] + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]))
+    P, Q = Pn([1.0]), Pn([0.0])
+    for k in range(n):
+        Pk, Qk = (x(Pn([0.0, d**k])) for x in out)  # the k-th sub-step sees g0 d^k
+        P, Q = Pk * P, Pk * Q + Qk
     res = np.zeros((2, N_COEF))
-    for r, poly in enumerate(out):
+    for r, poly in enumerate((P, Q)):
         c = poly.coef
         res[r, : len(c)] = c
     return res
@@ -223,6 +231,10 @@ def build_topology(cfg: NetworkConfig) -> Topology:
             raise ValueError(f"populations.{n}.neuron.integration.dt_ms: {h} must be a multiple of the "
                              f"network dt_ms ({dt}) that divides 2 ms")
         h = ratio * dt
+        if ORDER[integ.method] * integ.bifixed_substeps > N_COEF - 1:
+            raise ValueError(f"populations.{n}.neuron.integration: {integ.method} with bifixed_substeps = "
+                             f"{integ.bifixed_substeps} is not supported (order x sub-steps must be <= "
+                             f"{N_COEF - 1})")
         ipar[i, I_KIND], ipar[i, I_RATIO], ipar[i, I_NFINE] = kind[i], ratio, integ.bifixed_substeps
         par[i, P_CM], par[i, P_GL], par[i, P_EL] = nrn.C_m_pF, nrn.g_L_nS, nrn.E_L_mV
         par[i, P_EA], par[i, P_EG] = nrn.E_AMPA_mV, nrn.E_GABA_mV
@@ -244,7 +256,7 @@ def build_topology(cfg: NetworkConfig) -> Topology:
         poly[i, 0] = step_polynomials(integ.method, h, nrn.C_m_pF, nrn.g_L_nS, E, np.exp(-h / tau),
                                       np.exp(-0.5 * h / tau))
         poly[i, 1] = step_polynomials(integ.method, hf, nrn.C_m_pF, nrn.g_L_nS, E, np.exp(-hf / tau),
-                                      np.exp(-0.5 * hf / tau))
+                                      np.exp(-0.5 * hf / tau), integ.bifixed_substeps)
 
     sparse: list[SparseProj] = []
     dense: list[DenseProj] = []
