@@ -9,7 +9,9 @@ Integration (thesis Eq. 2.2-2.8): conductances decay exactly (g <- g e^(-h/tau))
 population has its own step h = ratio * dt and method (``LIFNeuron.integration``: RK4, RK2 = Heun,
 or Euler; default RK4 at dt). A population integrated with ratio > 1 advances at the end of the
 substeps t with (t + 1) % ratio == 0; input that arrives in the middle of one of its steps takes
-effect at the next step boundary with its conductance decayed exactly over the time in between.
+effect at the next step boundary with its conductance decayed exactly over the time in between
+(until then it waits in the spike ring, so ``Network.g`` read between two control steps does not
+show it yet).
 A spike is emitted when V >= V_thr at the end of a step; V is then reset to E_L and held there
 for t_ref (rounded to whole steps).
 
@@ -119,8 +121,10 @@ def _lif_poly(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp):
     f32 = np.float32
     p0, p1, p2, p3, p4 = c[0, 0, 0], c[0, 0, 1], c[0, 0, 2], c[0, 0, 3], c[0, 0, 4]
     q0, q1, q2, q3, q4 = c[0, 1, 0], c[0, 1, 1], c[0, 1, 2], c[0, 1, 3], c[0, 1, 4]
-    r0, r1, r2, r3, r4, r5, r6 = c[1, 0, 0], c[1, 0, 1], c[1, 0, 2], c[1, 0, 3], c[1, 0, 4], c[1, 0, 5], c[1, 0, 6]
-    s0, s1, s2, s3, s4, s5, s6 = c[1, 1, 0], c[1, 1, 1], c[1, 1, 2], c[1, 1, 3], c[1, 1, 4], c[1, 1, 5], c[1, 1, 6]
+    r0, r1, r2, r3, r4, r5, r6 = (c[1, 0, 0], c[1, 0, 1], c[1, 0, 2], c[1, 0, 3], c[1, 0, 4], c[1, 0, 5],
+                                  c[1, 0, 6])
+    s0, s1, s2, s3, s4, s5, s6 = (c[1, 1, 0], c[1, 1, 1], c[1, 1, 2], c[1, 1, 3], c[1, 1, 4], c[1, 1, 5],
+                                  c[1, 1, 6])
     lo_u = f32(0.0) if clamp else f32(-3.0e38)
     zero, one = f32(0.0), f32(1.0)
     n = u.shape[0]
@@ -178,7 +182,8 @@ def _mg(v):
     f32 = np.float32
     v = min(max(v, f32(-150.0)), f32(50.0))
     y = (f32(-0.062) * v + f32(MG_LN)) * f32(1.0 / 64.0)
-    e = f32(1.0) + y * (f32(1.0) + y * (f32(0.5) + y * (f32(1.0 / 6.0) + y * (f32(1.0 / 24.0) + y * f32(1.0 / 120.0)))))
+    e = f32(1.0) + y * (f32(1.0) + y * (f32(0.5) + y * (f32(1.0 / 6.0) + y * (
+        f32(1.0 / 24.0) + y * f32(1.0 / 120.0)))))
     e = e * e
     e = e * e
     e = e * e
@@ -202,7 +207,8 @@ def _lif_full(u, gA, gN, gG, ref, flag, p):
     h = f32(p[P_H])
     gL, EL, invC = f32(p[P_GL]), f32(p[P_EL]), f32(1.0 / p[P_CM])
     EAL, EGL = f32(p[P_EA] - p[P_EL]), f32(p[P_EG] - p[P_EL])
-    dA, dAh, dN, dNh, dG, dGh = f32(p[P_DA]), f32(p[P_DAH]), f32(p[P_DN]), f32(p[P_DNH]), f32(p[P_DG]), f32(p[P_DGH])
+    dA, dAh, dN, dNh = f32(p[P_DA]), f32(p[P_DAH]), f32(p[P_DN]), f32(p[P_DNH])
+    dG, dGh = f32(p[P_DG]), f32(p[P_DGH])
     uth, nref = f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF])
     method = int(p[P_METHOD])
     lo_u = f32(0.0) if p[P_CLAMP] > 0.5 else f32(-3.0e38)
@@ -365,7 +371,8 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
         for p in range(sp_i.shape[0]):
             if sp_i[p, 5] != 0:
                 continue
-            pre_lo, n_pre, off, rec, delay, pp = sp_i[p, 0], sp_i[p, 1], sp_i[p, 2], sp_i[p, 3], sp_i[p, 4], sp_i[p, 6]
+            pre_lo, n_pre, off, rec, delay = sp_i[p, 0], sp_i[p, 1], sp_i[p, 2], sp_i[p, 3], sp_i[p, 4]
+            pp = sp_i[p, 6]
             ratio = pop_i[pp, I_RATIO]
             if t % ratio != 0:
                 continue

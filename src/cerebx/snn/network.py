@@ -10,8 +10,15 @@ import numpy as np
 
 from cerebx.schema.network import NetworkConfig
 from cerebx.snn import kernels
-from cerebx.snn.topology import (I_COMPACT, I_RATIO, KIND_INPUT, KIND_LIF_AMPA, P_EL, build_topology,
-                                 structure_fingerprint)
+from cerebx.snn.topology import (
+    I_COMPACT,
+    I_RATIO,
+    KIND_INPUT,
+    KIND_LIF_AMPA,
+    P_EL,
+    build_topology,
+    structure_fingerprint,
+)
 
 COMPACT_MIN = 4096  # AMPA-only populations this large integrate only their non-resting neurons
 PF_RING = 1 << 16  # buffered PF arrivals per plastic projection (must cover the kernel window)
@@ -83,8 +90,8 @@ class Network:
         self.sp_post = np.concatenate([s.post for s in sp]) if sp else np.zeros(0, np.int32)
         self.sp_w = np.concatenate([s.w for s in sp]) if sp else np.zeros(0, np.float32)
         self.de_i = np.array(
-            [(d.pre_lo, d.n_pre, d.post_lo, d.n_post, d.w_off, d.receptor, d.delay, d.plastic, pop_of[d.post_lo])
-             for d in topo.dense], dtype=np.int64).reshape(-1, 9)
+            [(d.pre_lo, d.n_pre, d.post_lo, d.n_post, d.w_off, d.receptor, d.delay, d.plastic,
+              pop_of[d.post_lo]) for d in topo.dense], dtype=np.int64).reshape(-1, 9)
         self.dense_w = topo.dense_w
         pl = topo.plastic
         k_off = np.cumsum([0] + [len(r.kernel) for r in pl])
@@ -131,7 +138,8 @@ class Network:
             self.slot[lo:hi] = -1
             self.slot[lo + live] = lo + np.arange(na, dtype=np.int32)
             self.cid[lo : lo + na] = lo + live
-            self.u[lo : lo + na], self._g[:, lo : lo + na], self._ref[lo : lo + na] = u[live], gg[:, live], r[live]
+            self.u[lo : lo + na], self._g[:, lo : lo + na] = u[live], gg[:, live]
+            self._ref[lo : lo + na] = r[live]
             self.u[lo + na : hi], self._g[:, lo + na : hi], self._ref[lo + na : hi] = 0, 0, 0
 
     def _neurons(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
