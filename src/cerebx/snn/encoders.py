@@ -13,11 +13,60 @@ a burst of floor(x / c_k) spikes (clipped to 1..max_burst), one per step.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from cerebx.schema.controller import BoxEncoder, CFEncoder
 
 STEP_S = 0.002
+
+
+@numba.njit(cache=True)
+def _mf_active(x, lo, hi, step, half_width, F, out):  # pragma: no cover - numba
+    """Box coding of x (n_joints, 4) into ``out``; returns the number of active fibres."""
+    n = 0
+    nj = x.shape[0]
+    for j in range(nj):
+        for s in range(4):
+            v = min(max(x[j, s], lo[j, s]), hi[j, s])
+            b = int(np.rint((v - lo[j, s]) / step[j, s]))
+            b = min(max(b, 0), F - 1)
+            base = (j * 4 + s) * F
+            # a neighbour is inside its box too only at an exact midpoint (0.5 step + 1e-12)
+            if b > 0 and abs(v - (lo[j, s] + (b - 1) * step[j, s])) < half_width[j, s]:
+                out[n] = base + b - 1
+                n += 1
+            out[n] = base + b
+            n += 1
+            if b < F - 1 and abs(v - (lo[j, s] + (b + 1) * step[j, s])) < half_width[j, s]:
+                out[n] = base + b + 1
+                n += 1
+    return n
+
+
+@numba.njit(cache=True)
+def _cf_step(e, u, centres, width, r_min, r_max, max_burst, half, burst_left, out):  # pragma: no cover
+    """One 2 ms step of the CF encoder: new events (u < rate * dt) on the side the error's sign
+    selects, bursts of floor(|e| / c_k) spikes; returns the number of fibres spiking now."""
+    per_joint = 2 * half
+    n = 0
+    for j in range(e.shape[0]):
+        x = abs(e[j])
+        side = 0 if e[j] > 0 else half
+        for k in range(half):
+            i = j * per_joint + side + k
+            if burst_left[i] == 0:
+                rate = r_min + (r_max - r_min) * (np.tanh((x - centres[k]) / width) + 1.0) / 2.0
+                if u[i] < rate * 0.002:
+                    b = int(np.floor(x / centres[k]))
+                    burst_left[i] = min(max(b, 1), max_burst)
+        for k in range(per_joint):
+            i = j * per_joint + k
+            if burst_left[i] > 0:
+                out[n] = i
+                n += 1
+                burst_left[i] -= 1
+    return n
 
 
 class MossyEncoder:
@@ -32,6 +81,8 @@ class MossyEncoder:
         self.half_width = self.step * cfg.width_factor
         self.n_joints = self.lo.shape[0]
         self.base = (np.arange(self.n_joints)[:, None] * 4 + np.arange(4)[None, :]) * self.F
+        self._x = np.zeros((self.n_joints, 4))
+        self._out = np.zeros(self.n_joints * 4 * 3, dtype=np.int64)
 
     @property
     def n_fibers(self) -> int:
@@ -39,20 +90,11 @@ class MossyEncoder:
 
     def active(self, q_des, q, qd_des, qd) -> np.ndarray:
         """Local indices of the fibres firing this step (one per signal; two only on an exact
-        box boundary, as in the original)."""
-        x = np.stack([q_des, q, qd_des, qd], axis=1)[: self.n_joints]
-        x = np.clip(x, self.lo, self.hi)
-        pos = (x - self.lo) / self.step
-        b = np.clip(np.rint(pos).astype(np.int64), 0, self.F - 1)
-        out = [(self.base + b).ravel()]
-        # a neighbour is also inside its box only at an exact midpoint (width is 0.5 step + 1e-12)
-        for nb in (b - 1, b + 1):
-            ok = (nb >= 0) & (nb < self.F)
-            c = self.lo + np.clip(nb, 0, self.F - 1) * self.step
-            both = ok & (np.abs(x - c) < self.half_width)
-            if both.any():
-                out.append((self.base + nb)[both])
-        return np.sort(np.concatenate(out)) if len(out) > 1 else out[0]
+        box boundary, as in the original), in increasing order."""
+        nj, x = self.n_joints, self._x
+        x[:, 0], x[:, 1], x[:, 2], x[:, 3] = q_des[:nj], q[:nj], qd_des[:nj], qd[:nj]
+        n = _mf_active(x, self.lo, self.hi, self.step, self.half_width, self.F, self._out)
+        return self._out[:n].copy()
 
 
 class ClimbingEncoder:
@@ -70,6 +112,7 @@ class ClimbingEncoder:
         self.width = (cfg.center_max - cfg.center_min) / max(n - 1, 1)
         self.rng = rng
         self.burst_left = np.zeros(n_joints * per_joint, dtype=np.int64)
+        self._out = np.zeros(n_joints * per_joint, dtype=np.int64)
 
     def error(self, q_des, q, qd_des, qd) -> np.ndarray:
         n = self.n_joints
@@ -93,13 +136,16 @@ class ClimbingEncoder:
         return np.concatenate([n, n], axis=1)
 
     def active(self, e: np.ndarray) -> np.ndarray:
-        """Local indices of the fibres spiking this step (new events plus ongoing bursts)."""
-        p = (self.rates(e) * STEP_S).ravel()
-        fire = (self.rng.random(p.shape[0]) < p) & (self.burst_left == 0)
-        self.burst_left[fire] = self.bursts(e).ravel()[fire]
-        spiking = np.flatnonzero(self.burst_left > 0)
-        self.burst_left[spiking] -= 1
-        return spiking
+        """Local indices of the fibres spiking this step (new events plus ongoing bursts).
+
+        Same rule as :meth:`rates` and :meth:`bursts`, in one numba pass; one uniform per fibre
+        per step keeps the random stream independent of the error.
+        """
+        c = self.cfg
+        u = self.rng.random(self.burst_left.shape[0])
+        n = _cf_step(np.ascontiguousarray(e, dtype=np.float64), u, self.centres, self.width, c.rate_min_hz,
+                     c.rate_max_hz, c.max_burst, self.half, self.burst_left, self._out)
+        return self._out[:n].copy()
 
     def reset(self) -> None:
         self.burst_left[:] = 0
