@@ -72,7 +72,8 @@ INVALID = [
      "network.projections.pf_pc.synapses: declared 35,000,000 but rule all_to_all gives 36,000,000"),
     (["+task=circle", "network.projections.pf_pc.weight_range_nS=[5.0,0.0]"],
      "network.projections.pf_pc: weight_range_nS min (5.0) is greater than max (0.0)"),
-    (["+task=circle", "plant.physics_dt_ms=0.3"], "plant.physics_dt_ms: 0.3 ms does not divide the 2.0 ms control step"),
+    (["+task=circle", "plant.physics_dt_ms=0.3"],
+     "plant.physics_dt_ms: 0.3 ms does not divide the 2.0 ms control step"),
     (["+task=circle", "+plant.colour=red"], "plant.colour: Extra inputs are not permitted"),
     (["+task=circle", "network.projections.pf_pc.plasticity.kernel_peak_ms=100"],
      "network.projections.pf_pc.plasticity: kernel_peak_ms (100.0) must be greater than kernel_onset_ms (120.0)"),
@@ -82,7 +83,8 @@ INVALID = [
     (["+task=circle", "plant.colour=red"], "plant.colour: not in the composed config"),
     (["+task=circle", "controller.decoder.alpha_Nm_per_spike=[1,2]"],
      "controller.decoder.alpha_Nm_per_spike: 2 values given but the plant has 6 joints"),
-    (["+task=circle", "~controller.mf.ranges", "+controller.mf.ranges={kind: given, q_min: [0,0,0,0,0,0], q_max: [1,1,1,1,1,0], "
+    (["+task=circle", "~controller.mf.ranges",
+      "+controller.mf.ranges={kind: given, q_min: [0,0,0,0,0,0], q_max: [1,1,1,1,1,0], "
       "qd_des_min: [0,0,0,0,0,0], qd_des_max: [1,1,1,1,1,1], qd_min: [0,0,0,0,0,0], qd_max: [1,1,1,1,1,1]}"],
      "controller.mf.ranges: q_min must be below q_max (empty range at joint 5)"),
 ]

@@ -20,8 +20,9 @@ from typing import Any
 import numpy as np
 
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
+from cerebx.controllers.ranges import mf_ranges
 from cerebx.errors import StateMismatchError
-from cerebx.schema.controller import GivenRanges, SNNController
+from cerebx.schema.controller import SNNController
 from cerebx.snn.decoder import DCNDecoder
 from cerebx.snn.encoders import ClimbingEncoder, MossyEncoder
 from cerebx.snn.network import Network
@@ -32,23 +33,7 @@ STATE_VERSION = 1
 
 def encoder_ranges(cfg: SNNController, n_joints: int, task: Any = None) -> tuple[np.ndarray, np.ndarray]:
     """(lo, hi) of shape (n_joints, 4) for the MF signals q_d, q, qd_d, qd."""
-    r = cfg.mf.ranges
-    if isinstance(r, GivenRanges):
-        qlo, qhi = np.asarray(r.q_min), np.asarray(r.q_max)
-        lo = np.stack([qlo, qlo, np.asarray(r.qd_des_min), np.asarray(r.qd_min)], axis=1)
-        hi = np.stack([qhi, qhi, np.asarray(r.qd_des_max), np.asarray(r.qd_max)], axis=1)
-        return lo[:n_joints], hi[:n_joints]
-    if task is None:
-        raise ValueError("controller.mf.ranges: 'from_task' needs a task to derive the encoder ranges")
-    q_min, q_max, qd_min, qd_max = (np.asarray(a, dtype=float)[:n_joints] for a in task.envelope())
-
-    def widen(a, b, m):
-        span = np.maximum(b - a, 1e-3)
-        return a - m * span, b + m * span
-
-    qlo, qhi = widen(q_min, q_max, r.margin)
-    vlo, vhi = widen(qd_min, qd_max, r.velocity_margin)
-    return np.stack([qlo, qlo, vlo, vlo], axis=1), np.stack([qhi, qhi, vhi, vhi], axis=1)
+    return mf_ranges(cfg.mf.ranges, n_joints, task)
 
 
 class SNNControllerImpl(Controller):

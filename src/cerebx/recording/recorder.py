@@ -35,8 +35,6 @@ import numpy as np
 import orjson
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
-from cerebx import __version__
-
 _TIME = {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}}
 _NUMS = {"type": "array", "items": {"type": "number"}}
 
