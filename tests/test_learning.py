@@ -29,3 +29,17 @@ def test_plasticity_off_does_not_learn(load):
     w = ctx.extras["controller"].net.weights("pf_pc")
     assert w.min() == w.max() == 2.0
     assert mae[-3:].mean() > 0.9 * mae[:3].mean()
+
+
+def test_pipelined_network_gives_identical_results(load):
+    """Running the network a chunk ahead on a worker thread changes wall time, not results."""
+    runs = {}
+    for pipeline in (True, False):
+        cfg = load(["+task=circle", "+experiment=small_snn", "trials=1", f"controller.pipeline={pipeline}"])
+        ctx = build_components(cfg)
+        loop = ClosedLoop(ctx, None)
+        loop.start()
+        m = loop.run_trial(0)
+        runs[pipeline] = (m.mae_per_joint, ctx.extras["controller"].net.weights("pf_pc").copy())
+    assert runs[True][0] == runs[False][0]
+    np.testing.assert_array_equal(runs[True][1], runs[False][1])

@@ -6,12 +6,18 @@ round(D / 2 ms) control steps: spikes encoded from the sample of step n enter th
 n + k (afferent), and the torque the network decodes at step m is returned at step m + k
 (efferent), stamped with the step's own time. The CF error pairs the measured state with the
 desired state of the same sample time (the sensor message's stamp).
+
+Pipelining: because the network's output is not needed until k steps after its input exists,
+the network can run ahead on a second thread, one chunk of k steps at a time, while the loop
+steps the plant and records (``pipeline: true``). The network sees the same inputs in the same
+order, so the results are identical to the synchronous order; only the wall time changes.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import threading
 import time
 from collections import deque
 from pathlib import Path
@@ -41,7 +47,11 @@ class SNNControllerImpl(Controller):
         t0 = time.perf_counter()
         self.cfg = cfg
         self.net_cfg = ctx.cfg.network
-        self.net = Network(self.net_cfg, parallel=cfg.parallel)
+        self.k_delay = int(round(cfg.pathway_delay_ms / (STEP_S * 1000)))
+        # pipelined: the network gets its own core, so its kernels run single-threaded
+        self.pipeline = cfg.pipeline and self.k_delay > 0
+        self._worker: tuple[threading.Thread, dict] | None = None
+        self.net = Network(self.net_cfg, parallel=cfg.parallel and not self.pipeline)
         self.net.learn = cfg.plasticity
         io = self.net_cfg.io
         self.sl_mf, self.sl_cf, self.sl_dcn = (self.net.index(p) for p in (io.mossy, io.climbing, io.output))
@@ -63,7 +73,6 @@ class SNNControllerImpl(Controller):
         self._rng_seed = ctx.rng("controller.snn.cf")
         self.cf = ClimbingEncoder(cfg.cf, nj, n_cf // nj, cfg.error.kpos, cfg.error.kvel, self._rng_seed)
         self.decoder = DCNDecoder(cfg.decoder.alpha_Nm_per_spike, nj, n_dcn // nj)
-        self.k_delay = int(round(cfg.pathway_delay_ms / (STEP_S * 1000)))
         self.recorder = None
         self.record = {name: self.net.index(name) for name in cfg.record_spikes}
         self.fingerprint = self.net.fingerprint
@@ -75,12 +84,77 @@ class SNNControllerImpl(Controller):
 
     # ------------------------------------------------------------------ loop
     def _reset_loop_state(self) -> None:
-        self._in = deque([np.zeros(0, np.int32)] * self.k_delay)
-        self._out = deque([np.zeros(self.n_ctrl)] * self.k_delay)
+        self._join()
+        k = self.k_delay
+        self._pending: deque[np.ndarray] = deque([np.zeros(0, np.int32)] * k)  # inputs not yet simulated
+        self._ready: deque[np.ndarray] = deque([np.zeros(self.n_ctrl)] * k)  # torques not yet applied
+        self._net_step = 0  # network steps simulated so far (step m is stamped m * 2 ms)
         self._des: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._dcn_spikes = 0
         self._steps = 0
         self.last_error = np.zeros(self.n_ctrl)
+
+    # ------------------------------------------------------------------ network execution
+    def _simulate(self, inputs: list[np.ndarray], first_step: int) -> list[tuple]:
+        """Run the network over ``inputs``; per step: (time, torque, DCN spike count, recorded spikes)."""
+        out = []
+        lo, hi = self.sl_dcn.start, self.sl_dcn.stop
+        for i, x in enumerate(inputs):
+            spikes = self.net.step(x)
+            idx = spikes.idx
+            dcn = idx[(idx >= lo) & (idx < hi)] - lo
+            rec = {name: idx[(idx >= sl.start) & (idx < sl.stop)] - sl.start
+                   for name, sl in self.record.items()} if self.recorder is not None else None
+            out.append(((first_step + i) * STEP_S, self.decoder.torque(dcn), dcn.size, rec))
+        return out
+
+    def _absorb(self, results: list[tuple]) -> None:
+        for t, tau, n_dcn, rec in results:
+            self._ready.append(tau)
+            self._dcn_spikes += n_dcn
+            if rec is not None:
+                for name, sel in rec.items():
+                    self.recorder.spikes(f"/spikes/{name}", t, sel)
+        self._net_step += len(results)
+
+    def _launch(self) -> None:
+        """Start simulating the next k pending inputs on the worker thread."""
+        chunk = [self._pending.popleft() for _ in range(self.k_delay)]
+        first = self._net_step  # no chunk is in flight when a new one starts
+        box: dict[str, Any] = {}
+
+        def work() -> None:
+            try:
+                box["out"] = self._simulate(chunk, first)
+            except BaseException as exc:  # re-raised in the loop's thread by _join
+                box["err"] = exc
+
+        self._worker = (threading.Thread(target=work, name="cerebx-snn", daemon=True), box)
+        self._worker[0].start()
+
+    def _join(self) -> None:
+        worker = self._worker
+        if worker is None:
+            return
+        thread, box = worker
+        thread.join()
+        self._worker = None
+        if "err" in box:
+            raise box["err"]
+        self._absorb(box["out"])
+
+    def _advance(self) -> None:
+        """Make sure this tick's torque is ready; in pipeline mode keep one chunk in flight."""
+        if not self.pipeline:
+            self._absorb(self._simulate([self._pending.popleft()], self._net_step))
+            return
+        while not self._ready:
+            if self._worker is not None:
+                self._join()
+            else:
+                self._absorb(self._simulate([self._pending.popleft()], self._net_step))
+        if self._worker is None and len(self._pending) >= self.k_delay:
+            self._launch()
 
     def reset(self, rng: np.random.Generator) -> None:
         self.cf.rng = rng
@@ -112,24 +186,16 @@ class SNNControllerImpl(Controller):
             self.last_error = e
             cf = self.cf.active(e)
             spikes_in = np.concatenate([mf + self.sl_mf.start, cf + self.sl_cf.start]).astype(np.int32)
-        self._in.append(spikes_in)
-        spikes = self.net.step(self._in.popleft())
-        lo, hi = self.sl_dcn.start, self.sl_dcn.stop
-        dcn = spikes.idx[(spikes.idx >= lo) & (spikes.idx < hi)] - lo
-        self._dcn_spikes += dcn.size
+        self._pending.append(spikes_in)
+        self._advance()
         self._steps += 1
-        self._out.append(self.decoder.torque(dcn))
-        tau_net = self._out.popleft()
-        if self.recorder is not None:
-            for name, sl in self.record.items():
-                sel = spikes.idx[(spikes.idx >= sl.start) & (spikes.idx < sl.stop)] - sl.start
-                self.recorder.spikes(f"/spikes/{name}", inp.t_s, sel)
         tau = np.zeros(self.n_joints)
-        tau[: self.n_ctrl] = tau_net
+        tau[: self.n_ctrl] = self._ready.popleft()
         return TorqueMsg(inp.t_s, tau)
 
     # ------------------------------------------------------------------ reporting
     def end_trial(self, trial: int) -> dict[str, float]:
+        self._join()  # weights and counters must not change while they are read
         out: dict[str, float] = {}
         n_dcn = self.sl_dcn.stop - self.sl_dcn.start
         if self._steps:
@@ -164,16 +230,17 @@ class SNNControllerImpl(Controller):
 
     # ------------------------------------------------------------------ state
     def save_state(self, path: Path) -> None:
+        self._join()
         path = Path(path)
         arrays = {f"net_{k}": v for k, v in self.net.state_arrays().items()}
         arrays["cf_burst_left"] = self.cf.burst_left
-        arrays["out_fifo"] = np.array(list(self._out)).reshape(len(self._out), self.n_ctrl)
+        arrays["out_fifo"] = np.array(list(self._ready)).reshape(len(self._ready), self.n_ctrl)
         meta = {"version": STATE_VERSION, "fingerprint": self.fingerprint, "config": self.config_hash,
                 "network": self.net_cfg.name, "rng": self.cf.rng.bit_generator.state}
         arrays["meta"] = np.array(json.dumps(meta))
         tmp = path.with_name(path.name + ".tmp")
         with open(tmp, "wb") as f:
-            np.savez(f, **arrays, in_fifo=np.array(json.dumps([a.tolist() for a in self._in])))
+            np.savez(f, **arrays, in_fifo=np.array(json.dumps([a.tolist() for a in self._pending])))
         tmp.replace(path)
 
     def load_state(self, path: Path) -> None:
@@ -195,6 +262,7 @@ class SNNControllerImpl(Controller):
         self.cf.burst_left[:] = data["cf_burst_left"]
         self.cf.rng.bit_generator.state = meta["rng"]
         fifo = json.loads(str(data["in_fifo"]))
-        if len(fifo) == self.k_delay:  # same pathway delay: resume exactly; otherwise start empty
-            self._in = deque(np.asarray(a, dtype=np.int32) for a in fifo)
-            self._out = deque(np.asarray(r, dtype=float) for r in data["out_fifo"])
+        self._join()
+        if len(fifo) + len(data["out_fifo"]) == 2 * self.k_delay:  # same pathway delay: resume exactly
+            self._pending = deque(np.asarray(a, dtype=np.int32) for a in fifo)
+            self._ready = deque(np.asarray(r, dtype=float) for r in data["out_fifo"])

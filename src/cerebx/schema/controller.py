@@ -175,7 +175,12 @@ class SNNController(_ControllerCommon):
     decoder: DCNDecoder = DCNDecoder()
     pathway_delay_ms: NonNegFloat = Field(50.0, description="afferent = efferent sensorimotor delay D")
     plasticity: bool = True
-    parallel: bool = Field(True, description="use numba threads in the network kernels")
+    parallel: bool = Field(True, description="use numba threads in the network kernels (when not pipelined)")
+    pipeline: bool = Field(
+        True,
+        description="simulate the network one pathway-delay chunk ahead on a second thread "
+        "(identical results; needs pathway_delay_ms > 0)",
+    )
     output_filter: TorqueFilter = MeanFilter()
     supervisor: Supervisor | None = Supervisor()
     record_spikes: list[str] = Field(default_factory=lambda: ["dcn"])

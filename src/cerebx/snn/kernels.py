@@ -348,7 +348,7 @@ def _ltd(w, n_post, col, n_col, lo_w, ltd, kern, pf_t, pf_j, pf_head, t, acc, ac
             w[k] = x if x > lo_w else lo_w
 
 
-@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
+@njit(cache=True, nogil=True, fastmath=True, error_model="numpy", boundscheck=False)
 def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n_rest,
              pop_i, pop_par, poly, ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w, de_i, dense_w,
              pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, acc, acc_j, out_idx, out_t):
