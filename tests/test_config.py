@@ -80,6 +80,7 @@ INVALID = [
     (["+task=circle", "network.populations.pc.microcomplexes=7"],
      "network.populations.pc: microcomplexes (7) must divide the population size (600)"),
     (["+task=square"], "task: unknown option 'square'"),
+    (["+task=circle", "init_from=/nonexistent/run"], "init_from: /nonexistent/run/controller_state.npz does not exist"),
     (["+task=circle", "plant.colour=red"], "plant.colour: not in the composed config"),
     (["+task=circle", "controller.decoder.alpha_Nm_per_spike=[1,2]"],
      "controller.decoder.alpha_Nm_per_spike: 2 values given but the plant has 6 joints"),

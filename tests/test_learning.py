@@ -43,3 +43,19 @@ def test_pipelined_network_gives_identical_results(load):
         runs[pipeline] = (m.mae_per_joint, ctx.extras["controller"].net.weights("pf_pc").copy())
     assert runs[True][0] == runs[False][0]
     np.testing.assert_array_equal(runs[True][1], runs[False][1])
+
+
+def test_init_from_other_network_is_one_clear_error(load, tmp_path, capsys):
+    """A learned state from a different network is refused with one line, and the run says so."""
+    from cerebx.loop.runner import run_experiment
+
+    first = run_experiment(load(["+task=circle", "+experiment=small_snn", "trials=1"]), tmp_path / "small")
+    assert first["status"] == "completed" and (tmp_path / "small" / "controller_state.npz").exists()
+    cfg = load(["+task=circle", "+experiment=small_snn", "trials=1", "network.projections.mf_dcn.weight_nS=0.2",
+                f"init_from={tmp_path / 'small'}"])
+    same = run_experiment(cfg, tmp_path / "same")  # same structure, other weights: allowed
+    assert same["status"] == "completed"
+    cfg = load(["+task=circle", "trials=1", f"init_from={tmp_path / 'small'}"])
+    other = run_experiment(cfg, tmp_path / "other")
+    assert other["status"] == "failed"
+    assert "different structure" in other["error"] and "\n" not in other["error"]

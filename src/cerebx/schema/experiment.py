@@ -123,6 +123,12 @@ class _ExperimentBase(Strict):
         problems += _per_joint_lengths(controller, "controller", n)
         if controller.kind == "snn":
             problems += _snn_fits_network(controller, self.network, n)
+        if self.init_from is not None:
+            from pathlib import Path
+
+            state = Path(self.init_from) / "controller_state.npz"
+            if not state.is_file():
+                problems.append(f"init_from: {state} does not exist (give a run folder that saved its state)")
         if problems:
             raise ValueError("; ".join(problems))
         return self
