@@ -64,7 +64,8 @@ def _stream_messages(fh, topics: list[str] | None) -> Iterator[tuple[str, int, A
         return
 
 
-def read_messages(path: Path | str, topics: list[str] | None = None) -> Iterator[tuple[str, int, Any]]:
+def read_messages(path: Path | str, topics: list[str] | None = None, start_ns: int | None = None,
+                  end_ns: int | None = None) -> Iterator[tuple[str, int, Any]]:
     """Yield (topic, log_time_ns, decoded message) in log-time order.
 
     A file without a summary section (a run still going, or one killed with SIGKILL) is read as a
@@ -75,11 +76,14 @@ def read_messages(path: Path | str, topics: list[str] | None = None) -> Iterator
         raise CerebxError(f"{p}: no such file")
     with open(p, "rb") as fh:
         if not _has_summary(fh):
-            yield from _stream_messages(fh, topics)
+            for topic, t, msg in _stream_messages(fh, topics):
+                if (start_ns is None or t >= start_ns) and (end_ns is None or t < end_ns):
+                    yield topic, t, msg
             return
         reader = _reader(fh)
         try:
-            for _schema, channel, message, decoded in reader.iter_decoded_messages(topics=topics):
+            for _schema, channel, message, decoded in reader.iter_decoded_messages(
+                    topics=topics, start_time=start_ns, end_time=end_ns):
                 yield channel.topic, message.log_time, decoded
         except CerebxError:
             raise

@@ -15,18 +15,22 @@ from cerebx.recording.reader import read_messages  # noqa: E402
 
 
 def _label(s: dict[str, Any]) -> str:
-    return f"{s['controller']} · {s['plant']} · delay {s['delay']} · seed {s['seed']}"
+    p = s.get("presets") or {}
+    return (f"{p.get('controller', s['controller'])} · {p.get('plant', s['plant'])} · "
+            f"delay {p.get('delay', s['delay'])} · seed {s['seed']}")
 
 
 def learning_curves(runs: list[tuple[Path, dict]], task: str, out: Path) -> Path:
     """MAE per trial for every run of one task (thesis Fig. 2.6 g / 2.7 g style)."""
     fig, ax = plt.subplots(figsize=(7.5, 4))
-    for _, s in runs:
+    longest = max((len(s.get("mae_per_trial") or []) for _, s in runs), default=0)
+    for i, (_, s) in enumerate(runs):
         mae = s.get("mae_per_trial") or []
-        if len(mae) > 1:
-            ax.plot(np.arange(len(mae)), mae, lw=1.2, label=_label(s))
-        elif mae:
-            ax.axhline(mae[0], lw=1, ls="--", label=_label(s))
+        if len(mae) > max(1, longest // 4):
+            ax.plot(np.arange(len(mae)), mae, lw=1.2, color=f"C{i % 10}", label=_label(s))
+        elif mae:  # a short baseline run: its final error as a reference line
+            ax.axhline(s.get("final_mae") or mae[-1], lw=1, ls="--", color=f"C{i % 10}",
+                       label=f"{_label(s)} (final, {len(mae)} trials)")
     ax.set_xlabel("trial")
     ax.set_ylabel("position MAE (rad)")
     ax.set_yscale("log")
@@ -45,9 +49,7 @@ def joint_tracking(run_dir: Path, s: dict, out: Path) -> Path:
     series: dict[str, list] = {"/joint_states/desired": [], "/joint_states/actual": []}
     times: list[float] = []
     names: list[str] = []
-    for topic, t, msg in read_messages(run_dir, list(series)):
-        if t < t_start:
-            continue
+    for topic, t, msg in read_messages(run_dir, list(series), start_ns=t_start):
         series[topic].append([j["position"] for j in msg["joints"]])
         if topic == "/joint_states/actual":
             times.append(t / 1e9)
