@@ -54,3 +54,16 @@ def test_gamma_monotonic_limiter_falls_one_step_at_most():
     g = Gamma(GammaParams(shape=3.5, scale_ms=3.5, offset_ms=15.0), monotonic=True, rng=np.random.default_rng(2))
     x = np.array([g.next_ms() for _ in range(5000)])
     assert np.all(np.diff(x) >= -2.0 - 1e-12)
+
+
+def test_symmetric_gamma_sends_half_of_one_round_trip_each_way():
+    from cerebx.loop.delays import HalfRoundTrip, _View
+
+    shared = HalfRoundTrip(Gamma(GammaParams(shape=3.5, scale_ms=3.5, offset_ms=25.0), True,
+                                 np.random.default_rng(4)))
+    r2c, c2r = _View(shared, draws=True), _View(shared, draws=False)
+    pairs = [(r2c.next_ms(), c2r.next_ms()) for _ in range(5000)]
+    assert all(a == b for a, b in pairs)
+    rt = np.array([a + b for a, b in pairs])
+    assert np.all(np.diff(rt) >= -2.0 - 1e-12)  # the limiter acts on the round trip
+    assert rt.mean() == pytest.approx(42.8, abs=1.0)  # facts §7: 37.25 nominal -> 42.8 with the limiter

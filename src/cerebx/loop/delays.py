@@ -51,6 +51,28 @@ class Gamma:
         return d
 
 
+class HalfRoundTrip:
+    """The original symmetric delay (facts §7): one limited round-trip sample per step, half on
+    each path. The R2C message of a step is sent first and draws; the C2R one reuses the draw."""
+
+    def __init__(self, round_trip: Gamma):
+        self.round_trip = round_trip
+        self.half = 0.0
+
+    def draw(self) -> float:
+        self.half = self.round_trip.next_ms() / 2.0
+        return self.half
+
+
+@dataclass
+class _View:
+    source: HalfRoundTrip
+    draws: bool
+
+    def next_ms(self) -> float:
+        return self.source.draw() if self.draws else self.source.half
+
+
 class Trace:
     """Replays a recorded delay series (ms per message), looping at the end if asked."""
 
@@ -105,6 +127,9 @@ def build_delay(cfg: Any, ctx: Any) -> DelayModel:
         r2c, c2r = cfg.per_direction()
         return DelayModel(Constant(r2c), Constant(c2r))
     if isinstance(cfg, schema.GammaDelay):
+        if cfg.symmetric:
+            shared = HalfRoundTrip(Gamma(cfg.r2c, cfg.monotonic, rng_r2c))
+            return DelayModel(_View(shared, draws=True), _View(shared, draws=False))
         return DelayModel(Gamma(cfg.r2c, cfg.monotonic, rng_r2c), Gamma(cfg.c2r, cfg.monotonic, rng_c2r))
     if isinstance(cfg, schema.TraceDelay):
         data = load_trace(cfg.path)

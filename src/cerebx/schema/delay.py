@@ -53,6 +53,17 @@ class GammaDelay(Strict):
     r2c: GammaParams
     c2r: GammaParams
     monotonic: bool = Field(True, description="a delay may fall by at most one step per step")
+    symmetric: bool = Field(
+        False,
+        description="the original's symmetric setup: one round-trip sample per step (r2c parameters), "
+        "limited as a whole, half sent down each path; c2r must then equal r2c",
+    )
+
+    @model_validator(mode="after")
+    def _symmetric_needs_one_distribution(self) -> GammaDelay:
+        if self.symmetric and self.c2r != self.r2c:
+            raise ValueError("symmetric: true draws one round-trip delay, so c2r must equal r2c")
+        return self
 
 
 class TraceDelay(Strict):
