@@ -116,3 +116,13 @@ def test_config_cannot_import_code(load):
     """A '_target_' or import path in config is just an unknown key, never executed."""
     with pytest.raises(Exception, match="Extra inputs are not permitted"):
         load(["+task=circle", "+controller._target_=os.system"])
+
+
+@pytest.mark.parametrize("group", ["biodelay", "kernel"])
+def test_every_global_option_validates(load, group):
+    for option in _options(group):
+        cfg = load(["+task=circle", f"+{group}={option}"])
+        k = cfg.network.projections["pf_pc"].plasticity
+        assert k.kernel_peak_ms - k.kernel_onset_ms == 30.0
+        if group == "biodelay":
+            assert k.kernel_peak_ms == 2 * cfg.controller.pathway_delay_ms + 50
