@@ -89,9 +89,25 @@ def build(run_dirs: list[Path], out: Path) -> tuple[Path, list[str], int]:
         png = figures.learning_curves(rs, task, fig_dir / f"learning_{task}")
         sections.append(f"<figure><img src='figures/{png.name}'><figcaption>MAE per trial, task "
                         f"{html.escape(task)}: every run of this task (log scale).</figcaption></figure>")
+        baselines = [s for _, s in rs if s["controller"] in ("pd", "position") and s.get("final_mae") is not None]
         for d, s in rs:
             if not s.get("trials_completed"):
                 continue
+            if s["controller"] in ("snn", "ann") and s["trials_completed"] >= 10:
+                from cerebx.report import stages
+
+                try:
+                    png = stages.stages_figure(d, s, fig_dir / f"stages_{task}_{d.name}")
+                    sections.append(f"<figure><img src='figures/{png.name}'><figcaption>{html.escape(str(d))}: "
+                                    "thesis Fig. 2.6/2.7 — DCN activity, torques, desired vs actual joints and the "
+                                    "end-effector path (density of the previous 10 trials) at an initial, "
+                                    "intermediate and final stage.</figcaption></figure>")
+                    png = stages.mae_per_joint_figure(s, baselines, fig_dir / f"mae_joints_{task}_{d.name}")
+                    sections.append(f"<figure><img src='figures/{png.name}'><figcaption>{html.escape(str(d))}: "
+                                    "thesis Fig. 2.6 g / 2.7 g — MAE per trial per joint and mean, with the "
+                                    "baselines' final MAE.</figcaption></figure>")
+                except (CerebxError, ValueError) as err:
+                    problems.append(str(err))
             try:
                 png = figures.joint_tracking(d, s, fig_dir / f"tracking_{task}_{d.name}")
             except (CerebxError, ValueError) as err:
