@@ -83,7 +83,7 @@ def read_messages(path: Path | str, topics: list[str] | None = None, start_ns: i
         reader = _reader(fh)
         try:
             for _schema, channel, message, decoded in reader.iter_decoded_messages(
-                    topics=topics, start_time=start_ns, end_time=end_ns):
+                    topics=topics, starting_at=start_ns, ending_before=end_ns):
                 yield channel.topic, message.log_time, decoded
         except CerebxError:
             raise
