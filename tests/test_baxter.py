@@ -209,3 +209,18 @@ def test_position_servo_holds_and_outputs_zero_without_sensor():
         plant.apply(servo.step(ControlInput(k, k * 0.002, REF, np.zeros(6), SensorMsg(k * 0.002, q, qd))).tau)
         plant.step()
     assert np.abs(plant.true_state()[0] - REF).max() < 1e-3
+
+
+def test_pendulum_body_only_when_an_experiment_schedules_one(load):
+    from cerebx.build import build_components
+    from cerebx.plants.base import PlantEvent
+
+    plain = build_components(load(["+task=circle", "controller=pd"])).plant
+    assert not plain.has_pendulum and plain.model.nv == 6
+    with pytest.raises(ValueError, match="built without the pendulum"):
+        plain.handle_event(PlantEvent(0.0, "attach_payload", {"mass_kg": 0.5, "rod_length_m": 0.3}))
+    plain.handle_event(PlantEvent(0.0, "attach_payload", {"mass_kg": 0.5, "rod_length_m": 0.0}))
+    cfg = load(["+task=circle", "controller=pd",
+                "events=[{at_trial: 1, action: {kind: attach_payload, mass_kg: 0.5, rod_length_m: 0.3}}]"])
+    swinging = build_components(cfg).plant
+    assert swinging.has_pendulum and swinging.model.nv == 9

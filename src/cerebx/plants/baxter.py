@@ -165,8 +165,9 @@ def kinematic_mjcf() -> str:
     )
 
 
-def baxter_mjcf(cfg: BaxterConfig) -> str:
-    """The full simulation model for ``cfg``."""
+def baxter_mjcf(cfg: BaxterConfig, pendulum: bool = True) -> str:
+    """The full simulation model for ``cfg``; ``pendulum`` adds the (idle) conical-pendulum payload
+    body with its ball joint, which costs ~25 % of the physics time when no experiment needs it."""
     link_attrs = []
     for i in range(6):
         attrs = (
@@ -188,10 +189,10 @@ def baxter_mjcf(cfg: BaxterConfig) -> str:
     payload = (
         gripper
         + '<body name="payload_point"><inertial pos="0 0 0" mass="0" diaginertia="0 0 0"/></body>'
-        + f'<body name="payload_pendulum"><inertial pos="0 0 0" mass="{_PAYLOAD_IDLE_MASS_KG}"'
-        f' diaginertia="{_PAYLOAD_IDLE_INERTIA} {_PAYLOAD_IDLE_INERTIA} {_PAYLOAD_IDLE_INERTIA}"/>'
-        '<joint name="payload_ball" type="ball" armature="1e-5" damping="1e-5"/></body>'
-        '<site name="band_hand" pos="0 0 0"/>'
+        + (f'<body name="payload_pendulum"><inertial pos="0 0 0" mass="{_PAYLOAD_IDLE_MASS_KG}"'
+           f' diaginertia="{_PAYLOAD_IDLE_INERTIA} {_PAYLOAD_IDLE_INERTIA} {_PAYLOAD_IDLE_INERTIA}"/>'
+           '<joint name="payload_ball" type="ball" armature="1e-5" damping="1e-5"/></body>' if pendulum else "")
+        + '<site name="band_hand" pos="0 0 0"/>'
     )
     chain = _chain_xml(link_attrs, gravcomp, payload)
 
@@ -242,7 +243,12 @@ class BaxterArm(Plant):
         n = self.substeps
         if n < 1 or abs(n * self.physics_dt_s - self.control_dt_s) > 1e-12:
             raise ValueError(f"physics_dt_ms {self.cfg.physics_dt_ms} does not divide the 2 ms control step")
-        self.xml = baxter_mjcf(self.cfg)
+        # the pendulum payload is built only when the experiment schedules one (or, without an
+        # experiment, always: contract checks apply every event kind)
+        events = getattr(getattr(ctx, "cfg", None), "events", None)
+        self.has_pendulum = events is None or any(
+            e.action.kind == "attach_payload" and e.action.rod_length_m > 0 for e in events)
+        self.xml = baxter_mjcf(self.cfg, pendulum=self.has_pendulum)
         self.model = mujoco.MjModel.from_xml_string(self.xml)
         self.data = mujoco.MjData(self.model)
         self._scratch = mujoco.MjData(self.model)
@@ -254,9 +260,9 @@ class BaxterArm(Plant):
         self._ee_site = m.site("end_effector").id
         self._hand = m.body("left_hand").id
         self._point = m.body("payload_point").id
-        self._pend = m.body("payload_pendulum").id
-        self._ball_q = m.jnt_qposadr[m.joint("payload_ball").id]
-        self._ball_v = m.jnt_dofadr[m.joint("payload_ball").id]
+        self._pend = m.body("payload_pendulum").id if self.has_pendulum else -1
+        self._ball_q = m.jnt_qposadr[m.joint("payload_ball").id] if self.has_pendulum else -1
+        self._ball_v = m.jnt_dofadr[m.joint("payload_ball").id] if self.has_pendulum else -1
         self._rotor_q = (
             np.array([m.jnt_qposadr[m.joint(f"rotor_{j}").id] for j in JOINTS])
             if self.cfg.sea.enabled
@@ -375,7 +381,8 @@ class BaxterArm(Plant):
         s.qpos[:6] = q
         s.qvel[:] = 0.0
         mujoco.mj_kinematics(m, s)
-        mujoco.mju_negQuat(s.qpos[self._ball_q : self._ball_q + 4], s.xquat[self._hand])
+        if self.has_pendulum:
+            mujoco.mju_negQuat(s.qpos[self._ball_q : self._ball_q + 4], s.xquat[self._hand])
         mujoco.mj_fwdPosition(m, s)
         mujoco.mj_fwdVelocity(m, s)
         out = s.qfrc_bias[:6] - s.qfrc_gravcomp[:6]
@@ -398,12 +405,13 @@ class BaxterArm(Plant):
         return s.site_xpos[self._ee_site].copy(), s.site_xmat[self._ee_site].reshape(3, 3).copy()
 
     def payload_mass_kg(self) -> float:
-        return float(self.model.body_mass[self._point] + self.model.body_mass[self._pend])
+        pend = self.model.body_mass[self._pend] if self.has_pendulum else 0.0
+        return float(self.model.body_mass[self._point] + pend)
 
     # ---- events ---------------------------------------------------------------------------
     def _restore_payload(self) -> None:
         m = self.model
-        for b in (self._point, self._pend):
+        for b in (self._point, self._pend) if self.has_pendulum else (self._point,):
             m.body_mass[b] = self._mass0[b]
             m.body_ipos[b] = self._ipos0[b]
             m.body_inertia[b] = self._inertia0[b]
@@ -416,6 +424,9 @@ class BaxterArm(Plant):
         self._restore_payload()
         if rod <= 0:
             m.body_mass[self._point] = mass
+        elif not self.has_pendulum:
+            raise ValueError("attach_payload with rod_length_m > 0: the plant was built without the pendulum body "
+                             "(it is added when the experiment's events schedule one)")
         else:
             # A small sphere (radius 2 cm) on a massless rod, pivoting freely at the end-effector.
             inertia = 0.4 * mass * 0.02**2
