@@ -164,3 +164,24 @@ def test_given_ranges():
                     qd_min=(-3,) * 6, qd_max=(3,) * 6)
     ctrl = make_ctrl(mf=BoxEncoder(fibers_per_signal=5, ranges=r))
     assert ctrl.mf.lo[0].tolist() == [-1, -1, -2, -3]
+
+
+@pytest.mark.parametrize("pipeline", [True, False])
+def test_stamped_efferent_sends_what_hold_applies_later(pipeline):
+    """'stamp' emits at tick k the torque 'hold' emits at tick k + D, with the same time stamp."""
+    out = {}
+    for mode in ("hold", "stamp"):
+        ctrl = make_ctrl(pathway_delay_ms=20.0, efferent=mode, pipeline=pipeline)
+        ctrl.reset(np.random.default_rng(0))
+        msgs = []
+        for k in range(120):
+            t = k * 0.002
+            q = np.sin(np.pi * t) * 0.3 * np.ones(6)
+            qd = np.cos(np.pi * t) * 0.3 * np.ones(6)
+            msgs.append(ctrl.step(ControlInput(k, t, q, qd, SensorMsg(t, q - 0.02, qd))))
+        out[mode] = msgs
+    D = 10
+    for k in range(120 - D):
+        held, sent = out["hold"][k + D], out["stamp"][k]
+        assert sent.stamp_s == pytest.approx(held.stamp_s)
+        np.testing.assert_array_equal(sent.tau, held.tau)

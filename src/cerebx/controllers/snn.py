@@ -49,7 +49,12 @@ class SNNControllerImpl(Controller):
         self.net_cfg = ctx.cfg.network
         self.k_delay = int(round(cfg.pathway_delay_ms / (STEP_S * 1000)))
         # pipelined: the network gets its own core, so its kernels run single-threaded
-        self.pipeline = cfg.pipeline and self.k_delay > 0
+        self.hold = cfg.efferent == "hold"
+        # steps the network may run ahead of the tick that needs its output: afferent D, plus the
+        # efferent D when outputs are held back; a chunk is half of that so one can be in flight
+        slack = self.k_delay * (2 if self.hold else 1)
+        self.chunk = max(1, slack // 2)
+        self.pipeline = cfg.pipeline and slack >= 2
         self._worker: tuple[threading.Thread, dict] | None = None
         self.net = Network(self.net_cfg, parallel=cfg.parallel and not self.pipeline)
         self.net.learn = cfg.plasticity
@@ -87,7 +92,8 @@ class SNNControllerImpl(Controller):
         self._join()
         k = self.k_delay
         self._pending: deque[np.ndarray] = deque([np.zeros(0, np.int32)] * k)  # inputs not yet simulated
-        self._ready: deque[np.ndarray] = deque([np.zeros(self.n_ctrl)] * k)  # torques not yet applied
+        # torques not yet emitted (held back by the efferent delay unless they are stamped instead)
+        self._ready: deque[np.ndarray] = deque([np.zeros(self.n_ctrl)] * (k if self.hold else 0))
         self._net_step = 0  # network steps simulated so far (step m is stamped m * 2 ms)
         self._des: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._dcn_spikes = 0
@@ -118,8 +124,8 @@ class SNNControllerImpl(Controller):
         self._net_step += len(results)
 
     def _launch(self) -> None:
-        """Start simulating the next k pending inputs on the worker thread."""
-        chunk = [self._pending.popleft() for _ in range(self.k_delay)]
+        """Start simulating the next chunk of pending inputs on the worker thread."""
+        chunk = [self._pending.popleft() for _ in range(self.chunk)]
         first = self._net_step  # no chunk is in flight when a new one starts
         box: dict[str, Any] = {}
 
@@ -153,7 +159,7 @@ class SNNControllerImpl(Controller):
                 self._join()
             else:
                 self._absorb(self._simulate([self._pending.popleft()], self._net_step))
-        if self._worker is None and len(self._pending) >= self.k_delay:
+        if self._worker is None and len(self._pending) >= self.chunk:
             self._launch()
 
     def reset(self, rng: np.random.Generator) -> None:
@@ -191,7 +197,8 @@ class SNNControllerImpl(Controller):
         self._steps += 1
         tau = np.zeros(self.n_joints)
         tau[: self.n_ctrl] = self._ready.popleft()
-        return TorqueMsg(inp.t_s, tau)
+        stamp = inp.t_s if self.hold else inp.t_s + self.k_delay * STEP_S
+        return TorqueMsg(stamp, tau)
 
     # ------------------------------------------------------------------ reporting
     def end_trial(self, trial: int) -> dict[str, float]:
@@ -263,6 +270,6 @@ class SNNControllerImpl(Controller):
         self.cf.rng.bit_generator.state = meta["rng"]
         fifo = json.loads(str(data["in_fifo"]))
         self._join()
-        if len(fifo) + len(data["out_fifo"]) == 2 * self.k_delay:  # same pathway delay: resume exactly
+        if len(fifo) + len(data["out_fifo"]) == self.k_delay * (2 if self.hold else 1):  # resume exactly
             self._pending = deque(np.asarray(a, dtype=np.int32) for a in fifo)
             self._ready = deque(np.asarray(r, dtype=float) for r in data["out_fifo"])

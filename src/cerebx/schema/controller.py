@@ -174,6 +174,12 @@ class SNNController(_ControllerCommon):
     error: ErrorGains = ErrorGains()
     decoder: DCNDecoder = DCNDecoder()
     pathway_delay_ms: NonNegFloat = Field(50.0, description="afferent = efferent sensorimotor delay D")
+    efferent: Literal["hold", "stamp"] = Field(
+        "hold",
+        description="'hold': a torque is emitted D after the network computed it; 'stamp': it is sent at "
+        "once, stamped with its application time (network time + D), for the plant-side future/past "
+        "filter (Eq. 3.6) as in the original delay setup",
+    )
     plasticity: bool = True
     parallel: bool = Field(True, description="use numba threads in the network kernels (when not pipelined)")
     pipeline: bool = Field(

@@ -43,6 +43,7 @@ from numba import njit, prange
 
 from cerebx.snn.topology import (
     I_COMPACT,
+    I_HI,
     I_KIND,
     I_LO,
     I_NFINE,
@@ -72,6 +73,7 @@ from cerebx.snn.topology import (
 G_FLOOR = np.float32(1e-12)  # conductances below this (nS) become exactly 0 (avoids denormals)
 U_FLOOR = np.float32(1e-6)  # |V - E_L| below this (mV) becomes exactly 0 (neuron back at rest)
 COMPACT_FRACTION = 8  # compact a population when at least 1/8 of its listed neurons are at rest
+RUN_MIN = 4  # targets at consecutive compact positions delivered as one vector add from this many on
 PAR_MIN = 4096  # neurons below which a population is integrated serially even when parallel
 
 MG_LN = float(np.log(1.2 / 3.57))  # NMDA Mg block g_inf(V) = 1 / (1 + e^(-0.062 V + MG_LN)), V in mV
@@ -109,56 +111,141 @@ def _decay(g, d):
         g[i] = x if x > G_FLOOR else zero
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _finish(un, r, g0, lo_u, uth, nref, dwin):
+    """Clamp, flush, threshold, reset and refractory of a step's result un (refractory count r at
+    the step start) and the decayed conductance: (u, ref, spike, g)."""
+    zero, one = np.float32(0.0), np.float32(1.0)
+    un = max(un, lo_u)
+    un = un if abs(un) >= U_FLOOR else zero
+    spk = (un >= uth) & (r <= zero)
+    un = zero if (r > zero) | spk else un
+    rn = nref if spk else max(r - one, zero)
+    gn = g0 * dwin
+    gn = gn if gn > G_FLOOR else zero
+    return un, rn, spk, gn
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _coarse(cf, x, g0):
+    """P(g0) x + Q(g0) of the coarse step; cf: the coefficients as a tuple (loaded once per call,
+    not per neuron: the arrays stored to in a loop could alias the coefficient array)."""
+    p0, p1, p2, p3, p4 = cf[0], cf[1], cf[2], cf[3], cf[4]
+    q0, q1, q2, q3, q4 = cf[5], cf[6], cf[7], cf[8], cf[9]
+    return (p0 + g0 * (p1 + g0 * (p2 + g0 * (p3 + g0 * p4)))) * x + (
+        q0 + g0 * (q1 + g0 * (q2 + g0 * (q3 + g0 * q4))))
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _fine(cf, x, g0):
+    r0, r1, r2, r3, r4, r5, r6 = cf[10], cf[11], cf[12], cf[13], cf[14], cf[15], cf[16]
+    s0, s1, s2, s3, s4, s5, s6 = cf[17], cf[18], cf[19], cf[20], cf[21], cf[22], cf[23]
+    return (r0 + g0 * (r1 + g0 * (r2 + g0 * (r3 + g0 * (r4 + g0 * (r5 + g0 * r6)))))) * x + (
+        s0 + g0 * (s1 + g0 * (s2 + g0 * (s3 + g0 * (s4 + g0 * (s5 + g0 * s6))))))
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _coefs(c):
+    return (c[0, 0, 0], c[0, 0, 1], c[0, 0, 2], c[0, 0, 3], c[0, 0, 4],
+            c[0, 1, 0], c[0, 1, 1], c[0, 1, 2], c[0, 1, 3], c[0, 1, 4],
+            c[1, 0, 0], c[1, 0, 1], c[1, 0, 2], c[1, 0, 3], c[1, 0, 4], c[1, 0, 5], c[1, 0, 6],
+            c[1, 1, 0], c[1, 1, 1], c[1, 1, 2], c[1, 1, 3], c[1, 1, 4], c[1, 1, 5], c[1, 1, 6])
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _pass(u, g, ref, flag, c, a, b, mode, tmp, ufine, lo_u, uth, nref, dwin):
+    """Neurons a..b-1: mode 0 coarse step, mode 1 coarse or bifixed (both evaluated), mode 2 the
+    coarse results already in tmp[0 : b - a], none of which needs the bifixed step. One fused loop
+    per mode (LLVM vectorises them). Returns (spikes, neurons at rest) as floats."""
+    zero, one = np.float32(0.0), np.float32(1.0)
+    cnt = zero
+    nrest = zero
+    if mode == 1:
+        for i in range(a, b):
+            x = u[i]
+            g0 = g[i]
+            r = ref[i]
+            un = _coarse(c, x, g0)
+            uf = _fine(c, x, g0)
+            un = uf if (x > ufine) | (un > ufine) else un
+            un, rn, spk, gn = _finish(un, r, g0, lo_u, uth, nref, dwin)
+            u[i] = un
+            ref[i] = rn
+            flag[i] = np.uint8(spk)
+            cnt += one if spk else zero
+            g[i] = gn
+            nrest += one if (abs(un) + gn + rn) == zero else zero
+    elif mode == 2:
+        for i in range(a, b):
+            g0 = g[i]
+            r = ref[i]
+            un, rn, spk, gn = _finish(tmp[i - a], r, g0, lo_u, uth, nref, dwin)
+            u[i] = un
+            ref[i] = rn
+            flag[i] = np.uint8(spk)
+            cnt += one if spk else zero
+            g[i] = gn
+            nrest += one if (abs(un) + gn + rn) == zero else zero
+    else:
+        for i in range(a, b):
+            x = u[i]
+            g0 = g[i]
+            r = ref[i]
+            un, rn, spk, gn = _finish(_coarse(c, x, g0), r, g0, lo_u, uth, nref, dwin)
+            u[i] = un
+            ref[i] = rn
+            flag[i] = np.uint8(spk)
+            cnt += one if spk else zero
+            g[i] = gn
+            nrest += one if (abs(un) + gn + rn) == zero else zero
+    return cnt, nrest
+
+
+FINE_BLOCK = 128  # outside the hot front, neurons are checked for the bifixed step in blocks of this
+HOT_FRACTION = 0.5  # compaction puts neurons with u > HOT_FRACTION * ufine in the hot front
+
+
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
-def _lif_poly(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp):
+def _lif_poly(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nh):
     """One step of an AMPA-only population (arguments are its slices): u' = P(g0) u + Q(g0), or,
     when ``fine`` and the step starts above ufine or its one-step estimate ends above it, the
     bifixed pair (the n sub-steps composed). c: float32 [2, 2, N_COEF] coefficients (lowest
     order first) of (P, Q) for the step and for the bifixed sub-steps composed.
-    Returns (spikes, neurons at rest after the step). Written as passes that each store to one or
-    two arrays and have no branches, so LLVM vectorises them (with more arrays stored in one loop
-    it gives up on the runtime alias checks)."""
+    With ``fine``, the first ``nh`` neurons (the "hot" front of a compact list, likely above
+    ufine) evaluate both polynomials; the rest go in blocks: the coarse step first, and the
+    bifixed one only for a block where some neuron needs it (same results as evaluating both
+    everywhere, at about the cost of the coarse step where the neurons stay low).
+    Returns (spikes, neurons at rest after the step)."""
     f32 = np.float32
-    p0, p1, p2, p3, p4 = c[0, 0, 0], c[0, 0, 1], c[0, 0, 2], c[0, 0, 3], c[0, 0, 4]
-    q0, q1, q2, q3, q4 = c[0, 1, 0], c[0, 1, 1], c[0, 1, 2], c[0, 1, 3], c[0, 1, 4]
-    r0, r1, r2, r3, r4, r5, r6 = (c[1, 0, 0], c[1, 0, 1], c[1, 0, 2], c[1, 0, 3], c[1, 0, 4], c[1, 0, 5],
-                                  c[1, 0, 6])
-    s0, s1, s2, s3, s4, s5, s6 = (c[1, 1, 0], c[1, 1, 1], c[1, 1, 2], c[1, 1, 3], c[1, 1, 4], c[1, 1, 5],
-                                  c[1, 1, 6])
     lo_u = f32(0.0) if clamp else f32(-3.0e38)
-    zero, one = f32(0.0), f32(1.0)
     n = u.shape[0]
-    if fine:
-        for i in range(n):
+    c = _coefs(c)
+    if not fine:
+        cnt, nrest = _pass(u, g, ref, flag, c, 0, n, 0, u, ufine, lo_u, uth, nref, dwin)
+        return int(cnt), int(nrest)
+    nh = min(max(nh, 0), n)
+    cnt, nrest = _pass(u, g, ref, flag, c, 0, nh, 1, u, ufine, lo_u, uth, nref, dwin)
+    tmp = np.empty(FINE_BLOCK, dtype=np.float32)
+    zero, one = f32(0.0), f32(1.0)
+    for a in range(nh, n, FINE_BLOCK):
+        b = min(a + FINE_BLOCK, n)
+        need = zero
+        for i in range(a, b):
             x = u[i]
-            g0 = g[i]
-            un = (p0 + g0 * (p1 + g0 * (p2 + g0 * (p3 + g0 * p4)))) * x + (
-                q0 + g0 * (q1 + g0 * (q2 + g0 * (q3 + g0 * q4))))
-            uf = (r0 + g0 * (r1 + g0 * (r2 + g0 * (r3 + g0 * (r4 + g0 * (r5 + g0 * r6)))))) * x + (
-                s0 + g0 * (s1 + g0 * (s2 + g0 * (s3 + g0 * (s4 + g0 * (s5 + g0 * s6))))))
-            un = uf if (x > ufine) | (un > ufine) else un
-            un = max(un, lo_u)
-            u[i] = un if abs(un) >= U_FLOOR else zero
-    else:
-        for i in range(n):
-            x = u[i]
-            g0 = g[i]
-            un = (p0 + g0 * (p1 + g0 * (p2 + g0 * (p3 + g0 * p4)))) * x + (
-                q0 + g0 * (q1 + g0 * (q2 + g0 * (q3 + g0 * q4))))
-            un = max(un, lo_u)
-            u[i] = un if abs(un) >= U_FLOOR else zero
-    cnt = _spikes(u, ref, flag, uth, nref)
-    nrest = zero
-    for i in range(n):  # conductance decay, and count the neurons now exactly at rest
-        x = g[i] * dwin
-        x = x if x > G_FLOOR else zero
-        g[i] = x
-        nrest += one if (abs(u[i]) + x + ref[i]) == zero else zero
-    return cnt, int(nrest)
+            un = _coarse(c, x, g[i])
+            tmp[i - a] = un
+            need += one if (x > ufine) | (un > ufine) else zero
+        if need > zero:
+            c1, r1 = _pass(u, g, ref, flag, c, a, b, 1, tmp, ufine, lo_u, uth, nref, dwin)
+        else:
+            c1, r1 = _pass(u, g, ref, flag, c, a, b, 2, tmp, ufine, lo_u, uth, nref, dwin)
+        cnt += c1
+        nrest += r1
+    return int(cnt), int(nrest)
 
 
 @njit(cache=True, parallel=True, fastmath=True, error_model="numpy", boundscheck=False)
-def _lif_poly_par(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nch):
+def _lif_poly_par(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nh, nch):
     """:func:`_lif_poly` on numba threads: ``nch`` contiguous chunks."""
     n = u.shape[0]
     cnt = 0
@@ -166,7 +253,8 @@ def _lif_poly_par(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nch):
     for ch in prange(nch):
         a = ch * n // nch
         b = (ch + 1) * n // nch
-        c1, r1 = _lif_poly(u[a:b], g[a:b], ref[a:b], flag[a:b], c, dwin, fine, ufine, uth, nref, clamp)
+        c1, r1 = _lif_poly(u[a:b], g[a:b], ref[a:b], flag[a:b], c, dwin, fine, ufine, uth, nref, clamp,
+                           nh - a)
         cnt += c1
         nrest += r1
     return cnt, nrest
@@ -295,21 +383,88 @@ def _collect(flag, ids, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp, so
 
 
 @njit(cache=True, boundscheck=False)
-def _compact(lo, na, u, g, ref, cid, slot):
-    """Drop the neurons at rest from a compact AMPA-only population (stable); returns the new count."""
-    j = lo
-    for k in range(lo, lo + na):
-        if u[k] == 0.0 and g[0, k] == 0.0 and ref[k] == 0.0:
-            slot[cid[k]] = -1
+def _compact(lo, hi, u, g, ref, cid, slot, uhot, sf, si):
+    """Drop the neurons at rest from a compact AMPA-only population and order the others: first
+    the "hot" ones (u > uhot, likely to need the bifixed step, see :func:`_lif_poly`), then the
+    rest, each part in global index order. The order of the list does not affect any result
+    (every per-neuron operation is independent and collected spikes are sorted); index order makes
+    the targets of one presynaptic neuron long runs, see :func:`_build_runs`. sf/si: scratch
+    (hot entries from the front, the others from the back). Returns (count, hot count)."""
+    n = sf.shape[1]
+    jh = 0
+    jc = 0
+    for i in range(lo, hi):
+        k = slot[i]
+        if k < 0:
+            continue
+        x, gk, r = u[k], g[0, k], ref[k]
+        if x == 0.0 and gk == 0.0 and r == 0.0:
+            slot[i] = -1
+            continue
+        if x > uhot:
+            m = jh
+            jh += 1
         else:
-            if j != k:
-                u[j] = u[k]
-                g[0, j] = g[0, k]
-                ref[j] = ref[k]
-                cid[j] = cid[k]
-                slot[cid[j]] = j
-            j += 1
-    return j - lo
+            m = n - 1 - jc
+            jc += 1
+        sf[0, m] = x
+        sf[1, m] = gk
+        sf[2, m] = r
+        si[m] = i
+    for d in range(jh + jc):
+        m = d if d < jh else n - 1 - (d - jh)
+        k = lo + d
+        u[k] = sf[0, m]
+        g[0, k] = sf[1, m]
+        ref[k] = sf[2, m]
+        i = si[m]
+        cid[k] = i
+        slot[i] = k
+    return jh + jc, jh
+
+
+@njit(cache=True, boundscheck=False)
+def _build_runs(qa, qb, sp_post, plo, pp, n_act, u, g, ref, cid, slot, c_k, c_q, c_l, kbuf):
+    """Positions in the compact list of the targets sp_post[qa:qb] of one presynaptic neuron
+    (activating the ones at rest), as runs of consecutive positions (c_k start, c_q first synapse,
+    c_l run length) of at least RUN_MIN, stored from qa on, followed by the remaining single targets
+    (c_k position, c_q synapse). Returns (runs, singles). Valid until the population is compacted
+    again (activation only appends)."""
+    for q in range(qa, qb):
+        i = sp_post[q]
+        kq = slot[i]
+        if kq < 0:
+            kq = plo + n_act[pp]
+            n_act[pp] += 1
+            slot[i] = kq
+            cid[kq] = i
+            u[kq] = 0.0
+            g[0, kq] = 0.0
+            g[1, kq] = 0.0
+            g[2, kq] = 0.0
+            ref[kq] = 0.0
+        kbuf[q - qa] = kq
+    n = qb - qa
+    nr = 0
+    for sweep in range(2):  # runs first, then the single targets
+        ns = 0
+        a = 0
+        while a < n:
+            b = a + 1
+            while b < n and kbuf[b] == kbuf[b - 1] + 1:
+                b += 1
+            if sweep == 0 and b - a >= RUN_MIN:
+                c_k[qa + nr] = kbuf[a]
+                c_q[qa + nr] = qa + a
+                c_l[qa + nr] = b - a
+                nr += 1
+            elif sweep == 1 and b - a < RUN_MIN:
+                for m in range(a, b):
+                    c_k[qa + nr + ns] = kbuf[m]
+                    c_q[qa + nr + ns] = qa + m
+                    ns += 1
+            a = b
+    return nr, ns
 
 
 @njit(cache=True, fastmath=True, boundscheck=False)
@@ -351,11 +506,17 @@ def _ltd(w, n_post, col, n_col, lo_w, ltd, kern, pf_t, pf_j, pf_head, t, acc, ac
 @njit(cache=True, nogil=True, fastmath=True, error_model="numpy", boundscheck=False)
 def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n_rest,
              pop_i, pop_par, poly, ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w, de_i, dense_w,
-             pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, acc, acc_j, out_idx, out_t):
+             pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, acc, acc_j, out_idx, out_t,
+             sp_c, c_k, c_q, c_l, pop_ep, scr_f, scr_i, n_hot):
     """Advance the network by one control step of ``n_sub`` substeps starting at substep t0.
 
     ``inputs`` are global indices of input fibres spiking at t0. Returns the number of spikes
     written to out_idx/out_t (out_t = substep 1..n_sub at whose end the spike happened).
+
+    ``n_hot``: per population, the length of the hot front of its compact list (see _lif_poly).
+    Sparse projections onto a compact population deliver through a per-presynaptic-neuron cache of
+    the targets' compact positions (``_build_runs``; sp_c[off + j] = (epoch, runs, singles), valid
+    while it equals pop_ep of the target population, which every compaction increments).
     """
     R = ring_idx.shape[0]
     slot0 = t0 % R
@@ -377,6 +538,7 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
             if t % ratio != 0:
                 continue
             plo = pop_i[pp, I_LO]
+            compact = pop_i[pp, I_COMPACT] != 0
             dec = pop_par[pp, P_D1A + rec]
             scale = 1.0
             for a in range(ratio):  # arrivals since the population's previous step boundary
@@ -389,6 +551,23 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
                 for k in range(ring_n[sl]):
                     j = ring_idx[sl, k] - pre_lo
                     if j < 0 or j >= n_pre:
+                        continue
+                    if compact:
+                        cj = off + j
+                        qa = sp_ptr[cj]
+                        if sp_c[cj, 0] != pop_ep[pp]:
+                            nr, ns = _build_runs(qa, sp_ptr[cj + 1], sp_post, plo, pp, n_act, u, g, ref, cid,
+                                                 slot, c_k, c_q, c_l, scr_i)
+                            sp_c[cj, 0], sp_c[cj, 1], sp_c[cj, 2] = pop_ep[pp], nr, ns
+                        nr, ns = sp_c[cj, 1], sp_c[cj, 2]
+                        gr = g[rec]
+                        for r in range(qa, qa + nr):  # (slices: the add loop vectorises)
+                            k0, q0, ln = c_k[r], c_q[r], c_l[r]
+                            gs, ws = gr[k0 : k0 + ln], sp_w[q0 : q0 + ln]
+                            for m in range(ln):
+                                gs[m] += ws[m] * sc
+                        for r in range(qa + nr, qa + nr + ns):
+                            gr[c_k[r]] += sp_w[c_q[r]] * sc
                         continue
                     for q in range(sp_ptr[off + j], sp_ptr[off + j + 1]):
                         i = sp_post[q]
@@ -441,17 +620,20 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
                                 g[2, kq] = 0.0
                                 ref[kq] = 0.0
                             g[rec, kq] += dense_w[row + q] * sc
-                    elif a == 0:
+                    elif a == 0:  # (1D slices: these loops vectorise)
+                        gs, ws = g[rec, post_lo : post_lo + n_post], dense_w[row : row + n_post]
                         for q in range(n_post):
-                            g[rec, post_lo + q] += dense_w[row + q]
+                            gs[q] += ws[q]
                     else:
+                        gs, ws = g[rec, post_lo : post_lo + n_post], dense_w[row : row + n_post]
                         for q in range(n_post):
-                            g[rec, post_lo + q] += dense_w[row + q] * sc
+                            gs[q] += ws[q] * sc
                     if pl >= 0 and learn:
                         ltp, hi_w = np.float32(pl_f[pl, 0]), np.float32(pl_f[pl, 3])
+                        ws = dense_w[row : row + n_post]
                         for q in range(n_post):
-                            x = dense_w[row + q] + ltp
-                            dense_w[row + q] = x if x < hi_w else hi_w
+                            x = ws[q] + ltp
+                            ws[q] = x if x < hi_w else hi_w
                     if pl >= 0:
                         cap = pf_t.shape[1]
                         e = pf_head[pl] % cap
@@ -500,7 +682,8 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
             if kind == KIND_LIF_AMPA:
                 args = (u[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], poly[pi], np.float32(pp[P_DA]),
                         pop_i[pi, I_NFINE] > 1, np.float32(pp[P_UFINE]),
-                        np.float32(pp[P_VTH] - pp[P_EL]), np.float32(pp[P_NREF]), pp[P_CLAMP] > 0.5)
+                        np.float32(pp[P_VTH] - pp[P_EL]), np.float32(pp[P_NREF]), pp[P_CLAMP] > 0.5,
+                        n_hot[pi])
                 if par > 1 and na >= PAR_MIN:
                     cnt, nr = _lif_poly_par(*args, par)
                 else:
@@ -515,6 +698,8 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
     # they are integrated as exact no-ops)
     for pi in range(pop_i.shape[0]):
         if pop_i[pi, I_COMPACT] != 0 and n_rest[pi] > 0 and COMPACT_FRACTION * n_rest[pi] >= n_act[pi]:
-            n_act[pi] = _compact(pop_i[pi, I_LO], n_act[pi], u, g, ref, cid, slot)
+            n_act[pi], n_hot[pi] = _compact(pop_i[pi, I_LO], pop_i[pi, I_HI], u, g, ref, cid, slot,
+                                            np.float32(HOT_FRACTION * pop_par[pi, P_UFINE]), scr_f, scr_i)
+            pop_ep[pi] += 1
             n_rest[pi] = 0
     return n_out
