@@ -153,20 +153,22 @@ def _coefs(c):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _pass(u, g, ref, flag, c, a, b, mode, tmp, ufine, lo_u, uth, nref, dwin):
+def _pass(u, g, ref, flag, cf, a, b, mode, tmp, ufine, lo_u, uth, nref, dwin):
     """Neurons a..b-1: mode 0 coarse step, mode 1 coarse or bifixed (both evaluated), mode 2 the
     coarse results already in tmp[0 : b - a], none of which needs the bifixed step. One fused loop
-    per mode (LLVM vectorises them). Returns (spikes, neurons at rest) as floats."""
+    per mode (LLVM vectorises them; the indices are unsigned so that numba emits no negative-index
+    wraparound, which would defeat the vectoriser). Returns (spikes, neurons at rest) as floats."""
     zero, one = np.float32(0.0), np.float32(1.0)
     cnt = zero
     nrest = zero
     if mode == 1:
-        for i in range(a, b):
+        for k in range(b - a):
+            i = np.uint64(a + k)
             x = u[i]
             g0 = g[i]
             r = ref[i]
-            un = _coarse(c, x, g0)
-            uf = _fine(c, x, g0)
+            un = _coarse(cf, x, g0)
+            uf = _fine(cf, x, g0)
             un = uf if (x > ufine) | (un > ufine) else un
             un, rn, spk, gn = _finish(un, r, g0, lo_u, uth, nref, dwin)
             u[i] = un
@@ -176,10 +178,11 @@ def _pass(u, g, ref, flag, c, a, b, mode, tmp, ufine, lo_u, uth, nref, dwin):
             g[i] = gn
             nrest += one if (abs(un) + gn + rn) == zero else zero
     elif mode == 2:
-        for i in range(a, b):
+        for k in range(b - a):
+            i = np.uint64(a + k)
             g0 = g[i]
             r = ref[i]
-            un, rn, spk, gn = _finish(tmp[i - a], r, g0, lo_u, uth, nref, dwin)
+            un, rn, spk, gn = _finish(tmp[np.uint64(k)], r, g0, lo_u, uth, nref, dwin)
             u[i] = un
             ref[i] = rn
             flag[i] = np.uint8(spk)
@@ -187,11 +190,12 @@ def _pass(u, g, ref, flag, c, a, b, mode, tmp, ufine, lo_u, uth, nref, dwin):
             g[i] = gn
             nrest += one if (abs(un) + gn + rn) == zero else zero
     else:
-        for i in range(a, b):
+        for k in range(b - a):
+            i = np.uint64(a + k)
             x = u[i]
             g0 = g[i]
             r = ref[i]
-            un, rn, spk, gn = _finish(_coarse(c, x, g0), r, g0, lo_u, uth, nref, dwin)
+            un, rn, spk, gn = _finish(_coarse(cf, x, g0), r, g0, lo_u, uth, nref, dwin)
             u[i] = un
             ref[i] = rn
             flag[i] = np.uint8(spk)
@@ -230,10 +234,11 @@ def _lif_poly(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nh):
     for a in range(nh, n, FINE_BLOCK):
         b = min(a + FINE_BLOCK, n)
         need = zero
-        for i in range(a, b):
+        for k in range(b - a):
+            i = np.uint64(a + k)
             x = u[i]
             un = _coarse(c, x, g[i])
-            tmp[i - a] = un
+            tmp[np.uint64(k)] = un
             need += one if (x > ufine) | (un > ufine) else zero
         if need > zero:
             c1, r1 = _pass(u, g, ref, flag, c, a, b, 1, tmp, ufine, lo_u, uth, nref, dwin)
