@@ -205,52 +205,28 @@ def _pass(u, g, ref, flag, cf, a, b, mode, tmp, ufine, lo_u, uth, nref, dwin):
     return cnt, nrest
 
 
-FINE_BLOCK = 128  # outside the hot front, neurons are checked for the bifixed step in blocks of this
-HOT_FRACTION = 0.5  # compaction puts neurons with u > HOT_FRACTION * ufine in the hot front
-
-
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
-def _lif_poly(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nh):
+def _lif_poly(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp):
     """One step of an AMPA-only population (arguments are its slices): u' = P(g0) u + Q(g0), or,
     when ``fine`` and the step starts above ufine or its one-step estimate ends above it, the
     bifixed pair (the n sub-steps composed). c: float32 [2, 2, N_COEF] coefficients (lowest
     order first) of (P, Q) for the step and for the bifixed sub-steps composed.
-    With ``fine``, the first ``nh`` neurons (the "hot" front of a compact list, likely above
-    ufine) evaluate both polynomials; the rest go in blocks: the coarse step first, and the
-    bifixed one only for a block where some neuron needs it (same results as evaluating both
-    everywhere, at about the cost of the coarse step where the neurons stay low).
-    Returns (spikes, neurons at rest after the step)."""
+    Integration, threshold, reset, refractory count, conductance decay and the count of neurons
+    at rest are one fused loop (it vectorises; ~40% faster than separate passes). With ``fine``
+    both polynomials are evaluated for every neuron: the bifixed one is needed by ~12% of the
+    active GCs (all those with two or more active inputs), and evaluating it only where needed
+    (a coarse pre-pass per block, then the bifixed one for the blocks that need it) costs as
+    much as it saves. Returns (spikes, neurons at rest after the step)."""
     f32 = np.float32
     lo_u = f32(0.0) if clamp else f32(-3.0e38)
     n = u.shape[0]
-    c = _coefs(c)
-    if not fine:
-        cnt, nrest = _pass(u, g, ref, flag, c, 0, n, 0, u, ufine, lo_u, uth, nref, dwin)
-        return int(cnt), int(nrest)
-    nh = min(max(nh, 0), n)
-    cnt, nrest = _pass(u, g, ref, flag, c, 0, nh, 1, u, ufine, lo_u, uth, nref, dwin)
-    tmp = np.empty(FINE_BLOCK, dtype=np.float32)
-    zero, one = f32(0.0), f32(1.0)
-    for a in range(nh, n, FINE_BLOCK):
-        b = min(a + FINE_BLOCK, n)
-        need = zero
-        for k in range(b - a):
-            i = np.uint64(a + k)
-            x = u[i]
-            un = _coarse(c, x, g[i])
-            tmp[np.uint64(k)] = un
-            need += one if (x > ufine) | (un > ufine) else zero
-        if need > zero:
-            c1, r1 = _pass(u, g, ref, flag, c, a, b, 1, tmp, ufine, lo_u, uth, nref, dwin)
-        else:
-            c1, r1 = _pass(u, g, ref, flag, c, a, b, 2, tmp, ufine, lo_u, uth, nref, dwin)
-        cnt += c1
-        nrest += r1
+    cf = _coefs(c)
+    cnt, nrest = _pass(u, g, ref, flag, cf, 0, n, 1 if fine else 0, u, ufine, lo_u, uth, nref, dwin)
     return int(cnt), int(nrest)
 
 
 @njit(cache=True, parallel=True, fastmath=True, error_model="numpy", boundscheck=False)
-def _lif_poly_par(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nh, nch):
+def _lif_poly_par(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nch):
     """:func:`_lif_poly` on numba threads: ``nch`` contiguous chunks."""
     n = u.shape[0]
     cnt = 0
@@ -258,8 +234,7 @@ def _lif_poly_par(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nh, n
     for ch in prange(nch):
         a = ch * n // nch
         b = (ch + 1) * n // nch
-        c1, r1 = _lif_poly(u[a:b], g[a:b], ref[a:b], flag[a:b], c, dwin, fine, ufine, uth, nref, clamp,
-                           nh - a)
+        c1, r1 = _lif_poly(u[a:b], g[a:b], ref[a:b], flag[a:b], c, dwin, fine, ufine, uth, nref, clamp)
         cnt += c1
         nrest += r1
     return cnt, nrest
@@ -388,16 +363,12 @@ def _collect(flag, ids, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp, so
 
 
 @njit(cache=True, boundscheck=False)
-def _compact(lo, hi, u, g, ref, cid, slot, uhot, sf, si):
-    """Drop the neurons at rest from a compact AMPA-only population and order the others: first
-    the "hot" ones (u > uhot, likely to need the bifixed step, see :func:`_lif_poly`), then the
-    rest, each part in global index order. The order of the list does not affect any result
-    (every per-neuron operation is independent and collected spikes are sorted); index order makes
-    the targets of one presynaptic neuron long runs, see :func:`_build_runs`. sf/si: scratch
-    (hot entries from the front, the others from the back). Returns (count, hot count)."""
-    n = sf.shape[1]
-    jh = 0
-    jc = 0
+def _compact(lo, hi, u, g, ref, cid, slot, sf, si):
+    """Drop the neurons at rest from a compact AMPA-only population and put the others in global
+    index order (the order of the list does not affect any result: every per-neuron operation is
+    independent and collected spikes are sorted; index order makes the targets of one presynaptic
+    neuron long runs, see :func:`_build_runs`). sf/si: scratch. Returns the new count."""
+    j = 0
     for i in range(lo, hi):
         k = slot[i]
         if k < 0:
@@ -406,26 +377,20 @@ def _compact(lo, hi, u, g, ref, cid, slot, uhot, sf, si):
         if x == 0.0 and gk == 0.0 and r == 0.0:
             slot[i] = -1
             continue
-        if x > uhot:
-            m = jh
-            jh += 1
-        else:
-            m = n - 1 - jc
-            jc += 1
-        sf[0, m] = x
-        sf[1, m] = gk
-        sf[2, m] = r
-        si[m] = i
-    for d in range(jh + jc):
-        m = d if d < jh else n - 1 - (d - jh)
-        k = lo + d
+        sf[0, j] = x
+        sf[1, j] = gk
+        sf[2, j] = r
+        si[j] = i
+        j += 1
+    for m in range(j):
+        k = lo + m
         u[k] = sf[0, m]
         g[0, k] = sf[1, m]
         ref[k] = sf[2, m]
         i = si[m]
         cid[k] = i
         slot[i] = k
-    return jh + jc, jh
+    return j
 
 
 @njit(cache=True, boundscheck=False)
@@ -512,13 +477,12 @@ def _ltd(w, n_post, col, n_col, lo_w, ltd, kern, pf_t, pf_j, pf_head, t, acc, ac
 def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n_rest,
              pop_i, pop_par, poly, ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w, de_i, dense_w,
              pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, acc, acc_j, out_idx, out_t,
-             sp_c, c_k, c_q, c_l, pop_ep, scr_f, scr_i, n_hot):
+             sp_c, c_k, c_q, c_l, pop_ep, scr_f, scr_i):
     """Advance the network by one control step of ``n_sub`` substeps starting at substep t0.
 
     ``inputs`` are global indices of input fibres spiking at t0. Returns the number of spikes
     written to out_idx/out_t (out_t = substep 1..n_sub at whose end the spike happened).
 
-    ``n_hot``: per population, the length of the hot front of its compact list (see _lif_poly).
     Sparse projections onto a compact population deliver through a per-presynaptic-neuron cache of
     the targets' compact positions (``_build_runs``; sp_c[off + j] = (epoch, runs, singles), valid
     while it equals pop_ep of the target population, which every compaction increments).
@@ -687,8 +651,7 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
             if kind == KIND_LIF_AMPA:
                 args = (u[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], poly[pi], np.float32(pp[P_DA]),
                         pop_i[pi, I_NFINE] > 1, np.float32(pp[P_UFINE]),
-                        np.float32(pp[P_VTH] - pp[P_EL]), np.float32(pp[P_NREF]), pp[P_CLAMP] > 0.5,
-                        n_hot[pi])
+                        np.float32(pp[P_VTH] - pp[P_EL]), np.float32(pp[P_NREF]), pp[P_CLAMP] > 0.5)
                 if par > 1 and na >= PAR_MIN:
                     cnt, nr = _lif_poly_par(*args, par)
                 else:
@@ -703,8 +666,7 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
     # they are integrated as exact no-ops)
     for pi in range(pop_i.shape[0]):
         if pop_i[pi, I_COMPACT] != 0 and n_rest[pi] > 0 and COMPACT_FRACTION * n_rest[pi] >= n_act[pi]:
-            n_act[pi], n_hot[pi] = _compact(pop_i[pi, I_LO], pop_i[pi, I_HI], u, g, ref, cid, slot,
-                                            np.float32(HOT_FRACTION * pop_par[pi, P_UFINE]), scr_f, scr_i)
+            n_act[pi] = _compact(pop_i[pi, I_LO], pop_i[pi, I_HI], u, g, ref, cid, slot, scr_f, scr_i)
             pop_ep[pi] += 1
             n_rest[pi] = 0
     return n_out

@@ -119,7 +119,6 @@ class Network:
         self.pop_ep = np.ones(len(topo.names), dtype=np.int64)
         self.scr_f = np.zeros((3, n), dtype=np.float32)
         self.scr_i = np.zeros(n, dtype=np.int64)
-        self.n_hot = np.zeros(len(topo.names), dtype=np.int64)
         self.learn = True
         self.t_sub = 0
         self.reset_state()
@@ -137,7 +136,6 @@ class Network:
         self.slot[:] = self.cid
         self.n_rest[:] = 0
         self.sp_c[:, 0] = 0  # the compact lists are rebuilt: delivery caches are stale
-        self.n_hot[:] = 0
         for pi in range(len(self.pop_lo)):
             lo, hi = int(self.pop_lo[pi]), int(self.pop_hi[pi])
             self.n_act[pi] = 0 if self.pop_kind[pi] == KIND_INPUT else hi - lo
@@ -243,7 +241,7 @@ class Network:
             self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
             self.de_i, self.dense_w, self.pl_i, self.pl_f, self.kern, self.pf_t, self.pf_j,
             self.pf_head, self.pf_lost, self.col_buf, self.acc, self.acc_j, self.out_idx, self.out_t,
-            self.sp_c, self.c_k, self.c_q, self.c_l, self.pop_ep, self.scr_f, self.scr_i, self.n_hot,
+            self.sp_c, self.c_k, self.c_q, self.c_l, self.pop_ep, self.scr_f, self.scr_i,
         )
         self.t_sub += self.n_sub
         return StepSpikes(self.out_idx[:n], self.out_t[:n])
