@@ -22,7 +22,8 @@ update is a few FMAs per neuron and vectorises. EDLUT's Bifixed refinement (a st
 with V above (E_L + V_thr)/2 is done as n equal sub-steps) is a second coefficient set; here a
 step is also refined when its one-step estimate ends above (E_L + V_thr)/2, so a fast rise from
 below the midpoint is not integrated with the coarse step alone (both pairs are evaluated for
-every neuron anyway, so this costs nothing).
+every neuron in one vectorised loop: ~12% of the active GCs need the bifixed pair, and picking
+them out costs about what it saves).
 Populations with NMDA/GABA input (DCN) run the RK stages in float32 with a branch-free Mg block
 (max abs error 1e-6 against the exact expression), so that loop vectorises too.
 
@@ -31,7 +32,13 @@ until input arrives (every RK stage is exactly 0). Large AMPA-only populations (
 their non-resting neurons packed in the front of the population's slice of u/g/ref, with
 ``cid`` (compact position -> global index) and ``slot`` (global index -> compact position, -1 at
 rest); delivered input activates a resting neuron by appending it, and neurons that came back
-to rest are dropped by a stable compaction at the end of a step. Conductances below 1e-12 nS and
+to rest are dropped by a compaction at the end of a step, which also puts the list back in global
+index order. The order of the list never changes a result (per-neuron updates are independent,
+each neuron's inputs are added in spike order, collected spikes are sorted). Sparse projections
+onto a compact population deliver through per-presynaptic-neuron caches of the targets' compact
+positions as runs of consecutive positions (index order makes e.g. one MF's 1000 GCs a single
+run), rebuilt after each compaction; each target receives exactly the same float32 additions in
+the same order as without the cache. Conductances below 1e-12 nS and
 |u| below 1e-6 mV become exactly 0 (V itself is only resolved to 7.6e-6 mV in float32 near -65
 mV), so a neuron returns to rest a few tens of ms after its last input.
 """
@@ -72,7 +79,7 @@ from cerebx.snn.topology import (
 
 G_FLOOR = np.float32(1e-12)  # conductances below this (nS) become exactly 0 (avoids denormals)
 U_FLOOR = np.float32(1e-6)  # |V - E_L| below this (mV) becomes exactly 0 (neuron back at rest)
-COMPACT_FRACTION = 8  # compact a population when at least 1/8 of its listed neurons are at rest
+COMPACT_FRACTION = 4  # compact a population when at least 1/4 of its listed neurons are at rest
 RUN_MIN = 4  # targets at consecutive compact positions delivered as one vector add from this many on
 PAR_MIN = 4096  # neurons below which a population is integrated serially even when parallel
 
@@ -153,17 +160,15 @@ def _coefs(c):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _pass(u, g, ref, flag, cf, a, b, mode, tmp, ufine, lo_u, uth, nref, dwin):
-    """Neurons a..b-1: mode 0 coarse step, mode 1 coarse or bifixed (both evaluated), mode 2 the
-    coarse results already in tmp[0 : b - a], none of which needs the bifixed step. One fused loop
-    per mode (LLVM vectorises them; the indices are unsigned so that numba emits no negative-index
-    wraparound, which would defeat the vectoriser). Returns (spikes, neurons at rest) as floats."""
+def _pass(u, g, ref, flag, cf, fine, ufine, lo_u, uth, nref, dwin):
+    """Step, threshold, reset, refractory count, conductance decay and rest count of every neuron
+    in one fused loop per variant (LLVM vectorises it). Returns (spikes, neurons at rest) as
+    floats (integer reductions of booleans defeat the vectoriser)."""
     zero, one = np.float32(0.0), np.float32(1.0)
     cnt = zero
     nrest = zero
-    if mode == 1:
-        for k in range(b - a):
-            i = np.uint64(a + k)
+    if fine:
+        for i in range(u.shape[0]):
             x = u[i]
             g0 = g[i]
             r = ref[i]
@@ -177,21 +182,8 @@ def _pass(u, g, ref, flag, cf, a, b, mode, tmp, ufine, lo_u, uth, nref, dwin):
             cnt += one if spk else zero
             g[i] = gn
             nrest += one if (abs(un) + gn + rn) == zero else zero
-    elif mode == 2:
-        for k in range(b - a):
-            i = np.uint64(a + k)
-            g0 = g[i]
-            r = ref[i]
-            un, rn, spk, gn = _finish(tmp[np.uint64(k)], r, g0, lo_u, uth, nref, dwin)
-            u[i] = un
-            ref[i] = rn
-            flag[i] = np.uint8(spk)
-            cnt += one if spk else zero
-            g[i] = gn
-            nrest += one if (abs(un) + gn + rn) == zero else zero
     else:
-        for k in range(b - a):
-            i = np.uint64(a + k)
+        for i in range(u.shape[0]):
             x = u[i]
             g0 = g[i]
             r = ref[i]
@@ -212,16 +204,15 @@ def _lif_poly(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp):
     bifixed pair (the n sub-steps composed). c: float32 [2, 2, N_COEF] coefficients (lowest
     order first) of (P, Q) for the step and for the bifixed sub-steps composed.
     Integration, threshold, reset, refractory count, conductance decay and the count of neurons
-    at rest are one fused loop (it vectorises; ~40% faster than separate passes). With ``fine``
+    at rest are one fused loop (it vectorises; ~25% faster than separate passes). With ``fine``
     both polynomials are evaluated for every neuron: the bifixed one is needed by ~12% of the
     active GCs (all those with two or more active inputs), and evaluating it only where needed
     (a coarse pre-pass per block, then the bifixed one for the blocks that need it) costs as
     much as it saves. Returns (spikes, neurons at rest after the step)."""
     f32 = np.float32
     lo_u = f32(0.0) if clamp else f32(-3.0e38)
-    n = u.shape[0]
     cf = _coefs(c)
-    cnt, nrest = _pass(u, g, ref, flag, cf, 0, n, 1 if fine else 0, u, ufine, lo_u, uth, nref, dwin)
+    cnt, nrest = _pass(u, g, ref, flag, cf, fine, ufine, lo_u, uth, nref, dwin)
     return int(cnt), int(nrest)
 
 
@@ -394,18 +385,23 @@ def _compact(lo, hi, u, g, ref, cid, slot, sf, si):
 
 
 @njit(cache=True, boundscheck=False)
-def _build_runs(qa, qb, sp_post, plo, pp, n_act, u, g, ref, cid, slot, c_k, c_q, c_l, kbuf):
+def _build_runs(qa, qb, sp_post, plo, pp, n_act, u, g, ref, cid, slot, c_k, c_q, c_l):
     """Positions in the compact list of the targets sp_post[qa:qb] of one presynaptic neuron
-    (activating the ones at rest), as runs of consecutive positions (c_k start, c_q first synapse,
-    c_l run length) of at least RUN_MIN, stored from qa on, followed by the remaining single targets
-    (c_k position, c_q synapse). Returns (runs, singles). Valid until the population is compacted
-    again (activation only appends)."""
+    (activating the ones at rest), as runs of consecutive positions: c_k start position, c_q
+    first synapse, c_l length, stored from qa on. Returns the number of runs. Valid until the
+    population is compacted again (activation only appends)."""
+    nr = 0
+    prev = -2
+    k0 = 0
+    q0 = qa
+    ln = 0
+    na = n_act[pp]
     for q in range(qa, qb):
         i = sp_post[q]
         kq = slot[i]
         if kq < 0:
-            kq = plo + n_act[pp]
-            n_act[pp] += 1
+            kq = plo + na
+            na += 1
             slot[i] = kq
             cid[kq] = i
             u[kq] = 0.0
@@ -413,28 +409,25 @@ def _build_runs(qa, qb, sp_post, plo, pp, n_act, u, g, ref, cid, slot, c_k, c_q,
             g[1, kq] = 0.0
             g[2, kq] = 0.0
             ref[kq] = 0.0
-        kbuf[q - qa] = kq
-    n = qb - qa
-    nr = 0
-    for sweep in range(2):  # runs first, then the single targets
-        ns = 0
-        a = 0
-        while a < n:
-            b = a + 1
-            while b < n and kbuf[b] == kbuf[b - 1] + 1:
-                b += 1
-            if sweep == 0 and b - a >= RUN_MIN:
-                c_k[qa + nr] = kbuf[a]
-                c_q[qa + nr] = qa + a
-                c_l[qa + nr] = b - a
+        if kq == prev + 1:
+            ln += 1
+        else:
+            if ln > 0:
+                c_k[qa + nr] = k0
+                c_q[qa + nr] = q0
+                c_l[qa + nr] = ln
                 nr += 1
-            elif sweep == 1 and b - a < RUN_MIN:
-                for m in range(a, b):
-                    c_k[qa + nr + ns] = kbuf[m]
-                    c_q[qa + nr + ns] = qa + m
-                    ns += 1
-            a = b
-    return nr, ns
+            k0 = kq
+            q0 = q
+            ln = 1
+        prev = kq
+    if ln > 0:
+        c_k[qa + nr] = k0
+        c_q[qa + nr] = q0
+        c_l[qa + nr] = ln
+        nr += 1
+    n_act[pp] = na
+    return nr
 
 
 @njit(cache=True, fastmath=True, boundscheck=False)
@@ -484,8 +477,8 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
     written to out_idx/out_t (out_t = substep 1..n_sub at whose end the spike happened).
 
     Sparse projections onto a compact population deliver through a per-presynaptic-neuron cache of
-    the targets' compact positions (``_build_runs``; sp_c[off + j] = (epoch, runs, singles), valid
-    while it equals pop_ep of the target population, which every compaction increments).
+    the targets' compact positions (``_build_runs``; sp_c[off + j] = (epoch, runs), valid while
+    the epoch equals pop_ep of the target population, which every compaction increments).
     """
     R = ring_idx.shape[0]
     slot0 = t0 % R
@@ -525,18 +518,19 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
                         cj = off + j
                         qa = sp_ptr[cj]
                         if sp_c[cj, 0] != pop_ep[pp]:
-                            nr, ns = _build_runs(qa, sp_ptr[cj + 1], sp_post, plo, pp, n_act, u, g, ref, cid,
-                                                 slot, c_k, c_q, c_l, scr_i)
-                            sp_c[cj, 0], sp_c[cj, 1], sp_c[cj, 2] = pop_ep[pp], nr, ns
-                        nr, ns = sp_c[cj, 1], sp_c[cj, 2]
+                            sp_c[cj, 1] = _build_runs(qa, sp_ptr[cj + 1], sp_post, plo, pp, n_act, u, g, ref,
+                                                      cid, slot, c_k, c_q, c_l)
+                            sp_c[cj, 0] = pop_ep[pp]
                         gr = g[rec]
-                        for r in range(qa, qa + nr):  # (slices: the add loop vectorises)
+                        for r in range(qa, qa + sp_c[cj, 1]):
                             k0, q0, ln = c_k[r], c_q[r], c_l[r]
-                            gs, ws = gr[k0 : k0 + ln], sp_w[q0 : q0 + ln]
-                            for m in range(ln):
-                                gs[m] += ws[m] * sc
-                        for r in range(qa + nr, qa + nr + ns):
-                            gr[c_k[r]] += sp_w[c_q[r]] * sc
+                            if ln >= RUN_MIN:  # (slices: the add loop vectorises)
+                                gs, ws = gr[k0 : k0 + ln], sp_w[q0 : q0 + ln]
+                                for m in range(ln):
+                                    gs[m] += ws[m] * sc
+                            else:
+                                for m in range(ln):
+                                    gr[k0 + m] += sp_w[q0 + m] * sc
                         continue
                     for q in range(sp_ptr[off + j], sp_ptr[off + j + 1]):
                         i = sp_post[q]

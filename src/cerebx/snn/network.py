@@ -111,7 +111,7 @@ class Network:
         self.out_idx = np.zeros(n * self.n_sub, dtype=np.int32)
         self.out_t = np.zeros(n * self.n_sub, dtype=np.int32)
         # delivery caches of sparse projections onto compact populations (see kernels.run_step)
-        self.sp_c = np.zeros((len(self.sp_ptr), 3), dtype=np.int64)
+        self.sp_c = np.zeros((len(self.sp_ptr), 2), dtype=np.int64)
         nsyn = len(self.sp_post)
         self.c_k = np.zeros(nsyn, dtype=np.int64)
         self.c_q = np.zeros(nsyn, dtype=np.int64)
