@@ -23,21 +23,26 @@ class HoldFilter:
 
 
 class MeanFilter:
-    """Mean of the last ``taps`` arrived samples (Eq. 2.18)."""
+    """Mean of the last ``taps`` arrived samples (Eq. 2.18), kept as a running sum (recomputed
+    exactly every 1000 samples so rounding cannot drift)."""
 
     def __init__(self, n: int, taps: int):
         self.buf = np.zeros((taps, n))
+        self.sum = np.zeros(n)
         self.count = 0
         self.taps = taps
         self.tau = np.zeros(n)
 
     def __call__(self, arrived: list[TorqueMsg], t_s: float) -> np.ndarray:
         for m in arrived:
-            self.buf[self.count % self.taps] = m.tau
+            i = self.count % self.taps
+            self.sum += m.tau - self.buf[i]
+            self.buf[i] = m.tau
             self.count += 1
+            if self.count % 1000 == 0:
+                self.sum = self.buf.sum(0)
         if self.count:
-            k = min(self.count, self.taps)
-            self.tau = self.buf[:k].mean(0) if k < self.taps else self.buf.mean(0)
+            self.tau = self.sum / min(self.count, self.taps)
         return self.tau
 
 

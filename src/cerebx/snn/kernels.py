@@ -664,3 +664,25 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
             pop_ep[pi] += 1
             n_rest[pi] = 0
     return n_out
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def run_chunk(t0, n_sub, inputs, in_off, learn, par, u, g, ref, flag, cid, slot, n_act, n_rest,
+              pop_i, pop_par, poly, ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w, de_i, dense_w,
+              pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, acc, acc_j, out_idx, out_t,
+              sp_c, c_k, c_q, c_l, pop_ep, scr_f, scr_i, chunk_idx, chunk_off):
+    """``len(in_off) - 1`` consecutive :func:`run_step` calls in one GIL-free call (a pipelined
+    chunk runs without touching Python). Inputs of step s are inputs[in_off[s]:in_off[s + 1]];
+    its spikes (global indices) end up in chunk_idx[chunk_off[s]:chunk_off[s + 1]]."""
+    total = 0
+    chunk_off[0] = 0
+    for s in range(in_off.shape[0] - 1):
+        n = run_step(t0 + s * n_sub, n_sub, inputs[in_off[s]:in_off[s + 1]], learn, par, u, g, ref, flag, cid,
+                     slot, n_act, n_rest, pop_i, pop_par, poly, ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w,
+                     de_i, dense_w, pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, acc, acc_j,
+                     out_idx, out_t, sp_c, c_k, c_q, c_l, pop_ep, scr_f, scr_i)
+        for i in range(n):
+            chunk_idx[total + i] = out_idx[i]
+        total += n
+        chunk_off[s + 1] = total
+    return total

@@ -231,6 +231,29 @@ class Network:
         return self.cfg.n_plastic
 
     # ------------------------------------------------------------------ run
+    def step_many(self, inputs: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """Several consecutive steps in one GIL-free call. Returns (spike indices, offsets): the
+        spikes of step s are ``idx[off[s]:off[s + 1]]`` (same spikes as calling :meth:`step`)."""
+        n = len(inputs)
+        flat = np.concatenate(inputs).astype(np.int32) if n else np.zeros(0, np.int32)
+        in_off = np.zeros(n + 1, dtype=np.int64)
+        in_off[1:] = np.cumsum([len(x) for x in inputs])
+        cap = n * self.out_idx.shape[0]
+        if getattr(self, "_chunk_idx", None) is None or self._chunk_idx.shape[0] < cap:
+            self._chunk_idx = np.zeros(cap, dtype=np.int32)
+        off = np.zeros(n + 1, dtype=np.int64)
+        total = kernels.run_chunk(
+            self.t_sub, self.n_sub, flat, in_off, self.learn, self.n_threads, self.u, self._g, self._ref,
+            self.flag, self.cid, self.slot, self.n_act, self.n_rest, self.pop_i, self.pop_par, self.poly,
+            self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
+            self.de_i, self.dense_w, self.pl_i, self.pl_f, self.kern, self.pf_t, self.pf_j,
+            self.pf_head, self.pf_lost, self.col_buf, self.acc, self.acc_j, self.out_idx, self.out_t,
+            self.sp_c, self.c_k, self.c_q, self.c_l, self.pop_ep, self.scr_f, self.scr_i,
+            self._chunk_idx, off,
+        )
+        self.t_sub += self.n_sub * n
+        return self._chunk_idx[:total].copy(), off
+
     def step(self, inputs: np.ndarray) -> StepSpikes:
         """One 2 ms step; ``inputs`` are global indices of input fibres spiking at its start
         (each fibre at most once)."""
