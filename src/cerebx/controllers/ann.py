@@ -25,6 +25,7 @@ import numpy as np
 
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
+from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
 from cerebx.schema.ann import ANNController
 
@@ -177,21 +178,11 @@ class ANN(Controller):
             "config": self.config_hash,
             "shape": list(self.w.shape),
         }
-        tmp = path.with_name(path.name + ".tmp")
-        with open(tmp, "wb") as f:
-            np.savez(f, w=self.w, meta=np.array(json.dumps(meta)))
-        tmp.replace(path)
+        save_state_npz(path, meta, w=self.w)
 
     def load_state(self, path: Path) -> None:
-        path = Path(path)
-        try:
-            data = np.load(path, allow_pickle=False)
-            meta = json.loads(str(data["meta"]))
-            w = data["w"]
-        except Exception as exc:  # noqa: BLE001 - any unreadable file gets the same one-line message
-            raise StateMismatchError(
-                f"{path}: not a readable cerebx ANN state ({type(exc).__name__})"
-            ) from None
+        data, meta = load_state_npz(path, "ANN")
+        w = data["w"] if "w" in data.files else np.zeros(0)
         if meta.get("kind") != "ann" or tuple(w.shape) != self.w.shape:
             raise StateMismatchError(
                 f"{path}: ANN state of shape {tuple(w.shape)} does not fit this controller "

@@ -27,6 +27,7 @@ import numpy as np
 
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
+from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
 from cerebx.schema.controller import SNNController
 from cerebx.snn.decoder import DCNDecoder
@@ -254,19 +255,12 @@ class SNNControllerImpl(Controller):
         arrays["out_fifo"] = np.array(list(self._ready)).reshape(len(self._ready), self.n_ctrl)
         meta = {"version": STATE_VERSION, "fingerprint": self.fingerprint, "config": self.config_hash,
                 "network": self.net_cfg.name, "rng": self.cf.rng.bit_generator.state}
-        arrays["meta"] = np.array(json.dumps(meta))
-        tmp = path.with_name(path.name + ".tmp")
-        with open(tmp, "wb") as f:
-            np.savez(f, **arrays, in_fifo=np.array(json.dumps([a.tolist() for a in self._pending])))
-        tmp.replace(path)
+        arrays["in_fifo"] = np.array(json.dumps([a.tolist() for a in self._pending]))
+        save_state_npz(path, meta, **arrays)
 
     def load_state(self, path: Path) -> None:
         path = Path(path)
-        try:
-            data = np.load(path, allow_pickle=False)
-            meta = json.loads(str(data["meta"]))
-        except Exception as exc:  # noqa: BLE001 - any unreadable file gets the same one-line message
-            raise StateMismatchError(f"{path}: not a readable cerebx SNN state ({type(exc).__name__})") from None
+        data, meta = load_state_npz(path, "SNN")
         if meta.get("fingerprint") != self.fingerprint:
             raise StateMismatchError(
                 f"{path}: saved from network {meta.get('network')!r} with a different structure "
