@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
 JOINTS_BAXTER = ("s0", "s1", "e0", "e1", "w0", "w1")
 
@@ -15,7 +15,21 @@ class Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
 
 
+CONTROL_DT_MS = 2.0
+"""The control step (500 Hz) every loop runs at."""
+
 PositiveFloat = Annotated[float, Field(gt=0)]
+
+
+def _divides_control_step(ms: float) -> float:
+    n = CONTROL_DT_MS / ms
+    if abs(n - round(n)) > 1e-9:
+        raise ValueError(f"{ms} ms does not divide the {CONTROL_DT_MS} ms control step")
+    return ms
+
+
+PhysicsStepMs = Annotated[float, Field(gt=0, description="MuJoCo timestep; must divide 2 ms"),
+                          AfterValidator(_divides_control_step)]
 NonNegFloat = Annotated[float, Field(ge=0)]
 PerJoint = tuple[float, ...]
 """One value per controlled joint, in joint order; length is checked against the plant."""

@@ -6,14 +6,14 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
-from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
+from cerebx.schema.base import NonNegFloat, PhysicsStepMs, PositiveFloat, Strict
 
 
 class Planar2Config(Strict):
     """Planar two-link arm in a vertical plane (shoulder, elbow), torque-driven; for fast tests."""
 
     kind: Literal["planar2"] = "planar2"
-    physics_dt_ms: PositiveFloat = Field(0.5, description="MuJoCo timestep; must divide 2 ms")
+    physics_dt_ms: PhysicsStepMs = 0.5
     link_length_m: tuple[PositiveFloat, PositiveFloat] = (0.3, 0.3)
     link_mass_kg: tuple[PositiveFloat, PositiveFloat] = (1.5, 1.0)
     damping_Nms_per_rad: NonNegFloat = 0.1
@@ -70,7 +70,7 @@ class BaxterConfig(Strict):
     """Compliant Baxter left arm (six controlled joints, w2 held at 0)."""
 
     kind: Literal["baxter"] = "baxter"
-    physics_dt_ms: PositiveFloat = Field(0.5, description="MuJoCo timestep; must divide 2 ms")
+    physics_dt_ms: PhysicsStepMs = 0.5
     integrator: Literal["euler", "implicitfast", "rk4"] = Field(
         "euler", description="MuJoCo integrator (Euler treats joint damping implicitly)"
     )
