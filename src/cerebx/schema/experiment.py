@@ -13,7 +13,6 @@ from cerebx.schema.base import CONTROL_DT_MS, NonNegFloat, PositiveFloat, Strict
 from cerebx.schema.network import NetworkConfig
 
 
-
 class AttachPayload(Strict):
     """Attach a mass at the end-effector; with ``rod_length_m`` it hangs from a rod (conical pendulum)."""
 
