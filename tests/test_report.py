@@ -15,7 +15,8 @@ def fixture_runs(tmp_path_factory):
 
     root = tmp_path_factory.mktemp("runs")
     run_experiment(load(["+task=circle", "+experiment=small_snn", "trials=10"])[0], root / "snn")
-    run_experiment(load(["+task=circle", "controller=pd", "trials=2"])[0], root / "pd")
+    run_experiment(load(["+task=circle", "controller=pd", "trials=2", "delay=constant", "delay.total_ms=20"])[0],
+                   root / "pd")
     return root
 
 
@@ -36,3 +37,5 @@ def test_report_draws_every_figure_from_logs(fixture_runs, tmp_path, monkeypatch
         assert p.with_suffix(".svg").read_text().lstrip().startswith("<?xml")
     assert (out / "paper_vs_cerebx.csv").exists() and (out / "runs.md").exists()
     assert "0.019" in html  # the paper's number beside ours
+    rows = (out / "delays.csv").read_text().splitlines()
+    assert len(rows) == 2 and ",constant," in rows[1] and ",20.0," in rows[1]  # realised round trip from the log
