@@ -21,7 +21,6 @@ class Entry:
     kind: str
     schema: type[BaseModel]
     builder: str | Callable[..., Any]
-    doc: str
 
     def resolve(self) -> Callable[..., Any]:
         """The builder callable; a ``"module:attr"`` string is imported on first use."""
@@ -45,8 +44,7 @@ class Registry:
             raise TypeError(f"{schema.__name__}: the 'kind' field needs a string default")
         if kind in self._entries and self._entries[kind].schema is not schema:
             raise ValueError(f"{self.group} kind {kind!r} is already registered")
-        doc = (schema.__doc__ or "").strip().splitlines()[0] if schema.__doc__ else ""
-        self._entries[kind] = Entry(kind, schema, builder, doc)
+        self._entries[kind] = Entry(kind, schema, builder)
         return schema
 
     def kinds(self) -> list[str]:

@@ -165,6 +165,3 @@ class DelayChannel:
         while q and q[0][0] <= tick:
             out.append(q.popleft()[1])
         return out
-
-    def __len__(self) -> int:
-        return len(self._queue)

@@ -57,6 +57,7 @@ class ClosedLoop:
         self.metrics: list[TrialMetrics] = []
         self.trials_done = 0
         self.tick = 0
+        self._sensor: SensorMsg | None = None  # newest sensor message delivered to the controller
         self._task_rng = ctx.rng("task")
         self._events = sorted(
             [e for e in cfg.events if e.at_s is not None], key=lambda e: e.at_s
@@ -85,7 +86,7 @@ class ClosedLoop:
         if rec is not None and trial == 0 and ref.xyz is not None:
             rec.write("/task/cartesian_path", "cerebx.CartesianPath", 0.0,
                       {"x": ref.xyz[:, 0].copy(), "y": ref.xyz[:, 1].copy(), "z": ref.xyz[:, 2].copy()})
-        sensor: SensorMsg | None = getattr(self, "_sensor", None)
+        sensor = self._sensor
         for i in range(ref.steps):
             tick = self.tick
             t = tick * self.dt_s
