@@ -10,6 +10,10 @@ export CEREBX_CACHE ?= $(CURDIR)/.cache/cerebx
 # The default experiment of `make run`; override e.g. `make run RUN_ARGS="+task=eight delay=gamma45"`.
 RUN_ARGS ?= +experiment=default
 BENCH_ARGS ?=
+# `make report` runs the report's missing studies with this profile (quick: < 30 min on 2 cores;
+# full: the thesis's trial counts, hours), then draws every figure. REPORT_ARGS e.g. "--figures fig3_4".
+PROFILE ?= quick
+REPORT_ARGS ?=
 
 .PHONY: help install run test test-full bench report lint format clean
 
@@ -36,8 +40,8 @@ test-full: $(STAMP) ## every test, including the slow ones
 bench: $(STAMP) ## speed of plant, network and closed loop, as JSON
 	$(BIN)/cerebx bench $(BENCH_ARGS)
 
-report: $(STAMP) ## build reports/ from the runs in runs/
-	$(BIN)/cerebx report
+report: $(STAMP) ## run missing studies (PROFILE=quick|full), then build reports/index.html
+	$(BIN)/cerebx report --profile $(PROFILE) $(REPORT_ARGS)
 
 lint: $(STAMP) ## ruff lint
 	$(BIN)/ruff check src tests

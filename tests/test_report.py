@@ -1,41 +1,128 @@
-"""The report re-plots runs from their logs only, and survives missing or unreadable runs."""
+"""The report: every registered figure drawn from tiny runs of every study, from the logs only;
+missing and unreadable runs cost one line each; the study runner reuses finished runs."""
 
 from __future__ import annotations
 
+import json
+import shutil
+
 import matplotlib.image as mpimg
 import pytest
+from report_fixtures import make_fixture_runs
 
-from cerebx.loop.runner import run_experiment
+from cerebx.config import check
+from cerebx.errors import ConfigError
 from cerebx.report.build import main as report_main
+from cerebx.report.registry import all_figures
+from cerebx.report.studies import Job, execute, load_studies, plan
 
 
 @pytest.fixture(scope="module")
 def fixture_runs(tmp_path_factory):
-    from cerebx.config import load
-
     root = tmp_path_factory.mktemp("runs")
-    run_experiment(load(["+task=circle", "+experiment=small_snn", "trials=10"])[0], root / "snn")
-    run_experiment(load(["+task=circle", "controller=pd", "trials=2", "delay=constant", "delay.total_ms=20"])[0],
-                   root / "pd")
-    return root
+    failed = make_fixture_runs(root)
+    assert failed == []
+    return root / "quick"
 
 
-def test_report_draws_every_figure_from_logs(fixture_runs, tmp_path, monkeypatch, capsys):
+def _valid_image(png):
+    img = mpimg.imread(png)
+    assert img.ndim == 3 and img.shape[0] > 100 and img.shape[1] > 100, png
+    assert png.with_suffix(".svg").read_text().lstrip().startswith("<?xml"), png
+
+
+def test_every_figure_is_drawn_from_fixture_runs(fixture_runs, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    assert report_main([str(fixture_runs / "snn"), str(fixture_runs / "pd"), str(tmp_path / "missing")]) == 0
+    assert report_main([str(fixture_runs), str(tmp_path / "missing")]) == 0
     err = capsys.readouterr().err
     assert "missing/summary.json: no such file" in err  # one clear line; the rest is still built
     out = tmp_path / "reports"
-    html = (out / "index.html").read_text()
-    pngs = sorted((out / "figures").glob("*.png"))
-    names = {p.name.split("_")[0] for p in pngs}
-    assert {"learning", "stages", "mae", "tracking"} <= names
-    for p in pngs:
-        assert p.name in html
-        img = mpimg.imread(p)
-        assert img.ndim == 3 and img.shape[0] > 100 and img.shape[1] > 100
-        assert p.with_suffix(".svg").read_text().lstrip().startswith("<?xml")
-    assert (out / "paper_vs_cerebx.csv").exists() and (out / "runs.md").exists()
-    assert "0.019" in html  # the paper's number beside ours
-    rows = (out / "delays.csv").read_text().splitlines()
-    assert len(rows) == 2 and ",constant," in rows[1] and ",20.0," in rows[1]  # realised round trip from the log
+    page = (out / "index.html").read_text()
+    assert "Not drawn" not in page and "could not be drawn" not in page
+    figures = all_figures()
+    assert {"fig2_6", "fig2_7", "fig2_9", "fig2_10", "fig3_3", "fig3_4", "fig3_5", "fig3_6", "fig3_7", "fig3_8",
+            "fig3_9", "fig3_10"} <= set(figures)
+    for name in figures:
+        pngs = sorted((out / "figures").glob(f"{name}*.png"))
+        assert pngs, f"{name}: no image"
+        for png in pngs:
+            assert png.name in page
+            _valid_image(png)
+    paper = (out / "paper_vs_cerebx.csv").read_text()
+    for name in figures:
+        assert f"\n{name}," in paper, f"{name}: no paper-vs-cerebx rows"
+    assert "0.019" in page and "0.000106" in page  # the paper's numbers beside ours
+
+
+def test_report_replots_given_runs_and_survives_unreadable_ones(fixture_runs, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    broken = tmp_path / "broken"
+    shutil.copytree(fixture_runs / "fig3_4_pd" / "delay.total_ms=20", broken)
+    (broken / "summary.json").write_text("{not json")
+    damaged = tmp_path / "damaged"
+    shutil.copytree(fixture_runs / "fig3_4_pd" / "delay.total_ms=40", damaged)
+    data = (damaged / "run.mcap").read_bytes()
+    (damaged / "run.mcap").write_bytes(data[: len(data) // 3])
+    runs = [fixture_runs / "fig3_4_pd" / f"delay.total_ms={d}" for d in (0, 60, 80)]
+    assert report_main([*map(str, runs), str(broken), str(damaged), "--figures", "fig3_4"]) == 0
+    err = capsys.readouterr().err
+    assert "broken/summary.json: not valid JSON" in err
+    page = (tmp_path / "reports" / "index.html").read_text()
+    assert "fig3_4.png" in page
+    _valid_image(tmp_path / "reports" / "figures" / "fig3_4.png")
+
+
+def test_a_figure_without_its_runs_says_which_study_is_missing(fixture_runs, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert report_main([str(fixture_runs / "fig3_4_pd"), "--figures", "fig3_6,fig3_4"]) == 0
+    err = capsys.readouterr().err
+    assert "fig3_6:" in err and "fig3_6_kernels" in err
+    assert (tmp_path / "reports" / "figures" / "fig3_4.png").exists()
+    assert report_main(["--figures", "fig9_9"]) == 2
+    assert "unknown figure" in capsys.readouterr().err
+
+
+def test_every_study_job_is_a_valid_experiment(fixture_runs):
+    state = fixture_runs / "learn_circle" / "run"
+    studies = load_studies()
+    figures = all_figures()
+    used = {s for f in figures.values() for s in f.studies}
+    assert used <= set(studies), used - set(studies)
+    for profile in ("quick", "full"):
+        for job in plan(profile, fixture_runs.parent):
+            ov = [f"init_from={state}" if o.startswith("init_from=") else o for o in job.overrides()]
+            assert check(ov) == [], (profile, job.name)
+
+
+def test_study_runner_reuses_finished_runs_and_skips_dependents_of_failures(tmp_path):
+    ran: list[str] = []
+
+    def fake(job: Job) -> int:
+        ran.append(job.name)
+        if job.study == "learn_circle":
+            return 1
+        job.run_dir.mkdir(parents=True, exist_ok=True)
+        (job.run_dir / "summary.json").write_text(json.dumps({"status": "completed", "trials_completed": job.trials,
+                                                              "final_mae": 0.1, "wall_seconds": 1}))
+        return 0
+
+    jobs = plan("quick", tmp_path, ["fig3_4_pd", "fig3_4_snn"])
+    assert [j.study for j in jobs].count("fig3_4_pd") == 5 and "learn_circle" in [j.study for j in jobs]
+    failed = execute(jobs, runner=fake, parallel=2, log=lambda line: None)
+    assert sorted(ran) == sorted(["learn_circle/run"] + [j.name for j in jobs if j.study == "fig3_4_pd"])
+    assert len(failed) == 6 and any("fig3_4_snn" in f and "learn_circle/run" in f for f in failed)
+    ran.clear()
+    execute(plan("quick", tmp_path, ["fig3_4_pd"]), runner=fake, log=lambda line: None)
+    assert ran == []  # every fig3_4_pd run is complete: reused
+
+
+def test_bad_studies_file_is_one_line(tmp_path):
+    bad = tmp_path / "studies.yaml"
+    bad.write_text("studies:\n  a:\n    args: [+experiment=demo]\n    init_from: nowhere\n"
+                   "    quick: {trials: 1}\n    full: {trials: 2}\n")
+    with pytest.raises(ConfigError, match="init_from: 'nowhere' is not a single-run study"):
+        load_studies(bad)
+    bad.write_text("studies:\n  a:\n    args: []\n    quick: {trials: 0}\n    full: {trials: 2}\n")
+    with pytest.raises(ConfigError) as err:
+        load_studies(bad)
+    assert all(line.startswith(str(bad)) for line in err.value.problems)

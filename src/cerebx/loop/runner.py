@@ -65,7 +65,8 @@ class ClosedLoop:
         self._trial_events = [e for e in cfg.events if e.at_trial is not None]
 
     def start(self) -> None:
-        self.plant.reset(np.asarray(self.task.start_position(), float), self.ctx.rng("plant"))
+        q0 = self.task.first_sample() if self.cfg.start_at == "path" else self.task.start_position()
+        self.plant.reset(np.asarray(q0, float), self.ctx.rng("plant"))
         self.controller.reset(self.ctx.rng("controller"))
         if self.rec is not None:
             self.controller.attach_recorder(self.rec)
@@ -141,7 +142,8 @@ class ClosedLoop:
         self.metrics.append(m)
         self.trials_done = trial + 1
         if rec is not None:
-            rec.write("/trial_metrics", "cerebx.TrialMetrics", self.tick * self.dt_s, m.__dict__)
+            rec.write("/trial_metrics", "cerebx.TrialMetrics", self.tick * self.dt_s,
+                      {**m.__dict__, "label": ref.label})
             extra = ctrl.end_trial(trial)
             if extra:
                 rec.write("/weights", "cerebx.WeightSummary", self.tick * self.dt_s, {"trial": trial, **extra})
@@ -197,7 +199,8 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
     summary: dict[str, Any] = {
         "status": "failed", "task": cfg.task.kind, "controller": cfg.controller.kind,
         "plant": cfg.plant.kind, "delay": cfg.delay.kind, "network": cfg.network.name,
-        "seed": cfg.seed, "trials": cfg.trials, "trials_completed": 0, "mae_per_trial": [],
+        "seed": cfg.seed, "trials": cfg.trials, "warmup_trials": cfg.warmup_trials, "trials_completed": 0,
+        "mae_per_trial": [],
         "final_mae": None, "sim_seconds": 0.0, "wall_seconds": 0.0, "rt_factor": None,
         "version": __version__, "overrides": list(overrides or []), "started_at": started, "error": None,
         "presets": dict(choices or {}),

@@ -12,7 +12,7 @@ topic                      schema                 content
 /control                   cerebx.Control         controller torque, supervisor torque, error,
                                                   end-effector and desired end-effector (m), delays
                                                   sampled for this step's messages (r2c_ms, c2r_ms)
-/trial_metrics             cerebx.TrialMetrics    per-trial MAE per joint, velocity MAE, dtau
+/trial_metrics             cerebx.TrialMetrics    per-trial MAE per joint, velocity MAE, dtau, task variant
 /events                    cerebx.PlantEvent      plant events as they happen
 /spikes/<population>       cerebx.Spikes          neuron indices that fired in the step
 /weights                   cerebx.WeightSummary   per-trial plastic-weight statistics
@@ -60,7 +60,7 @@ SCHEMAS: dict[str, dict] = {
         "type": "object",
         "properties": {"trial": {"type": "integer"}, "mae": {"type": "number"}, "mae_per_joint": _NUMS,
                        "vel_mae": {"type": "number"}, "torque_variability_Nm_per_ms": {"type": "number"},
-                       "ee_error_m": {"type": ["number", "null"]}},
+                       "ee_error_m": {"type": ["number", "null"]}, "label": {"type": "string"}},
     },
     "cerebx.PlantEvent": {"type": "object", "properties": {"t": {"type": "number"}, "kind": {"type": "string"},
                                                            "params": {"type": "object"}}},

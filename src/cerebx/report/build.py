@@ -1,166 +1,213 @@
 """``cerebx report``: rebuild reports/ (index.html, figures, tables) from run folders.
 
-Without arguments every run under ``runs/`` is used; with RUN_DIR arguments only those. A run that
-is missing or unreadable is reported in one line and skipped; the rest of the report is built.
+    cerebx report                         every run under runs/
+    cerebx report RUN_DIR...              only those runs (a folder of runs is searched)
+    cerebx report --profile quick|full    first run the studies whose runs are missing, then draw them
+
+Every registered figure (report/registry.py) is drawn from the runs it finds; one whose runs are
+missing, and any run that is missing or unreadable, gives one line and the rest is still built.
 """
 
 from __future__ import annotations
 
+import argparse
+import csv
 import html
 import sys
+import time
 from collections import defaultdict
 from pathlib import Path
-from typing import Any
 
 from cerebx.errors import CerebxError
-from cerebx.metrics import window_stats
-from cerebx.recording.reader import read_summary
+from cerebx.report.registry import Figure, MissingRuns, all_figures
+from cerebx.report.runs import RunSet, find_run_dirs, load_runs
 
-# Thesis Tables 2.3 / 2.4: (task) -> windows [(start, stop, mean, std)] and the factory controller.
-PAPER = {
-    "circle": {"snn": [(0, 100, 0.115, 0.055), (100, 200, 0.036, 0.013), (400, 500, 0.019, 0.003)],
-               "position": (0.077, 0.0004)},
-    "eight": {"snn": [(0, 100, 0.111, 0.034), (100, 200, 0.046, 0.013), (400, 500, 0.017, 0.003)],
-              "position": (0.063, 0.0003)},
-    "reaching": {"snn": [(0, 100, 0.155, 0.050), (300, 400, 0.043, 0.024), (900, 1000, 0.019, 0.006)],
-                 "position": (0.026, 0.006)},
-}
+MAX_TRACKING_RUNS = 12  # per-run joint-tracking figures only for small run sets
 
 
-def find_runs(root: Path) -> list[Path]:
-    return sorted(p.parent for p in root.rglob("summary.json"))
+def _markdown(rows: list[list[str]]) -> str:
+    out = ["| " + " | ".join(rows[0]) + " |", "|" + "---|" * len(rows[0])]
+    out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows[1:]]
+    return "\n".join(out) + "\n"
+
+
+def _html_table(rows: list[list[str]]) -> str:
+    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in rows[0])
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>" for r in rows[1:])
+    return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def _write_table(out: Path, name: str, rows: list[list[str]]) -> None:
+    (out / f"{name}.md").write_text(_markdown(rows))
+    with open(out / f"{name}.csv", "w", newline="") as fh:
+        csv.writer(fh).writerows(rows)
 
 
 def _fmt(x: float | None, nd: int = 4) -> str:
     return "–" if x is None else f"{x:.{nd}f}"
 
 
-def paper_table(runs: list[tuple[Path, dict]]) -> list[list[str]]:
-    """Rows: task, window, paper mean±std, cerebx mean±std (best matching completed snn run)."""
-    rows = [["task", "controller", "trials", "paper MAE (rad)", "cerebx MAE (rad)", "run"]]
-    for task, ref in PAPER.items():
-        snn = [(p, s) for p, s in runs if s["task"] == task and s["controller"] == "snn" and s["delay"] == "none"]
-        snn.sort(key=lambda ps: len(ps[1].get("mae_per_trial") or []), reverse=True)
-        for a, b, m, sd in ref["snn"]:
-            ours = window_stats(snn[0][1]["mae_per_trial"], a, b) if snn else None
-            rows.append([task, "snn", f"{a}-{b}", f"{m:.3f} ± {sd:.3f}",
-                         f"{ours[0]:.3f} ± {ours[1]:.3f}" if ours else "not run", snn[0][0].name if snn else ""])
-        pos = [(p, s) for p, s in runs
-               if s["task"] == task and s.get("presets", {}).get("controller") == "position_factory"]
-        m, sd = ref["position"]
-        if pos:
-            ours = window_stats(pos[0][1]["mae_per_trial"], 0, len(pos[0][1]["mae_per_trial"]))
-            cell = f"{ours[0]:.3f} ± {ours[1]:.4f}"
-        else:
-            cell = "not run"
-        rows.append([task, "position (factory)", "all", f"{m:.3f} ± {sd:.4f}", cell, pos[0][0].name if pos else ""])
+def _runs_table(runs: RunSet) -> list[list[str]]:
+    rows = [["run", "status", "task", "controller", "plant", "delay", "network", "trials", "final MAE (rad)",
+             "rt factor"]]
+    for r in runs:
+        s = r.summary
+        rows.append([str(r.dir), s["status"], r.task, r.controller_preset, s["plant"], r.delay_preset, r.network,
+                     str(r.trials), _fmt(s.get("final_mae")), _fmt(s.get("rt_factor"), 1)])
     return rows
 
 
-def _markdown(rows: list[list[str]]) -> str:
-    out = ["| " + " | ".join(rows[0]) + " |", "|" + "---|" * len(rows[0])]
-    out += ["| " + " | ".join(r) + " |" for r in rows[1:]]
-    return "\n".join(out) + "\n"
-
-
-def _html_table(rows: list[list[str]]) -> str:
-    head = "".join(f"<th>{html.escape(c)}</th>" for c in rows[0])
-    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>" for r in rows[1:])
-    return f"<table><tr>{head}</tr>{body}</table>"
-
-
-def build(run_dirs: list[Path], out: Path) -> tuple[Path, list[str], int]:
+def _general_figures(runs: RunSet, fig_dir: Path, problems: list[str]) -> list[str]:
+    """Learning curves of every task, and joint tracking of each run when there are few."""
     from cerebx.report import figures
 
-    problems: list[str] = []
-    runs: list[tuple[Path, dict[str, Any]]] = []
-    for d in run_dirs:
-        try:
-            runs.append((d, read_summary(d)))
-        except CerebxError as err:
-            problems.append(str(err))
-    out.mkdir(parents=True, exist_ok=True)
-    fig_dir = out / "figures"
-    sections: list[str] = []
+    sections = []
     by_task: dict[str, list] = defaultdict(list)
-    for d, s in runs:
-        by_task[s["task"]].append((d, s))
+    for r in runs:
+        by_task[r.task].append((r.dir, r.summary))
     for task, rs in sorted(by_task.items()):
         png = figures.learning_curves(rs, task, fig_dir / f"learning_{task}")
-        sections.append(f"<figure><img src='figures/{png.name}'><figcaption>MAE per trial, task "
-                        f"{html.escape(task)}: every run of this task (log scale).</figcaption></figure>")
-        baselines = [s for _, s in rs if s["controller"] in ("pd", "position") and s.get("final_mae") is not None]
-        for d, s in rs:
-            if not s.get("trials_completed"):
+        sections.append(_img(png, f"MAE per trial of every {task} run (log scale)."))
+    if len(runs) <= MAX_TRACKING_RUNS:
+        for r in runs:
+            if not r.trials:
                 continue
-            if s["controller"] in ("snn", "ann") and s["trials_completed"] >= 10:
-                from cerebx.report import stages
-
-                try:
-                    png = stages.stages_figure(d, s, fig_dir / f"stages_{task}_{d.name}")
-                    sections.append(f"<figure><img src='figures/{png.name}'><figcaption>{html.escape(str(d))}: "
-                                    "thesis Fig. 2.6/2.7 — DCN activity, torques, desired vs actual joints and the "
-                                    "end-effector path (density of the previous 10 trials) at an initial, "
-                                    "intermediate and final stage.</figcaption></figure>")
-                    png = stages.mae_per_joint_figure(s, baselines, fig_dir / f"mae_joints_{task}_{d.name}")
-                    sections.append(f"<figure><img src='figures/{png.name}'><figcaption>{html.escape(str(d))}: "
-                                    "thesis Fig. 2.6 g / 2.7 g — MAE per trial per joint and mean, with the "
-                                    "baselines' final MAE.</figcaption></figure>")
-                except (CerebxError, ValueError) as err:
-                    problems.append(str(err))
             try:
-                png = figures.joint_tracking(d, s, fig_dir / f"tracking_{task}_{d.name}")
+                png = figures.joint_tracking(r.dir, r.summary, fig_dir / f"tracking_{r.task}_{r.name}")
             except (CerebxError, ValueError) as err:
                 problems.append(str(err))
                 continue
-            sections.append(f"<figure><img src='figures/{png.name}'><figcaption>{html.escape(str(d))}: desired "
-                            f"(dashed) vs actual joint positions over the last trial.</figcaption></figure>")
-    runs_rows = [["run", "status", "task", "controller", "plant", "delay", "trials", "final MAE (rad)", "rt factor"]]
-    for d, s in runs:
-        runs_rows.append([str(d), s["status"], s["task"], s["controller"], s["plant"], s["delay"],
-                          str(s.get("trials_completed")), _fmt(s.get("final_mae")), _fmt(s.get("rt_factor"), 1)])
-    paper = paper_table(runs)
+            sections.append(_img(png, f"{r.dir}: desired (dashed) vs actual joint positions, last trial."))
+    return sections
+
+
+def _img(png: Path, caption: str) -> str:
+    return (f"<figure><a href='figures/{png.name}'><img src='figures/{png.name}'></a>"
+            f"<figcaption>{html.escape(caption)} <a href='figures/{png.with_suffix('.svg').name}'>SVG</a>"
+            "</figcaption></figure>")
+
+
+def build(run_dirs: list[Path], out: Path, names: list[str] | None = None,
+          log=lambda line: None) -> tuple[Path, list[str], int]:
+    """Draw every figure (or the named ones) from ``run_dirs`` into ``out``; returns (index, problems, runs)."""
+    runs, problems = load_runs(run_dirs)
+    out.mkdir(parents=True, exist_ok=True)
+    fig_dir = out / "figures"
+    specs = all_figures()
+    unknown = [n for n in names or [] if n not in specs]
+    if unknown:
+        raise CerebxError(f"--figures: unknown figure(s) {', '.join(unknown)} (known: {', '.join(specs)})")
+    chosen = [specs[n] for n in names] if names else list(specs.values())
+    drawn: list[tuple] = []
+    missing: list[str] = []
+    paper_rows = [["figure", "quantity", "paper", "cerebx"]]
+    for spec in chosen:
+        t0 = time.monotonic()
+        try:
+            fig: Figure = spec.draw(runs, fig_dir / spec.name)
+        except MissingRuns as err:
+            missing.append(f"{spec.name}: {err}")
+            continue
+        except Exception as err:  # one broken figure must not cost the others
+            problems.append(f"{spec.name}: could not be drawn ({type(err).__name__}: {err})")
+            continue
+        log(f"  {spec.name}: {len(fig.files)} image(s) in {time.monotonic() - t0:.1f} s")
+        drawn.append((spec, fig))
+        for row in fig.table[1:]:
+            paper_rows.append([spec.name, *row])
+    toc, sections = [], []
+    for spec, fig in drawn:
+        toc.append(f"<li><a href='#{spec.name}'>{html.escape(spec.title)}</a></li>")
+        imgs = "".join(f"<a href='figures/{p.name}'><img src='figures/{p.name}'></a>" for p in fig.files)
+        svgs = " ".join(f"<a href='figures/{p.with_suffix('.svg').name}'>{p.stem}.svg</a>" for p in fig.files)
+        table = (f"<div class='side'><h4>Paper beside cerebx</h4>{_html_table(fig.table)}</div>"
+                 if len(fig.table) > 1 else "")
+        notes = "".join(f"<li>{html.escape(n)}</li>" for n in fig.notes)
+        sections.append(
+            f"<section id='{spec.name}'><h2>{html.escape(spec.title)}</h2><div class='row'><div class='imgs'>{imgs}"
+            f"<p class='cap'>{html.escape(fig.caption)} ({svgs})</p>"
+            f"{'<ul class=notes>' + notes + '</ul>' if notes else ''}</div>{table}</div>"
+            f"<p class='runs'>studies: {html.escape(', '.join(spec.studies))}</p></section>")
+    general = _general_figures(runs, fig_dir, problems) if runs else []
+    runs_rows = _runs_table(runs)
+    _write_table(out, "runs", runs_rows)
+    _write_table(out, "paper_vs_cerebx", paper_rows)
     from cerebx.report.delays import delay_rows
 
-    delays = delay_rows(runs)
-    (out / "runs.md").write_text(_markdown(runs_rows))
-    (out / "paper_vs_cerebx.md").write_text(_markdown(paper))
-    import csv
-
-    (out / "delays.md").write_text(_markdown(delays))
-    for name, rows in (("runs.csv", runs_rows), ("paper_vs_cerebx.csv", paper), ("delays.csv", delays)):
-        with open(out / name, "w", newline="") as fh:
-            csv.writer(fh).writerows(rows)
-    notes = "".join(f"<li>{html.escape(p)}</li>" for p in problems)
+    _write_table(out, "delays", delay_rows([(r.dir, r.summary) for r in runs]))
+    miss = "".join(f"<li>{html.escape(m)}</li>" for m in missing)
+    probs = "".join(f"<li>{html.escape(p)}</li>" for p in problems)
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>cerebx report</title>
-<style>body{{font-family:sans-serif;max-width:1200px;margin:2em auto}}img{{max-width:100%}}
-table{{border-collapse:collapse;font-size:13px}}td,th{{border:1px solid #ccc;padding:3px 6px}}</style></head><body>
+<style>body{{font-family:sans-serif;max-width:1500px;margin:2em auto;padding:0 1em}}img{{max-width:100%}}
+.row{{display:flex;gap:1.5em;align-items:flex-start}}.imgs{{flex:3}}.side{{flex:1.3;font-size:13px}}
+table{{border-collapse:collapse;font-size:13px}}td,th{{border:1px solid #ccc;padding:3px 6px;vertical-align:top}}
+.cap{{font-size:14px;color:#333}}.runs{{font-size:12px;color:#777}}section{{border-top:1px solid #ddd;
+margin-top:2em}}</style></head><body>
 <h1>cerebx report</h1>
-<h2>Paper (thesis Tables 2.3 / 2.4) beside cerebx</h2>{_html_table(paper)}
-<h2>Delay studies (thesis Fig. 3.4, 3.7, 3.8)</h2>
-<p>Thesis: the SNN stays near its no-delay MAE (about 0.02-0.03 rad) up to 80 ms; PD and the rate-based
-ANN degrade 3-4x and oscillate above about 20 ms (torque variability PD 0.019 to 0.036 N·m/ms, ANN 0.016
-to 0.026 N·m/ms from 0 to 50 ms).</p>{_html_table(delays) if len(delays) > 1 else '<p>No delay runs.</p>'}
-<h2>Figures</h2>{''.join(sections) or '<p>No runs found.</p>'}
-<h2>Runs</h2>{_html_table(runs_rows)}
-{'<h2>Skipped</h2><ul>' + notes + '</ul>' if notes else ''}
+<p>{len(runs)} runs, {len(drawn)} of {len(chosen)} thesis figures drawn from their logs. Each figure is shown
+with the thesis's numbers beside cerebx's (all numbers in paper_vs_cerebx.csv). Absolute numbers depend on the
+plant (the real Baxter vs a MuJoCo model); the shapes and orderings are what should hold.</p>
+<ul>{''.join(toc)}</ul>
+{'<h3>Not drawn (runs missing)</h3><ul>' + miss + '</ul>' if miss else ''}
+{''.join(sections)}
+<section><h2>All runs</h2>{''.join(general)}{_html_table(runs_rows)}</section>
+{'<h3>Problems</h3><ul>' + probs + '</ul>' if probs else ''}
 </body></html>"""
     index = out / "index.html"
     index.write_text(page)
-    return index, problems, len(runs)
+    return index, problems + missing, len(runs)
 
 
-def main(args: list[str]) -> int:
-    out = Path("reports")
-    if args:
-        dirs = []
-        for a in args:
-            p = Path(a)
-            dirs.extend(find_runs(p) if p.is_dir() and not (p / "summary.json").exists() else [p])
-    else:
-        dirs = find_runs(Path("runs"))
-    index, problems, n = build(dirs, out)
+def needed_studies(names: list[str] | None) -> list[str]:
+    specs = all_figures()
+    chosen = [specs[n] for n in names if n in specs] if names else list(specs.values())
+    out: list[str] = []
+    for spec in chosen:
+        out += [s for s in spec.studies if s not in out]
+    return out
+
+
+def main(argv: list[str]) -> int:
+    ap = argparse.ArgumentParser(prog="cerebx report", description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("runs", nargs="*", type=Path, help="run folders or folders of runs (default: runs/)")
+    ap.add_argument("--profile", choices=("quick", "full"),
+                    help="run the missing studies of this profile into runs/report/PROFILE first")
+    ap.add_argument("--figures", help="comma-separated figure names (default: all), e.g. fig3_4,fig3_6")
+    ap.add_argument("--jobs", type=int, default=2, help="experiments run at once (default 2)")
+    ap.add_argument("--dry-run", action="store_true", help="with --profile: list the jobs, run nothing")
+    ap.add_argument("--out", type=Path, default=Path("reports"), help="output folder (default reports/)")
+    ap.add_argument("--list", action="store_true", help="list the figures and the studies they need")
+    a = ap.parse_args(argv)
+    names = [n.strip() for n in a.figures.split(",") if n.strip()] if a.figures else None
+    t0 = time.monotonic()
+    try:
+        if a.list:
+            for spec in all_figures().values():
+                print(f"{spec.name:8s} {spec.title}\n         studies: {', '.join(spec.studies)}")
+            return 0
+        failed: list[str] = []
+        if a.profile:
+            from cerebx.report.studies import execute, plan
+
+            root = Path("runs") / "report"
+            jobs = plan(a.profile, root, needed_studies(names))
+            if a.dry_run:
+                for j in jobs:
+                    print(f"{'reuse' if j.done() else 'run  '} {j.run_dir}  cerebx run {' '.join(j.overrides())}")
+                return 0
+            failed = execute(jobs, parallel=a.jobs)
+            dirs = [j.run_dir for j in jobs]
+        else:
+            dirs = []
+            for p in a.runs or [Path("runs")]:
+                dirs.extend(find_run_dirs(p) if p.is_dir() and not (p / "summary.json").exists() else [p])
+        index, problems, n = build(dirs, a.out, names, log=print)
+    except CerebxError as err:
+        for line in str(err).splitlines():
+            print(line, file=sys.stderr)
+        return 2
     for p in problems:
         print(p, file=sys.stderr)
-    print(f"report: {index} ({n} runs)")
-    return 0
+    print(f"report: {index} ({n} runs) in {time.monotonic() - t0:.0f} s")
+    return 1 if failed else 0

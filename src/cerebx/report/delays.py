@@ -11,7 +11,7 @@ import numpy as np
 from cerebx.recording.reader import read_messages
 
 
-def realised_round_trip_ms(run_dir: Path, max_messages: int = 20000) -> float | None:
+def realised_round_trip_ms(run_dir: Path, max_messages: int = 5000) -> float | None:
     """Mean R2C + C2R delay sampled in the first ``max_messages`` steps."""
     total, n = 0.0, 0
     for _, _, msg in read_messages(run_dir, ["/control"]):

@@ -36,7 +36,8 @@ def learning_curves(runs: list[tuple[Path, dict]], task: str, out: Path) -> Path
     ax.set_yscale("log")
     ax.set_title(f"{task}: MAE per trial")
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7, loc="upper right")
+    if len(runs) <= 10:  # beyond that a legend hides the curves
+        ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
     return _save(fig, out)
 

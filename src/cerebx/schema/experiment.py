@@ -102,6 +102,12 @@ class _ExperimentBase(Strict):
     recording: RecordingConfig = RecordingConfig()
     events: list[ScheduledEvent] = Field(default_factory=list)
     init_from: str | None = Field(None, description="run folder whose learned state starts this run")
+    warmup_trials: int = Field(
+        0, ge=0, description="the first trials let a learned controller settle onto the path; they are run and "
+        "logged like the others, and the report leaves them out of its statistics")
+    start_at: Literal["home", "path"] = Field(
+        "home", description="where the arm starts: the task's home pose, or at rest on the path's first sample "
+        "(as consecutive trials do; used when a learned controller is evaluated)")
 
     @model_validator(mode="after")
     def _cross_checks(self) -> _ExperimentBase:
@@ -116,6 +122,8 @@ class _ExperimentBase(Strict):
         problems += _per_joint_lengths(controller, "controller", n)
         if controller.kind == "snn":
             problems += _snn_fits_network(controller, self.network, n)
+        if self.warmup_trials >= self.trials:
+            problems.append(f"warmup_trials: {self.warmup_trials} leaves no measured trial of {self.trials}")
         if self.init_from is not None:
             from pathlib import Path
 

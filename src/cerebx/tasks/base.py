@@ -44,6 +44,10 @@ class Task(ABC):
     def start_position(self) -> np.ndarray:
         """Joint positions where the plant starts (the robot is not moved to the path first)."""
 
+    def first_sample(self) -> np.ndarray:
+        """Joint positions of the path's first sample (where ``start_at: path`` puts the plant)."""
+        return self.start_position()
+
     def envelope(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Min/max of desired position and velocity over all trial variants, per joint.
 

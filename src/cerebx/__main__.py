@@ -1,0 +1,7 @@
+"""``python -m cerebx`` is the ``cerebx`` command."""
+
+import sys
+
+from cerebx.cli import main
+
+sys.exit(main())

@@ -1,0 +1,557 @@
+"""Thesis chapter 2 figures (2.6, 2.7, 2.9, 2.10) and the trajectory figures of chapter 3 (3.3, 3.5).
+
+Runs are chosen by content:
+
+- learning from scratch: snn controller, no delay, no ``init_from``, no plant events, one PF-PC kernel
+  peaking at 150 ms (the thesis kernel; this keeps the multikernel and kernel-sweep runs out);
+- the factory position controller: controller kind ``position`` whose preset is ``position_factory``
+  or, for runs that recorded no preset, whose ``controller.velocity_feedforward`` is false (the factory
+  stand-in sends position-only commands; the stiff servo ``position`` sends velocity feed-forward);
+- the PD baseline: controller preset ``pd`` (the launch gains), no delay.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.colors import to_rgb  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
+
+from cerebx.metrics import final_mae  # noqa: E402
+from cerebx.report import stages  # noqa: E402
+from cerebx.report.registry import Figure, MissingRuns, figure, mean_std, save  # noqa: E402
+from cerebx.report.runs import Run, RunSet  # noqa: E402
+
+THESIS_KERNEL_MS = 150.0
+# Tables 2.3 / 2.4: thesis run length, snn windows (start, stop, mean, std), factory position MAE as printed
+PAPER_STAGES: dict[str, tuple[int, list[tuple[int, int, float, float]], str]] = {
+    "circle": (500, [(0, 100, 0.115, 0.055), (100, 200, 0.036, 0.013), (400, 500, 0.019, 0.003)], "0.077 ± 0.0004"),
+    "eight": (500, [(0, 100, 0.111, 0.034), (100, 200, 0.046, 0.013), (400, 500, 0.017, 0.003)], "0.063 ± 0.0003"),
+    "reaching": (1000, [(0, 100, 0.155, 0.050), (300, 400, 0.043, 0.024), (900, 1000, 0.019, 0.006)],
+                 "0.026 ± 0.006"),
+}
+# Fig. 2.9: stages at t1 = 160 s, t2 = 600 s, t3 = 2000 s of 1000 trials; density of the last 80 trials
+REACH_STAGES = (0.08, 0.3, 1.0)
+REACH_DENSITY = 0.08
+CH3_TASKS = ("circle", "inclined_circle", "circle_eight")
+TASK_NAMES = {"circle": "horizontal circle", "inclined_circle": "inclined circle",
+              "circle_eight": "circle-Lissajous sequence", "eight": "eight", "reaching": "reaching"}
+# Chapter 3 text: factory-default position controller MAE without delay (rad)
+PAPER_FACTORY_CH3 = {"circle": "0.077", "inclined_circle": "0.055", "circle_eight": "0.068"}
+FIG3_5_DELAY_MS = 50.0
+FIG3_5_TRIALS = 16  # trials read per run for the densities (evenly spaced)
+CONVERGENCE_TOL = 0.10
+
+
+# ---- run selection ---------------------------------------------------------------------------------
+def from_scratch(runs: RunSet, task: str) -> Run | None:
+    """The longest snn run learning ``task`` from scratch without delay."""
+    return runs.where(lambda r: r.learned_from is None and not r.events and r.trials > 0
+                      and r.kernel_peaks_ms == [THESIS_KERNEL_MS],
+                      task=task, controller="snn", delay="none").best()
+
+
+def is_factory(r: Run) -> bool:
+    return r.controller == "position" and (r.controller_preset == "position_factory"
+                                           or r.get("controller.velocity_feedforward") is False)
+
+
+def baselines(runs: RunSet, task: str) -> list[tuple[str, Run]]:
+    """(label, run) of the PD and factory-position baselines on ``task`` without delay, those present."""
+    none = runs.where(lambda r: r.trials > 0 and not r.events, task=task, delay="none")
+    found = [("PD", none.where(controller="pd", controller_preset="pd").best()),
+             ("factory position", none.where(is_factory).best())]
+    return [(name, r) for name, r in found if r is not None]
+
+
+def _rel(r: Run | str) -> str:
+    d = Path(r) if isinstance(r, str) else r.dir
+    return f"{d.parent.name}/{d.name}"
+
+
+def _trials(a: int, b: int) -> str:
+    """Trials [a, b) as text."""
+    return f"trial {a}" if b - a == 1 else f"trials {a}–{b - 1}"
+
+
+# ---- Tables 2.3 / 2.4 ------------------------------------------------------------------------------
+def scaled_windows(n: int, total: int, windows: list[tuple[int, int, float, float]]) -> list[tuple[int, int]]:
+    """The thesis trial windows, scaled by n / total for runs shorter than the thesis's (at least 1 trial)."""
+    f = min(1.0, n / total)
+    out = []
+    for a, b, _, _ in windows:
+        lo = min(int(round(a * f)), n - 1)
+        out.append((lo, max(lo + 1, int(round(b * f)))))
+    return out
+
+
+def stage_table(run: Run, task: str, base: list[tuple[str, Run]]) -> tuple[list[list[str]], list[tuple[int, int]]]:
+    """Rows of Table 2.3 / 2.4 for ``task`` beside ours, and the windows used."""
+    total, ref, factory = PAPER_STAGES[task]
+    wins = scaled_windows(run.trials, total, ref)
+    rows = [["quantity", "paper", "cerebx"]]
+    for (a, b, m, s), (lo, hi) in zip(ref, wins, strict=True):
+        ours = f"trials {lo}–{hi}" if hi - lo > 1 else f"trial {lo}"
+        used = "" if (lo, hi) == (a, b) else f" [cerebx: {ours} of {run.trials}]"
+        rows.append([f"SNN MAE (rad), trials {a}–{b}{used}", f"{m:.3f} ± {s:.3f}", mean_std(run.mae[lo:hi])])
+    for name, b in base:
+        paper = factory if name == "factory position" else "not in the thesis table"
+        nd = 4 if name == "factory position" else 3
+        rows.append([f"{name} MAE (rad), all trials [cerebx: {b.n_measured} trials]", paper, mean_std(b.mae, nd)])
+    if not any(name == "factory position" for name, _ in base):
+        rows.append(["factory position MAE (rad), all trials", factory, "not run"])
+    return rows, wins
+
+
+def _baseline_text(base: list[tuple[str, Run]]) -> str:
+    if not base:
+        return "no baseline run"
+    return "dashed: mean MAE of " + ", ".join(f"{name} ({b.n_measured} trials, {_rel(b)})" for name, b in base)
+
+
+def _trajectory_learning(runs: RunSet, stem: Path, task: str, fig_no: str, study: str) -> Figure:
+    run = from_scratch(runs, task)
+    if run is None:
+        raise MissingRuns(f"no {task} run of snn learning from scratch (study {study})")
+    base = baselines(runs, task)
+    table, wins = stage_table(run, task, base)
+    files = [stages.stages_figure(run.dir, run.summary, stem.with_name(stem.name + "_stages")),
+             stages.mae_per_joint_figure(run.summary, [b.summary for _, b in base],
+                                         stem.with_name(stem.name + "_mae"),
+                                         labels=[name for name, _ in base], windows=wins)]
+    ks = stages.stage_trials(run.trials)
+    notes = [] if base else [f"no {task} baseline runs (pd / position_factory without delay): MAE figure without "
+                             "baselines"]
+    total = PAPER_STAGES[task][0]
+    caption = (f"Thesis Fig. {fig_no} ({TASK_NAMES[task]}): the snn controller learning from scratch, run "
+               f"{_rel(run)} with {run.n_measured} trials of {run.period_s:.0f} s (thesis: {total}). "
+               f"Stage figure (a–f): trials {', '.join(map(str, ks))} (thesis: 18–20 s, 318–320 s, 998–1000 s, "
+               "scaled by fraction of the run); end-effector density of the previous 10 trials. "
+               "MAE figure (g): MAE per trial of each joint and their mean; shaded: the table windows "
+               f"({', '.join(f'{a}–{b}' for a, b in wins)}); {_baseline_text(base)}.")
+    return Figure(files, caption, table, notes)
+
+
+@figure("fig2_6", "Circle learnt from scratch: stages and MAE per joint (Fig. 2.6, Table 2.3)",
+        studies=("learn_circle", "baselines_circle"))
+def fig2_6(runs: RunSet, stem: Path) -> Figure:
+    return _trajectory_learning(runs, stem, "circle", "2.6", "learn_circle")
+
+
+@figure("fig2_7", "Eight learnt from scratch: stages and MAE per joint (Fig. 2.7, Table 2.3)",
+        studies=("learn_eight", "baselines_eight"))
+def fig2_7(runs: RunSet, stem: Path) -> Figure:
+    return _trajectory_learning(runs, stem, "eight", "2.7", "learn_eight")
+
+
+# ---- Fig. 2.9: reaching ----------------------------------------------------------------------------
+def reach_target(ee_des: np.ndarray, n_targets: int) -> int:
+    """Target index from the direction of ee_des at its farthest point from the first sample
+    (targets at angles pi + 2 pi k / n in the xy plane, as the reaching task lays them out)."""
+    d = ee_des[:, :2] - ee_des[0, :2]
+    far = d[int(np.argmax(np.hypot(d[:, 0], d[:, 1])))]
+    step = 2 * np.pi / n_targets
+    return int(round((np.arctan2(far[1], far[0]) - np.pi) / step)) % n_targets
+
+
+def _label_target(label: str | None) -> int | None:
+    if label and "target" in label:
+        tail = label.rsplit("target", 1)[1]
+        return int(tail) if tail.isdigit() else None
+    return None
+
+
+def _reach_window(run: Run, first: int, stop: int, n_targets: int) -> dict[int, dict[str, np.ndarray]]:
+    """Per trial in [first, stop): t, ee, ee_des and its target (label if logged, else derived)."""
+    period = run.period_s
+    rows: dict[int, dict[str, list]] = {}
+    labels: dict[int, int | None] = {}
+    for topic, t, msg in run.messages(["/control", "/trial_metrics"], first * period, stop * period + period / 2):
+        k = int(msg.get("trial", -1))
+        if not first <= k < stop:
+            continue
+        if topic == "/trial_metrics":
+            labels[k] = _label_target(msg.get("label"))
+        elif "ee" in msg and "ee_des" in msg:
+            row = rows.setdefault(k, {"t": [], "ee": [], "ee_des": []})
+            row["t"].append(t - k * period)
+            row["ee"].append(msg["ee"])
+            row["ee_des"].append(msg["ee_des"])
+    out = {}
+    for k, row in rows.items():
+        arr = {key: np.asarray(v, dtype=float) for key, v in row.items()}
+        target = labels.get(k)
+        arr["target"] = np.asarray(reach_target(arr["ee_des"], n_targets) if target is None else target)
+        out[k] = arr
+    return out
+
+
+def _speed(tr: dict[str, np.ndarray], key: str) -> np.ndarray:
+    if len(tr["t"]) < 2:
+        return np.zeros(len(tr["t"]))
+    return np.linalg.norm(np.gradient(tr[key], tr["t"], axis=0), axis=1)
+
+
+@figure("fig2_9", "Reaching learnt from scratch: paths, speed profiles and MAE (Fig. 2.9, Table 2.4)",
+        studies=("learn_reaching", "baselines_reaching"))
+def fig2_9(runs: RunSet, stem: Path) -> Figure:
+    run = from_scratch(runs, "reaching")
+    if run is None:
+        raise MissingRuns("no reaching run of snn learning from scratch (study learn_reaching)")
+    n, n_targets = run.trials, int(run.get("task.targets", 8))
+    base = baselines(runs, "reaching")
+    table, wins = stage_table(run, "reaching", base)
+    ends = sorted({max(1, int(round(f * n))) for f in REACH_STAGES})
+    width = max(1, int(round(REACH_DENSITY * n)))
+    windows = [_reach_window(run, max(0, e - width), e, n_targets) for e in ends]
+    last = [{int(tr["target"]): k for k, tr in sorted(w.items())} for w in windows]
+    # the starred target: performed in the last window and in as many of the others as possible
+    star = min(last[-1], key=lambda g: (-sum(g in d for d in last), g)) if last and last[-1] else None
+    fig = plt.figure(figsize=(4.4 * len(ends), 11.5))
+    gs = fig.add_gridspec(3, len(ends), height_ratios=[1.25, 0.8, 1.0])
+    hsv = plt.get_cmap("hsv")
+
+    def colors(target: int):
+        return hsv(0.9 * target / n_targets)
+    for c, (e, w, lastk) in enumerate(zip(ends, windows, last, strict=True)):
+        ax = fig.add_subplot(gs[0, c])
+        if w:
+            pts = np.concatenate([tr["ee"] for tr in w.values()])
+            stages.density(ax, pts[:, 0], pts[:, 1], bins=70, cmap="Greys", alpha=0.6)
+        for target, k in sorted(lastk.items()):
+            tr = w[k]
+            ax.plot(tr["ee_des"][:, 0], tr["ee_des"][:, 1], "k--", lw=0.7)
+            ax.plot(tr["ee"][:, 0], tr["ee"][:, 1], color=colors(target), lw=1.2, label=f"target {target}")
+            if target == star:
+                far = tr["ee_des"][int(np.argmax(np.linalg.norm(tr["ee_des"] - tr["ee_des"][0], axis=1)))]
+                ax.plot(far[0], far[1], "k*", ms=12)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        t_end = e * run.period_s
+        ax.set_title(f"before t = {t_end:.0f} s (trial {e}); density: {_trials(max(0, e - width), e)}",
+                     fontsize=9)
+        stages.panel_letter(ax, "abc"[c])
+        ax.legend(fontsize=6, ncol=2, loc="upper right")
+        ax = fig.add_subplot(gs[1, c])
+        if star in lastk:
+            tr = w[lastk[star]]
+            ax.plot(tr["t"], _speed(tr, "ee_des"), "k--", lw=1, label="desired")
+            ax.plot(tr["t"], _speed(tr, "ee"), color=colors(star), lw=1.4, label="actual")
+            ax.set_title(f"target {star} (*), trial {lastk[star]}", fontsize=9)
+            ax.legend(fontsize=7)
+        else:
+            ax.text(0.5, 0.5, f"target {star} not performed in this window", transform=ax.transAxes,
+                    ha="center", fontsize=8)
+        ax.set_xlabel("time in trial (s)")
+        ax.set_ylabel("end-effector speed (m/s)")
+        stages.panel_letter(ax, "def"[c])
+    ax = fig.add_subplot(gs[2, :])
+    stages.mae_per_joint_axes(ax, run.summary, [b.summary for _, b in base], [name for name, _ in base], wins)
+    ax.set_title(f"reaching / snn: MAE per joint, {n} trials (table windows shaded)", fontsize=10)
+    stages.panel_letter(ax, "g")
+    fig.tight_layout()
+    files = [save(fig, stem)]
+    notes = []
+    if star is None:
+        notes.append("no trial in the last stage window: no speed profiles")
+    if not base:
+        notes.append("no reaching baseline runs (pd / position_factory without delay)")
+    caption = (f"Thesis Fig. 2.9 (reaching, {n_targets} targets): run {_rel(run)}, {n} trials of "
+               f"{run.period_s:.0f} s (thesis: 1000). (a–c) end-effector paths in the xy plane: the last trial of "
+               f"each target before trials {', '.join(map(str, ends))} (thesis t1 = 160 s, t2 = 600 s, t3 = 2000 s, "
+               f"scaled by fraction of the run), over the density of the last {width} trials (thesis: 80). "
+               f"(d–f) speed profile of the starred target at those stages. (g) MAE per trial of each joint and "
+               f"their mean; {_baseline_text(base)}. Targets from /trial_metrics labels, else from the direction "
+               "of the farthest desired point.")
+    return Figure(files, caption, table, notes)
+
+
+# ---- Fig. 2.10: unstructured environment ---------------------------------------------------------
+# event kind -> (condition, switched on)
+CONDITIONS = {"attach_payload": ("payload", True), "detach_payload": ("payload", False),
+              "elastic_band": ("elastic band", True), "remove_band": ("elastic band", False)}
+
+
+def run_events(run: Run) -> list[tuple[float, str]]:
+    """(trial position, kind) of each plant event: from /events, else from the configured events."""
+    period = run.period_s
+    logged = [(t / period, msg["kind"]) for _, t, msg in run.messages(["/events"])]
+    if logged:
+        return logged
+    out = []
+    for e in run.events:
+        at = e.get("at_trial")
+        out.append((float(at) if at is not None else float(e.get("at_s", 0.0)) / period, e["action"]["kind"]))
+    return sorted(out)
+
+
+def phases(events: list[tuple[float, str]], n: int) -> list[tuple[int, int, str]]:
+    """Trial ranges [a, b) between events, named by the conditions on (or 'before' / 'after ...')."""
+    cuts = sorted({min(n, int(np.ceil(x - 1e-9))) for x, _ in events} | {0, n})
+    out, active, last_off = [], set(), ""
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        for x, kind in events:
+            if int(np.ceil(x - 1e-9)) == a and kind in CONDITIONS:
+                cond, on = CONDITIONS[kind]
+                (active.add if on else active.discard)(cond)
+                last_off = last_off if on else cond
+        name = " + ".join(sorted(active)) if active else (f"after {last_off}" if last_off else "before")
+        out.append((a, b, name))
+    return out
+
+
+@figure("fig2_10", "Adaptation to a payload and an elastic band (Fig. 2.10)", studies=("fig2_10_adaptation",))
+def fig2_10(runs: RunSet, stem: Path) -> Figure:
+    run = runs.where(lambda r: bool(r.events) and r.trials > 0, controller="snn").best()
+    if run is None:
+        raise MissingRuns("no snn run with plant events (study fig2_10_adaptation)")
+    events, mae, period = run_events(run), run.mae, run.period_s
+    parts = phases(events, len(mae))
+    fig, ax = plt.subplots(figsize=(9, 4.2))
+    shade = {"payload": "C1", "elastic band": "C2"}
+    for cond, color in shade.items():
+        on = None
+        for x, kind in events:
+            c, is_on = CONDITIONS.get(kind, (None, None))
+            if c == cond and is_on and on is None:
+                on = x
+            elif c == cond and not is_on and on is not None:
+                ax.axvspan(on - 0.5, x - 0.5, color=color, alpha=0.18, lw=0, label=f"{cond} on")
+                on = None
+        if on is not None:
+            ax.axvspan(on - 0.5, len(mae) - 0.5, color=color, alpha=0.18, lw=0, label=f"{cond} on")
+    for x, kind in events:
+        ax.axvline(x - 0.5, color="0.4", ls=":", lw=0.8)
+        ax.annotate(kind.replace("_", " "), (x - 0.5, 1.0), xycoords=("data", "axes fraction"), rotation=90,
+                    fontsize=7, va="top", ha="right", color="0.3")
+    ax.plot(np.arange(len(mae)), mae, "k.-", lw=1, ms=4, label="MAE per trial")
+    for i, (a, b, _) in enumerate(parts):
+        ax.hlines(mae[a:b].mean(), a - 0.5, b - 0.5, color="C3", lw=2, label="phase mean" if i == 0 else None)
+    ax.set_xlabel("trial")
+    ax.set_ylabel("position MAE (rad)")
+    ax.secondary_xaxis("top", functions=(lambda x: x * period, lambda s: s / period)).set_xlabel("time (s)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    files = [save(fig, stem)]
+    claim = "figure only (MAE rises with the disturbance, then recovers: the cerebellum adapts)"
+    table = [["quantity", "paper", "cerebx"]]
+    for a, b, name in parts:
+        seg = mae[a:b]
+        k = max(1, min(3, len(seg) // 3))
+        table.append([f"MAE (rad), {_trials(a, b)}: {name}", claim, mean_std(seg)])
+        if name != "before" and len(seg) >= 2:
+            table.append([f"{name}: MAE first {k} → last {k} trials (rad)", "figure only",
+                          f"{seg[:k].mean():.3f} → {seg[-k:].mean():.3f}"])
+        claim = "figure only"
+    notes = [] if events else ["the run's events were neither logged nor configured"]
+    origin = _rel(run.learned_from) if run.learned_from else "scratch"
+    caption = (f"Thesis Fig. 2.10: the snn controller, learnt state from {origin}, performing "
+               f"the {TASK_NAMES.get(run.task, run.task)} while the plant is disturbed (run {_rel(run)}, {len(mae)} "
+               f"trials of {period:.0f} s). Shaded: payload / elastic band attached; dotted: events "
+               f"({', '.join(f'{k} at trial {x:g}' for x, k in events)}); red: mean MAE of each phase. "
+               "The thesis's human-robot interactions (iii) are not simulated.")
+    return Figure(files, caption, table, notes)
+
+
+# ---- Fig. 3.3: convergence -------------------------------------------------------------------------
+def convergence_trial(mae: np.ndarray, tol: float = CONVERGENCE_TOL) -> tuple[int | None, int, float | None]:
+    """(first trial where the trailing running mean is within ``tol`` of the final level, window, level).
+
+    Running mean over a trailing window of max(5, n/50) trials (10 of 500; at most n); the final level is
+    the mean of the last 10 % of trials.
+    """
+    n = len(mae)
+    level = final_mae(list(mae))
+    w = max(1, min(n, max(5, n // 50)))
+    if level is None:
+        return None, w, None
+    run_mean = np.convolve(mae, np.ones(w) / w, mode="valid")
+    hits = np.nonzero(run_mean <= (1 + tol) * level)[0]
+    return (int(hits[0]) + w - 1 if hits.size else None), w, level
+
+
+@figure("fig3_3", "Trajectory learning convergence curves (Fig. 3.3)",
+        studies=("learn_circle", "learn_inclined_circle", "learn_circle_eight"))
+def fig3_3(runs: RunSet, stem: Path) -> Figure:
+    found = {task: from_scratch(runs, task) for task in CH3_TASKS}
+    if not any(found.values()):
+        raise MissingRuns("no snn runs learning circle / inclined_circle / circle_eight from scratch "
+                          "(studies learn_circle, learn_inclined_circle, learn_circle_eight)")
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.3))
+    table = [["quantity", "paper", "cerebx"]]
+    notes, used = [], []
+    for ax, letter, task in zip(axes, "ABC", CH3_TASKS, strict=True):
+        ax.set_title(f"{letter}  {TASK_NAMES[task]}", loc="left", fontweight="bold", fontsize=10, pad=30)
+        run = found[task]
+        if run is None:
+            notes.append(f"no {task} run of snn learning from scratch: panel {letter} empty")
+            ax.text(0.5, 0.5, "no run", transform=ax.transAxes, ha="center")
+            continue
+        mae, period = run.mae, run.period_s
+        k, w, level = convergence_trial(mae)
+        ax.plot(mae, color="0.6", lw=0.7, label="MAE per trial")
+        ax.plot(np.arange(w - 1, len(mae)), np.convolve(mae, np.ones(w) / w, mode="valid"), "C0", lw=1.5,
+                label=f"running mean ({w} trials)")
+        if level is not None:
+            ax.axhline(level, color="C3", ls="--", lw=1, label="final level (last 10 %)")
+        if k is not None:
+            ax.axvline(k, color="C2", lw=1.2, label=f"within {CONVERGENCE_TOL:.0%}: trial {k}")
+        ax.set_yscale("log")
+        ax.set_xlabel("trial")
+        ax.set_ylabel("position MAE (rad)")
+        ax.secondary_xaxis("top", functions=(lambda x, p=period: x * p, lambda s, p=period: s / p)).set_xlabel(
+            "time (s)", fontsize=8)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+        name, secs = TASK_NAMES[task], 500 * (4 if task == "circle_eight" else 2)
+        table += [[f"{name}: MAE first 10 trials (rad)", "figure only", f"{mae[:10].mean():.3f}"],
+                  [f"{name}: MAE last 10 trials (rad)", "figure only", f"{mae[-10:].mean():.3f}"],
+                  [f"{name}: trials to stabilize", f"about 500 trials ({secs} s)",
+                   "not reached" if k is None else f"{k} ({k * period:.0f} s) of {len(mae)}"]]
+        used.append(f"{letter}: {_rel(run)}, {len(mae)} trials of {period:.0f} s")
+    fig.tight_layout()
+    caption = ("Thesis Fig. 3.3: MAE per trial of the snn controller learning from scratch (thesis: stabilization "
+               f"after about 500 trials). Runs: {'; '.join(used)}. Stabilization trial: the first trial where the "
+               f"trailing running mean (max(5, n/50) trials) is within {CONVERGENCE_TOL:.0%} of the final level "
+               "(mean of the last 10 % of trials).")
+    return Figure([save(fig, stem)], caption, table, notes)
+
+
+# ---- Fig. 3.5: end-effector density under a 50 ms delay ------------------------------------------
+def _sample_ee(run: Run, trials: int = FIG3_5_TRIALS) -> tuple[np.ndarray, np.ndarray, int]:
+    """ee and ee_des of up to ``trials`` evenly spaced trials (time-windowed reads), and how many."""
+    n, period, w = run.trials, run.period_s, min(run.warmup, max(run.trials - 1, 0))
+    picks = np.unique(np.linspace(w, n - 1, min(n - w, trials)).round().astype(int))
+    ee, des = [], []
+    for k in picks:
+        c = run.control(["ee", "ee_des"], k * period, (k + 1) * period, every=2)
+        if c["ee"].size:
+            ee.append(c["ee"])
+            des.append(c["ee_des"])
+    if not ee:
+        return np.zeros((0, 3)), np.zeros((0, 3)), 0
+    return np.concatenate(ee), np.concatenate(des), len(picks)
+
+
+def plane(des: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Origin, 2x3 projection and axis labels: x-y for a flat path, else its two principal axes."""
+    if not des.size:
+        return np.zeros(3), np.eye(3)[:2], ["x (m)", "y (m)"]
+    spread = np.ptp(des, axis=0)
+    if spread[2] <= 0.05 * max(spread[0], spread[1]):
+        return np.zeros(3), np.eye(3)[:2], ["x (m)", "y (m)"]
+    centre = des.mean(0)
+    axes = np.linalg.svd(des - centre, full_matrices=False)[2][:2]
+    for i in range(2):  # orient: first axis along +x, second along +y
+        if axes[i, i] < 0:
+            axes[i] *= -1
+    labels = [f"{u} (m) along ({a[0]:.2f}, {a[1]:.2f}, {a[2]:.2f})" for u, a in zip("uv", axes, strict=True)]
+    return centre, axes, labels
+
+
+def _limits(des2: np.ndarray, clouds: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Panel limits: the desired path with a 6 cm margin, widened to the 1-99 % range of the densities but at
+    most 35 cm from the path's centre."""
+    if not des2.size:
+        return np.full(2, -0.3), np.full(2, 0.3)
+    lo, hi = des2.min(0) - 0.06, des2.max(0) + 0.06
+    if clouds:
+        pts = np.concatenate(clouds)
+        lo, hi = np.minimum(lo, np.percentile(pts, 1, axis=0)), np.maximum(hi, np.percentile(pts, 99, axis=0))
+    mid = (des2.min(0) + des2.max(0)) / 2
+    return np.maximum(lo, mid - 0.35), np.minimum(hi, mid + 0.35)
+
+
+def _density_rgba(h: np.ndarray, color: str) -> np.ndarray:
+    img = np.zeros((*h.shape, 4))
+    img[..., :3] = to_rgb(color)
+    img[..., 3] = 0.85 * np.sqrt(h / h.max()) if h.max() > 0 else 0.0
+    return img
+
+
+@figure("fig3_5", "End-effector density under a 50 ms delay: PD vs SNN and ANN vs SNN (Fig. 3.5)",
+        studies=("fig3_5_snn_circle", "fig3_5_snn_inclined_circle", "fig3_5_snn_circle_eight", "fig3_5_ann_circle",
+                 "fig3_5_ann_inclined_circle", "fig3_5_ann_circle_eight", "fig3_5_pd_circle",
+                 "fig3_5_pd_inclined_circle", "fig3_5_pd_circle_eight", "fig3_5_position", "baselines_circle"))
+def fig3_5(runs: RunSet, stem: Path) -> Figure:
+    delayed = runs.where(lambda r: r.delay == "constant" and r.delay_total_ms == FIG3_5_DELAY_MS and r.trials > 0
+                         and (r.controller != "snn" or r.kernel_peaks_ms == [THESIS_KERNEL_MS]))
+    slots = {(task, c): delayed.where(task=task, controller=c).best()
+             for task in CH3_TASKS for c in ("pd", "ann", "snn")}
+    if not any(slots.values()):
+        raise MissingRuns(f"no pd / ann / snn runs under a constant {FIG3_5_DELAY_MS:.0f} ms delay "
+                          "(studies fig3_5_*)")
+    refs = {task: runs.where(lambda r: is_factory(r) and r.trials > 0, task=task, delay="none").best()
+            for task in CH3_TASKS}
+    data = {key: _sample_ee(r) for key, r in slots.items() if r is not None}
+    colors = {"pd": "C3", "ann": "C1", "snn": "C0"}
+    fig, axes = plt.subplots(2, 3, figsize=(15, 9.6))
+    notes: list[str] = []
+    table = [["quantity", "paper", "cerebx"]]
+    claims = {"snn": "figure only (SNN stays accurate)", "ann": "figure only (ANN degrades)",
+              "pd": "figure only (PD degrades)"}
+    for col, task in enumerate(CH3_TASKS):
+        des = next((data[(task, c)][1] for c in ("snn", "ann", "pd") if (task, c) in data), np.zeros((0, 3)))
+        ref = refs[task]
+        ref_ee = (ref.control(["ee"], (ref.trials - 1) * ref.period_s, ref.trials * ref.period_s)["ee"]
+                  if ref is not None else np.zeros((0, 3)))
+        if not des.size and ref_ee.size:
+            des = ref_ee
+        centre, proj, labels = plane(des)
+        pd_ = {key: (v[0] - centre) @ proj.T for key, v in data.items() if key[0] == task}
+        des2 = (des - centre) @ proj.T if des.size else np.zeros((0, 2))
+        lo, hi = _limits(des2, list(pd_.values()))
+        for row, other in enumerate(("pd", "ann")):
+            ax = axes[row, col]
+            handles = []
+            for c in (other, "snn"):
+                pts = pd_.get((task, c))
+                r = slots[(task, c)]
+                if pts is None or r is None:
+                    continue
+                h, xe, ye = np.histogram2d(pts[:, 0], pts[:, 1], bins=120, range=[[lo[0], hi[0]], [lo[1], hi[1]]])
+                ax.imshow(_density_rgba(h.T, colors[c]), origin="lower", extent=(xe[0], xe[-1], ye[0], ye[-1]),
+                          interpolation="nearest", aspect="equal")
+                handles.append(Patch(color=colors[c], label=f"{c.upper()} ({data[(task, c)][2]} trials)"))
+            if des2.size:
+                handles += ax.plot(des2[:, 0], des2[:, 1], "k--", lw=1, label="desired")
+            if ref_ee.size:
+                r2 = (ref_ee - centre) @ proj.T
+                handles += ax.plot(r2[:, 0], r2[:, 1], color="C2", lw=1.2, label="factory position, no delay")
+            ax.set_xlim(lo[0], hi[0])
+            ax.set_ylim(lo[1], hi[1])
+            ax.set_xlabel(labels[0], fontsize=8)
+            ax.set_ylabel(labels[1], fontsize=8)
+            ax.set_title(f"{'ABCDEF'[3 * row + col]}  {other.upper()} vs SNN, {TASK_NAMES[task]}", loc="left",
+                         fontweight="bold", fontsize=10)
+            if handles:
+                ax.legend(handles=handles, fontsize=7, loc="upper right")
+            else:
+                ax.text(0.5, 0.5, "no runs", transform=ax.transAxes, ha="center")
+        for c in ("pd", "ann", "snn"):
+            r = slots[(task, c)]
+            table.append([f"{TASK_NAMES[task]}, {c.upper()} at {FIG3_5_DELAY_MS:.0f} ms: MAE (rad)", claims[c],
+                          f"{mean_std(r.mae)} ({r.n_measured} trials)" if r is not None else "not run"])
+        missing = [c for c in ("pd", "ann", "snn") if slots[(task, c)] is None]
+        if missing:
+            notes.append(f"no {' / '.join(missing)} run on {task} at {FIG3_5_DELAY_MS:.0f} ms")
+        table.append([f"{TASK_NAMES[task]}, factory position, no delay: MAE (rad)", PAPER_FACTORY_CH3[task],
+                      f"{mean_std(ref.mae)} ({ref.n_measured} trials)" if ref is not None else "not run"])
+        if ref is None:
+            notes.append(f"no factory position run on {task} without delay: no reference path")
+    fig.suptitle(f"End-effector density under a constant {FIG3_5_DELAY_MS:.0f} ms round-trip delay", fontsize=11)
+    fig.tight_layout()
+    counts = sorted({f"{data[k][2]} of {slots[k].trials}" for k in data})
+    caption = (f"Thesis Fig. 3.5: end-effector density of PD vs SNN (A–C) and ANN vs SNN (D–F) under a constant "
+               f"{FIG3_5_DELAY_MS:.0f} ms round-trip delay (thesis: 100 trials per controller; here the density of "
+               f"{', '.join(counts)} trials, evenly spaced, every 2nd control step); dashed: desired path; green: "
+               "last trial of the factory position controller without delay. Circle and circle-Lissajous in the xy "
+               "plane, the inclined circle in the principal plane of its desired path.")
+    return Figure([save(fig, stem)], caption, table, notes)

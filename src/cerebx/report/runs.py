@@ -1,0 +1,205 @@
+"""Run folders as the report sees them: summary, resolved config and log, selected by content.
+
+Figures never look at folder names: they ask for "circle runs of the snn controller under a constant
+delay" and get whatever runs match, so any past run folder can be re-plotted.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cerebx.errors import CerebxError
+from cerebx.recording.reader import read_messages, read_metadata, read_summary
+
+
+@dataclass
+class Run:
+    dir: Path
+    summary: dict[str, Any]
+    _config: dict[str, Any] | None = field(default=None, repr=False)
+
+    @classmethod
+    def load(cls, run_dir: Path | str) -> Run:
+        d = Path(run_dir)
+        return cls(d, read_summary(d))
+
+    # ---- the resolved configuration (recorded as MCAP metadata) ------------------------------
+    @cached_property
+    def config(self) -> dict[str, Any]:
+        if self._config is not None:
+            return self._config
+        try:
+            return json.loads(read_metadata(self.dir)["config"]["json"])
+        except (CerebxError, KeyError, OSError, json.JSONDecodeError):
+            return {}
+
+    def get(self, dotted: str, default: Any = None) -> Any:
+        node: Any = self.config
+        for part in dotted.split("."):
+            if not isinstance(node, dict) or part not in node:
+                return default
+            node = node[part]
+        return node
+
+    # ---- what the figures select on ----------------------------------------------------------
+    @property
+    def name(self) -> str:
+        return self.dir.name
+
+    @property
+    def task(self) -> str:
+        return self.summary["task"]
+
+    @property
+    def controller(self) -> str:
+        return self.summary["controller"]
+
+    @property
+    def controller_preset(self) -> str:
+        return (self.summary.get("presets") or {}).get("controller", self.controller)
+
+    @property
+    def delay(self) -> str:
+        """The delay kind (none, constant, gamma, percentiles, trace)."""
+        return self.summary["delay"]
+
+    @property
+    def delay_preset(self) -> str:
+        return (self.summary.get("presets") or {}).get("delay", self.delay)
+
+    @property
+    def delay_total_ms(self) -> float | None:
+        """The constant round-trip delay, 0 without delay, None for random delays."""
+        if self.delay == "none":
+            return 0.0
+        if self.delay == "constant":
+            total = self.get("delay.total_ms")  # None when the log's config cannot be read
+            return None if total is None else float(total)
+        return None
+
+    @property
+    def network(self) -> str:
+        return self.summary.get("network", "")
+
+    @property
+    def kernel_peaks_ms(self) -> list[float]:
+        """Peak (ms) of every plastic projection's PF-PC kernel, in network order."""
+        projections = self.get("network.projections", {}) or {}
+        return [float(p["plasticity"]["kernel_peak_ms"]) for p in projections.values()
+                if isinstance(p, dict) and (p.get("plasticity") or {}).get("kind") == "kernel_stdp"]
+
+    @property
+    def learned_from(self) -> str | None:
+        return self.get("init_from")
+
+    @property
+    def events(self) -> list[dict[str, Any]]:
+        return self.get("events", []) or []
+
+    @property
+    def completed(self) -> bool:
+        return self.summary.get("status") == "completed"
+
+    @property
+    def trials(self) -> int:
+        return int(self.summary.get("trials_completed") or 0)
+
+    @property
+    def period_s(self) -> float:
+        return self.summary["sim_seconds"] / max(self.trials, 1)
+
+    @property
+    def warmup(self) -> int:
+        """Leading trials in which a learned controller settled onto the path (not measured)."""
+        return int(self.summary.get("warmup_trials") or 0)
+
+    @property
+    def n_measured(self) -> int:
+        return max(0, self.trials - self.warmup)
+
+    def series(self, key: str) -> np.ndarray:
+        """A per-trial list from the summary (mae_per_trial, torque_variability_per_trial, ...), without
+        the warm-up trials."""
+        return np.asarray(self.summary.get(key) or [], dtype=float)[self.warmup:]
+
+    @property
+    def mae(self) -> np.ndarray:
+        return self.series("mae_per_trial")
+
+    def messages(self, topics: list[str], t0: float | None = None, t1: float | None = None) -> Iterator:
+        """(topic, t in s, message) of the run's log between t0 and t1 seconds."""
+        lo = None if t0 is None else int(round(t0 * 1e9))
+        hi = None if t1 is None else int(round(t1 * 1e9))
+        for topic, t, msg in read_messages(self.dir, topics, start_ns=lo, end_ns=hi):
+            yield topic, t / 1e9, msg
+
+    def control(self, keys: Iterable[str], t0: float | None = None, t1: float | None = None,
+                every: int = 1) -> dict[str, np.ndarray]:
+        """Columns of /control (e.g. ee, ee_des, r2c_ms, c2r_ms, trial) as arrays, every n-th step."""
+        keys = list(keys)
+        cols: dict[str, list] = {k: [] for k in ["t", *keys]}
+        for i, (_, t, msg) in enumerate(self.messages(["/control"], t0, t1)):
+            if i % every:
+                continue
+            if any(k not in msg for k in keys):
+                continue
+            cols["t"].append(t)
+            for k in keys:
+                cols[k].append(msg[k])
+        return {k: np.asarray(v, dtype=float) for k, v in cols.items()}
+
+    def describe(self) -> str:
+        return f"{self.dir} ({self.controller_preset}, {self.task}, delay {self.delay_preset}, {self.trials} trials)"
+
+
+class RunSet(list):
+    """A list of runs with content filters."""
+
+    def where(self, pred: Callable[[Run], bool] | None = None, **eq: Any) -> RunSet:
+        def ok(r: Run) -> bool:
+            return all(getattr(r, k) == v for k, v in eq.items()) and (pred is None or pred(r))
+        return RunSet(r for r in self if ok(r))
+
+    def best(self) -> Run | None:
+        """The run to show when several match: completed first, then the most trials, then the newest."""
+        if not self:
+            return None
+        return max(self, key=lambda r: (r.completed, r.trials, _mtime(r.dir)))
+
+    def by(self, key: Callable[[Run], Any]) -> dict[Any, Run]:
+        """The best run for each value of ``key`` (runs where it is None are left out), sorted by value."""
+        groups: dict[Any, RunSet] = {}
+        for r in self:
+            k = key(r)
+            if k is not None:
+                groups.setdefault(k, RunSet()).append(r)
+        return {k: groups[k].best() for k in sorted(groups)}
+
+
+def _mtime(d: Path) -> float:
+    try:
+        return (d / "summary.json").stat().st_mtime
+    except OSError:
+        return 0.0
+
+
+def find_run_dirs(root: Path) -> list[Path]:
+    return sorted(p.parent for p in root.rglob("summary.json"))
+
+
+def load_runs(dirs: Iterable[Path]) -> tuple[RunSet, list[str]]:
+    """Every readable run of ``dirs``; each one that is not gives one line in the second list."""
+    runs, problems = RunSet(), []
+    for d in dirs:
+        try:
+            runs.append(Run.load(d))
+        except CerebxError as err:
+            problems.append(str(err))
+    return runs, problems
