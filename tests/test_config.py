@@ -27,7 +27,7 @@ def test_every_task_validates(load, task):
 
 @pytest.mark.parametrize("network", _options("network"))
 def test_every_network_validates(load, network):
-    extra = ["+experiment=small_snn"] if network == "small" else []
+    extra = ["+experiment=small_snn"] if network.startswith("small") else []
     cfg = load(["+task=circle", *extra, f"network={network}"])
     assert cfg.network.n_neurons > 0
 

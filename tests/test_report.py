@@ -88,10 +88,14 @@ def test_every_study_job_is_a_valid_experiment(fixture_runs):
     figures = all_figures()
     used = {s for f in figures.values() for s in f.studies}
     assert used <= set(studies), used - set(studies)
+    seen = set()
     for profile in ("quick", "full"):
         for job in plan(profile, fixture_runs.parent):
             ov = [f"init_from={state}" if o.startswith("init_from=") else o for o in job.overrides()]
-            assert check(ov) == [], (profile, job.name)
+            key = tuple(o for o in ov if not o.startswith("trials="))  # the profiles mostly differ in trials
+            if key not in seen:
+                seen.add(key)
+                assert check(ov) == [], (profile, job.name)
 
 
 def test_study_runner_reuses_finished_runs_and_skips_dependents_of_failures(tmp_path):

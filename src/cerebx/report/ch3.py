@@ -80,16 +80,6 @@ def _prefer_learned(rs: RunSet) -> Run | None:
     return (learned or rs).best()
 
 
-def _group(rs: RunSet, key: Callable[[Run], Any], pick: Callable[[RunSet], Run | None] = RunSet.best) -> dict:
-    """One run per key value (sorted), chosen by ``pick``."""
-    groups: dict[Any, RunSet] = {}
-    for r in rs:
-        k = key(r)
-        if k is not None:
-            groups.setdefault(k, RunSet()).append(r)
-    return {k: pick(groups[k]) for k in sorted(groups)}
-
-
 def _sweep(runs: RunSet, controller: str, multikernel: bool = False) -> tuple[dict[float, Run], list[str]]:
     """Best circle run per constant round-trip delay of one controller kind (learned-state runs first), all
     started from the same state (the one most delays used); a note for each delay left out for that."""
@@ -98,7 +88,7 @@ def _sweep(runs: RunSet, controller: str, multikernel: bool = False) -> tuple[di
                 and _total_ms(r) is not None):
             return False
         return controller != "snn" or (len(r.kernel_peaks_ms) > 1) == multikernel and bool(r.kernel_peaks_ms)
-    picked = _group(runs.where(ok), _total_ms, _prefer_learned)
+    picked = runs.where(ok).by(_total_ms, _prefer_learned)
     origins = Counter(r.learned_from for r in picked.values())
     main = max(origins, key=lambda o: (origins[o], sum(r.trials for r in picked.values() if r.learned_from == o)),
                default=None)
@@ -121,7 +111,7 @@ def _reference(runs: RunSet, controller: str) -> Run | None:
 def _snn_delay_runs(runs: RunSet, pred: Callable[[Run], bool]) -> dict[str, Run]:
     """Best SNN circle run per delay preset among those ``pred`` accepts."""
     rs = runs.where(lambda r: _plain_circle(r) and r.controller == "snn" and pred(r))
-    return _group(rs, _delay_label, _prefer_learned)
+    return rs.by(_delay_label, _prefer_learned)
 
 
 # ---- data helpers ------------------------------------------------------------------------------------
@@ -280,7 +270,7 @@ def fig3_4(runs: RunSet, stem: Path) -> Figure:
 def fig3_6(runs: RunSet, stem: Path) -> Figure:
     rs = runs.where(lambda r: _plain_circle(r) and r.controller == "snn" and _total_ms(r) == 0
                     and len(r.kernel_peaks_ms) == 1)
-    by_peak = _group(rs, lambda r: r.kernel_peaks_ms[0])
+    by_peak = rs.by(lambda r: r.kernel_peaks_ms[0])
     if not by_peak:
         raise MissingRuns("no single-kernel SNN circle runs without delay (study fig3_6_kernels)")
     notes = []

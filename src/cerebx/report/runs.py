@@ -173,14 +173,15 @@ class RunSet(list):
             return None
         return max(self, key=lambda r: (r.completed, r.trials, _mtime(r.dir)))
 
-    def by(self, key: Callable[[Run], Any]) -> dict[Any, Run]:
-        """The best run for each value of ``key`` (runs where it is None are left out), sorted by value."""
+    def by(self, key: Callable[[Run], Any], pick: Callable[[RunSet], Run | None] | None = None) -> dict[Any, Run]:
+        """One run for each value of ``key`` (runs where it is None are left out), sorted by value; ``pick``
+        chooses among a value's runs (default: best)."""
         groups: dict[Any, RunSet] = {}
         for r in self:
             k = key(r)
             if k is not None:
                 groups.setdefault(k, RunSet()).append(r)
-        return {k: groups[k].best() for k in sorted(groups)}
+        return {k: (pick or RunSet.best)(groups[k]) for k in sorted(groups)}
 
 
 def _mtime(d: Path) -> float:
