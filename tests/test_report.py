@@ -40,8 +40,8 @@ def test_every_figure_is_drawn_from_fixture_runs(fixture_runs, tmp_path, monkeyp
     page = (out / "index.html").read_text()
     assert "Not drawn" not in page and "could not be drawn" not in page
     figures = all_figures()
-    assert {"fig2_6", "fig2_7", "fig2_9", "fig2_10", "fig3_3", "fig3_4", "fig3_5", "fig3_6", "fig3_7", "fig3_8",
-            "fig3_9", "fig3_10"} <= set(figures)
+    assert {"table2_3", "fig2_6", "fig2_7", "fig2_9", "fig2_10", "fig3_3", "fig3_4", "fig3_5", "fig3_6", "fig3_7",
+            "fig3_8", "fig3_9", "fig3_10"} <= set(figures)
     for name in figures:
         pngs = sorted((out / "figures").glob(f"{name}*.png"))
         assert pngs, f"{name}: no image"

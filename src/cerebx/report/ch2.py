@@ -149,6 +149,51 @@ def fig2_7(runs: RunSet, stem: Path) -> Figure:
     return _trajectory_learning(runs, stem, "eight", "2.7", "learn_eight")
 
 
+@figure("table2_3", "Tables 2.3 / 2.4: MAE per learning stage beside the thesis",
+        studies=("learn_circle", "learn_eight", "learn_reaching", "baselines_circle", "baselines_eight",
+                 "baselines_reaching"))
+def table2_3(runs: RunSet, stem: Path) -> Figure:
+    """The thesis's stage windows (mean ± std) beside ours for every task learnt from scratch, as bars."""
+    found = {task: from_scratch(runs, task) for task in PAPER_STAGES}
+    found = {t: r for t, r in found.items() if r is not None}
+    if not found:
+        raise MissingRuns("no run of snn learning circle, eight or reaching from scratch (studies learn_circle, "
+                          "learn_eight, learn_reaching)")
+    fig, axes = plt.subplots(1, len(found), figsize=(4.6 * len(found), 3.8), squeeze=False)
+    table = [["quantity", "paper", "cerebx"]]
+    for ax, (task, run) in zip(axes[0], found.items(), strict=True):
+        total, ref, factory = PAPER_STAGES[task]
+        base = baselines(runs, task)
+        rows, wins = stage_table(run, task, base)
+        table += [[f"{task}: {q}", p, c] for q, p, c in rows[1:]]
+        x = np.arange(len(ref))
+        ours = [run.mae[lo:hi] for lo, hi in wins]
+        ax.bar(x - 0.2, [m for *_, m, _ in ref], 0.4, yerr=[sd for *_, sd in ref], capsize=3, color="0.6",
+               label=f"thesis ({total} trials)")
+        ax.bar(x + 0.2, [o.mean() for o in ours], 0.4, yerr=[o.std() for o in ours], capsize=3, color="C0",
+               label=f"cerebx ({run.n_measured} trials)")
+        ax.axhline(float(factory.split()[0]), color="0.4", ls="--", lw=1, label="factory position, thesis")
+        for name, b in base:
+            if name == "factory position":
+                ax.axhline(b.mae.mean(), color="C2", ls="--", lw=1.2, label="factory position, cerebx")
+        ax.set_xticks(x, [f"{a}–{b}\n[{lo}–{hi}]" if (lo, hi) != (a, b) else f"{a}–{b}"
+                          for (a, b, *_), (lo, hi) in zip(ref, wins, strict=True)], fontsize=8)
+        ax.set_xlabel("trials (thesis) [cerebx window]")
+        ax.set_ylabel("position MAE (rad)")
+        ax.set_title(TASK_NAMES[task])
+        ax.grid(alpha=0.3, axis="y")
+        ax.legend(fontsize=7)
+    fig.suptitle("Thesis Tables 2.3 / 2.4 beside cerebx: MAE (mean ± std) per learning stage")
+    fig.tight_layout()
+    caption = ("Thesis Tables 2.3 (circle, eight) and 2.4 (reaching): the cerebellar controller's position MAE "
+               "(mean ± std over the trials of each window) at the initial, intermediate and final stage of "
+               "learning from scratch, beside the factory position controller. Runs shorter than the thesis's "
+               "use the same fractions of their length (the window in brackets). Runs: "
+               + ", ".join(f"{t} {_rel(r)}" for t, r in found.items()) + ".")
+    notes = [f"{t}: no run learning from scratch" for t in PAPER_STAGES if t not in found]
+    return Figure([save(fig, stem)], caption, table, notes)
+
+
 # ---- Fig. 2.9: reaching ----------------------------------------------------------------------------
 def reach_target(ee_des: np.ndarray, n_targets: int) -> int:
     """Target index from the direction of ee_des at its farthest point from the first sample
