@@ -170,6 +170,16 @@ def _letter(ax, s: str) -> None:
     ax.text(-0.14, 1.04, s, transform=ax.transAxes, fontsize=13, fontweight="bold", va="bottom")
 
 
+def _finish(fig, stem: Path, panels: dict[str, Any], legend_size: int = 8) -> Path:
+    """Grid, legend and panel letter on each lettered axes; save PNG + SVG."""
+    for s, ax in panels.items():
+        ax.grid(alpha=0.3)
+        _legend(ax, legend_size)
+        _letter(ax, s)
+    fig.tight_layout()
+    return save(fig, stem)
+
+
 def _ref_lines(ax, runs: RunSet) -> list[Run]:
     """Dashed lines at the no-delay MAE of the PD and factory position controllers, when such runs exist."""
     used = []
@@ -217,13 +227,9 @@ def fig3_4(runs: RunSet, stem: Path) -> Figure:
         ax_a.axhline(pos.mae.mean(), ls="--", color="0.4", lw=1.1, label="factory position, no delay")
     ax_a.set_ylabel("position MAE (rad), mean ± std over trials")
     ax_b.set_ylabel("torque variability (N·m/ms), mean ± std")
-    for ax, s in ((ax_a, "A"), (ax_b, "B")):
+    for ax in (ax_a, ax_b):
         ax.set_xlabel("constant round-trip delay δT (ms)")
-        ax.grid(alpha=0.3)
-        _legend(ax, 8)
-        _letter(ax, s)
-    fig.tight_layout()
-    png = save(fig, stem)
+    png = _finish(fig, stem, {"A": ax_a, "B": ax_b})
 
     table = [HEADER]
     paper0 = {"pd": "0.076", "ann": "0.021 ± 0.002", "snn": "0.018 ± 0.004"}
@@ -444,12 +450,7 @@ def fig3_8(runs: RunSet, stem: Path) -> Figure:
         _cdf(ax_d, d[k][1], color=f"C{i}", lw=1.4, ls="--", label=f"{labels[i]}: C2R (motor)")
     ax_d.axvline(20.0, color="0.5", lw=0.8, ls=":")
     ax_d.set(xlabel="one-way delay (ms)", ylabel="CDF")
-    for ax, s in ((ax_c, "C"), (ax_d, "D")):
-        ax.grid(alpha=0.3)
-        _legend(ax, 7)
-        _letter(ax, s)
-    fig.tight_layout()
-    png = save(fig, stem)
+    png = _finish(fig, stem, {"C": ax_c, "D": ax_d}, legend_size=7)
 
     pooled = np.concatenate([wifi[k].mae for k in loads])
     table = [HEADER, ["average MAE over loads (rad)", "0.025 ± 0.007", mean_std(pooled)]]
@@ -559,12 +560,7 @@ def fig3_10(runs: RunSet, stem: Path) -> Figure:
             s = np.array([_ms(r.mae) for r in sweep.values()])
             ax_c.errorbar(list(sweep), s[:, 0], s[:, 1], marker="o", capsize=3, color=color, label=label)
     ax_c.set(xlabel="constant round-trip delay δT (ms)", ylabel="position MAE (rad), mean ± std")
-    for ax, s in ((ax_a, "A"), (ax_b, "B"), (ax_c, "C")):
-        ax.grid(alpha=0.3)
-        _legend(ax, 8)
-        _letter(ax, s)
-    fig.tight_layout()
-    png = save(fig, stem)
+    png = _finish(fig, stem, {"A": ax_a, "B": ax_b, "C": ax_c})
 
     table = [HEADER]
     for dt in sorted(set(multi) | set(mono)):

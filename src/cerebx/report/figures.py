@@ -12,6 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from cerebx.recording.reader import read_messages  # noqa: E402
+from cerebx.report.registry import save  # noqa: E402
 
 
 def _label(s: dict[str, Any]) -> str:
@@ -39,7 +40,7 @@ def learning_curves(runs: list[tuple[Path, dict]], task: str, out: Path) -> Path
     if len(runs) <= 10:  # beyond that a legend hides the curves
         ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
-    return _save(fig, out)
+    return save(fig, out)
 
 
 def joint_tracking(run_dir: Path, s: dict, out: Path) -> Path:
@@ -72,12 +73,5 @@ def joint_tracking(run_dir: Path, s: dict, out: Path) -> Path:
     np.atleast_1d(axes)[0].legend(fontsize=7)
     fig.suptitle(f"{s['task']} / {s['controller']}: last trial", fontsize=10)
     fig.tight_layout()
-    return _save(fig, out)
+    return save(fig, out)
 
-
-def _save(fig, out: Path) -> Path:
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out.with_suffix(".png"), dpi=120)
-    fig.savefig(out.with_suffix(".svg"))
-    plt.close(fig)
-    return out.with_suffix(".png")

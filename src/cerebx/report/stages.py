@@ -14,7 +14,7 @@ import numpy as np  # noqa: E402
 from matplotlib.colors import PowerNorm  # noqa: E402
 
 from cerebx.recording.reader import read_messages  # noqa: E402
-from cerebx.report.figures import _save  # noqa: E402
+from cerebx.report.registry import save  # noqa: E402
 
 # thesis stages for a 500-trial run: t1 = 18-20 s, t2 = 318-320 s, t3 = 998-1000 s
 STAGE_FRACTIONS = (0.02, 0.32, 1.0)
@@ -111,7 +111,7 @@ def stages_figure(run_dir: Path, summary: dict, out: Path) -> Path:
     fig.suptitle(f"{summary['task']} / {summary['controller']}: initial, intermediate and final stage "
                  "(end-effector: previous 10 trials as density)", fontsize=11)
     fig.tight_layout()
-    return _save(fig, out)
+    return save(fig, out)
 
 
 def _baseline_label(b: dict) -> str:
@@ -152,4 +152,4 @@ def mae_per_joint_figure(summary: dict, baselines: list[dict], out: Path, labels
                  + (" (table windows shaded)" if windows else ""))
     panel_letter(ax, "g")
     fig.tight_layout()
-    return _save(fig, out)
+    return save(fig, out)
