@@ -196,7 +196,12 @@ def main(argv: list[str]) -> int:
                 for j in jobs:
                     print(f"{'reuse' if j.done() else 'run  '} {j.run_dir}  cerebx run {' '.join(j.overrides())}")
                 return 0
-            failed = execute(jobs, parallel=a.jobs)
+            try:
+                failed = execute(jobs, parallel=a.jobs)
+            except KeyboardInterrupt:
+                print("report: interrupted; finished runs are kept (run the same command again to resume)",
+                      file=sys.stderr)
+                return 130
             dirs = [j.run_dir for j in jobs]
         else:
             dirs = []

@@ -11,10 +11,12 @@ from __future__ import annotations
 import itertools
 import json
 import shutil
+import signal
 import subprocess
 import sys
 import time
 from collections.abc import Callable
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -153,7 +155,15 @@ def subprocess_runner(job: Job) -> int:
     with open(job.run_dir / "job.log", "w") as log:
         log.write(" ".join(cmd) + "\n")
         log.flush()
-        return subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT).returncode
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT)
+        _children.add(proc)
+        try:
+            return proc.wait()
+        finally:
+            _children.discard(proc)
+
+
+_children: set[subprocess.Popen] = set()  # the `cerebx run` processes under way
 
 
 def in_process_runner(job: Job) -> int:
@@ -168,68 +178,74 @@ def in_process_runner(job: Job) -> int:
 
 def execute(jobs: list[Job], runner: Runner = subprocess_runner, parallel: int = 2,
             log: Callable[[str], None] | None = None) -> list[str]:
-    """Run every job that is not done, ``parallel`` at a time; returns one line per failed job."""
-    log = log or (lambda line: print(line, flush=True))
-    todo = [j for j in jobs if not j.done()]
-    reused = len(jobs) - len(todo)
-    log(f"studies: {len(jobs)} jobs, {reused} reused, {len(todo)} to run")
-    failed: dict[str, str] = {}
-    finished: set[str] = {j.name for j in jobs if j.done()}
-    if not todo:
-        return []
-    from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+    """Run every job that is not done, ``parallel`` at a time; returns one line per failed job.
 
-    t_start = time.monotonic()
-    # the runs others start from go first (longest first), so the critical path starts at once
-    dependents = {j.name: sum(d.name == j.name for k in todo for d in k.deps) for j in todo}
-    pending = sorted(todo, key=lambda j: (-dependents[j.name], -j.trials))
-    running: dict = {}
-
-    def ready(j: Job) -> bool:
-        return all(d.name in finished for d in j.deps)
-
-    def blocked(j: Job) -> str | None:
-        for d in j.deps:
-            if d.name in failed:
-                return d.name
-        return None
-
-    with ThreadPoolExecutor(max_workers=max(1, parallel)) as pool:
-        while pending or running:
-            for j in list(pending):
-                why = blocked(j)
-                if why is not None:
-                    pending.remove(j)
-                    failed[j.name] = f"{j.name}: not run, the run it starts from ({why}) failed"
-                    log(failed[j.name])
-                elif ready(j) and len(running) < max(1, parallel):
-                    pending.remove(j)
-                    if j.run_dir.exists():
-                        shutil.rmtree(j.run_dir)  # an unfinished earlier attempt
-                    log(f"[{_clock(t_start)}] start {j.name} ({j.trials} trials)")
-                    running[pool.submit(runner, j)] = j
-            if not running:
-                continue
-            done, _ = wait(list(running), return_when=FIRST_COMPLETED)
-            for fut in done:
-                j = running.pop(fut)
-                try:
-                    rc = fut.result()
-                except Exception as err:  # a runner that raises is a failed job, not a failed report
-                    rc, err_text = 1, f"{type(err).__name__}: {err}"
-                else:
-                    err_text = f"exit code {rc}, see {j.run_dir / 'job.log'}"
-                if rc == 0 and j.done():
-                    finished.add(j.name)
-                    s = json.loads((j.run_dir / "summary.json").read_text())
-                    log(f"[{_clock(t_start)}] done  {j.name}: final MAE {s.get('final_mae') or float('nan'):.4f} rad, "
-                        f"{s.get('wall_seconds', 0):.0f} s ({len(finished) - reused}/{len(todo)})")
-                else:
-                    failed[j.name] = f"{j.name}: failed ({err_text})"
-                    log(failed[j.name])
-    return list(failed.values())
+    Ctrl-C stops the jobs under way (their runs end as ``interrupted``) and re-raises; finished runs
+    are kept, so running again resumes.
+    """
+    return _Scheduler(jobs, runner, max(1, parallel), log or (lambda line: print(line, flush=True))).run()
 
 
-def _clock(t0: float) -> str:
-    s = int(time.monotonic() - t0)
-    return f"{s // 60:02d}:{s % 60:02d}"
+class _Scheduler:
+    def __init__(self, jobs: list[Job], runner: Runner, parallel: int, log: Callable[[str], None]):
+        self.runner, self.parallel, self.log = runner, parallel, log
+        self.todo = [j for j in jobs if not j.done()]
+        self.reused = len(jobs) - len(self.todo)
+        self.finished = {j.name for j in jobs if j not in self.todo}
+        self.failed: dict[str, str] = {}
+        # the runs others start from go first (longest first), so the critical path starts at once
+        dependents = {j.name: sum(d.name == j.name for k in self.todo for d in k.deps) for j in self.todo}
+        self.pending = sorted(self.todo, key=lambda j: (-dependents[j.name], -j.trials))
+        self.running: dict[Future, Job] = {}
+        self.t0 = time.monotonic()
+
+    def run(self) -> list[str]:
+        self.log(f"studies: {self.reused + len(self.todo)} jobs, {self.reused} reused, {len(self.todo)} to run")
+        with ThreadPoolExecutor(max_workers=self.parallel) as pool:
+            try:
+                while self.pending or self.running:
+                    self._start_ready(pool)
+                    if self.running:
+                        done, _ = wait(list(self.running), return_when=FIRST_COMPLETED)
+                        for fut in done:
+                            self._record(self.running.pop(fut), fut)
+            except KeyboardInterrupt:
+                self.log("interrupted: stopping the jobs under way (their runs end as 'interrupted'); "
+                         "run again to resume")
+                for proc in list(_children):
+                    proc.send_signal(signal.SIGINT)
+                raise
+        return list(self.failed.values())
+
+    def _start_ready(self, pool: ThreadPoolExecutor) -> None:
+        for j in list(self.pending):
+            broken = [d.name for d in j.deps if d.name in self.failed]
+            if broken:
+                self.pending.remove(j)
+                self.failed[j.name] = f"{j.name}: not run, the run it starts from ({broken[0]}) failed"
+                self.log(self.failed[j.name])
+            elif all(d.name in self.finished for d in j.deps) and len(self.running) < self.parallel:
+                self.pending.remove(j)
+                if j.run_dir.exists():
+                    shutil.rmtree(j.run_dir)  # an unfinished earlier attempt
+                self.log(f"[{self._clock()}] start {j.name} ({j.trials} trials)")
+                self.running[pool.submit(self.runner, j)] = j
+
+    def _record(self, j: Job, fut: Future) -> None:
+        try:
+            rc, why = fut.result(), f"see {j.run_dir / 'job.log'}"
+        except Exception as err:  # a runner that raises is a failed job, not a failed report
+            rc, why = 1, f"{type(err).__name__}: {err}"
+        if rc == 0 and j.done():
+            self.finished.add(j.name)
+            s = json.loads((j.run_dir / "summary.json").read_text())
+            mae = s.get("final_mae")
+            self.log(f"[{self._clock()}] done  {j.name}: final MAE {mae if mae is None else round(mae, 4)} rad, "
+                     f"{s.get('wall_seconds', 0):.0f} s ({len(self.finished) - self.reused}/{len(self.todo)})")
+        else:
+            self.failed[j.name] = f"{j.name}: failed (exit code {rc}, {why})"
+            self.log(self.failed[j.name])
+
+    def _clock(self) -> str:
+        s = int(time.monotonic() - self.t0)
+        return f"{s // 60:02d}:{s % 60:02d}"
