@@ -130,3 +130,18 @@ def test_bad_studies_file_is_one_line(tmp_path):
     with pytest.raises(ConfigError) as err:
         load_studies(bad)
     assert all(line.startswith(str(bad)) for line in err.value.problems)
+
+
+def test_ctrl_c_stops_the_study_runner_and_says_how_to_resume(tmp_path):
+    import _thread
+    import time
+
+    def interrupted(job: Job) -> int:
+        _thread.interrupt_main()  # Ctrl-C arrives while a job runs
+        time.sleep(0.2)
+        return 1
+
+    lines: list[str] = []
+    with pytest.raises(KeyboardInterrupt):
+        execute(plan("quick", tmp_path, ["fig3_4_pd"]), runner=interrupted, log=lines.append)
+    assert any("interrupted" in line and "run again to resume" in line for line in lines)
