@@ -103,6 +103,8 @@ def test_sigint_leaves_readable_log(tmp_path):
     proc = subprocess.Popen(
         [sys.executable, "-m", "cerebx.cli", "run", *DEMO, "trials=2000", "hydra.run.dir=run"],
         cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        # a shell that starts the tests in the background ignores SIGINT, and children inherit that
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     mcap = tmp_path / "run" / "run.mcap"
     deadline = time.time() + 120  # generous: CI machines can be slow to start Python + Hydra

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import signal
 
 import matplotlib.image as mpimg
 import pytest
@@ -142,6 +143,11 @@ def test_ctrl_c_stops_the_study_runner_and_says_how_to_resume(tmp_path):
         return 1
 
     lines: list[str] = []
-    with pytest.raises(KeyboardInterrupt):
-        execute(plan("quick", tmp_path, ["fig3_4_pd"]), runner=interrupted, log=lines.append)
+    # interrupt_main does nothing while SIGINT is ignored (tests started in the background)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            execute(plan("quick", tmp_path, ["fig3_4_pd"]), runner=interrupted, log=lines.append)
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert any("interrupted" in line and "run again to resume" in line for line in lines)

@@ -170,12 +170,13 @@ def _letter(ax, s: str) -> None:
     ax.text(-0.14, 1.04, s, transform=ax.transAxes, fontsize=13, fontweight="bold", va="bottom")
 
 
-def _finish(fig, stem: Path, panels: dict[str, Any], legend_size: int = 8) -> Path:
-    """Grid, legend and panel letter on each lettered axes; save PNG + SVG."""
+def _finish(fig, stem: Path, panels: dict[str, Any], legend_size: int = 8, others: Iterable[Any] = ()) -> Path:
+    """Grid and legend on every axes, a letter on each of ``panels``; save PNG + SVG."""
     for s, ax in panels.items():
+        _letter(ax, s)
+    for ax in (*panels.values(), *others):
         ax.grid(alpha=0.3)
         _legend(ax, legend_size)
-        _letter(ax, s)
     fig.tight_layout()
     return save(fig, stem)
 
@@ -313,12 +314,7 @@ def fig3_6(runs: RunSet, stem: Path) -> Figure:
         notes.append("only one kernel peak: no linear fit")
     ax_c.set_xlabel("kernel peak τ_LTD (ms)")
     ax_c.set_ylabel("position MAE (rad)")
-    _legend(ax_c, 8)
-    for ax, s in ((ax_a, "A"), (ax_b, "B"), (ax_c, "C")):
-        ax.grid(alpha=0.3)
-        _letter(ax, s)
-    fig.tight_layout()
-    png = save(fig, stem)
+    png = _finish(fig, stem, {"A": ax_a, "B": ax_b, "C": ax_c})
 
     table = [HEADER,
              ["slope (rad/ms)", f"{THESIS_FIT[0]:.6f}", "–" if fit is None else f"{fit[0]:.6f}"],
@@ -328,6 +324,8 @@ def fig3_6(runs: RunSet, stem: Path) -> Figure:
         line = "" if fit is None else f"; fit {np.polyval(fit, x):.4f}"
         table.append([f"MAE at peak {x:g} ms (rad)", f"{THESIS_FIT[0] * x + THESIS_FIT[1]:.4f} (line)",
                       f"{ours}{line}"])
+    best = min(by_peak, key=lambda x: _mae(by_peak[x], last[x]).mean())
+    table.append(["kernel peak with the lowest MAE (ms)", "90, the shortest (MAE rises with the peak)", f"{best:g}"])
     table.append(["PD reference, no delay (rad)", "0.076", "–" if pd is None else mean_std(pd.mae)])
     origins: dict[str, list[str]] = {}
     for p, r in by_peak.items():
@@ -392,13 +390,7 @@ def fig3_7(runs: RunSet, stem: Path) -> Figure:
         ax.set(xlabel="one-way delay (ms)", ylabel="CDF")
     for ax in (ax_c, ax_e):
         ax.set_ylabel("SNN position MAE (rad) per trial")
-    for ax, s in zip((ax_a, ax_b, ax_c, axes_d[0], ax_e), "ABCDE"):
-        _letter(ax, s)
-    for ax in (ax_a, ax_b, ax_c, *axes_d, ax_e):
-        ax.grid(alpha=0.3)
-        _legend(ax, 7)
-    fig.tight_layout()
-    png = save(fig, stem)
+    png = _finish(fig, stem, dict(zip("ABCDE", (ax_a, ax_b, ax_c, axes_d[0], ax_e))), 7, others=axes_d[1:])
 
     table = [HEADER]
     for k in sym:
@@ -482,7 +474,7 @@ def fig3_9(runs: RunSet, stem: Path) -> Figure:
     notes = [f"no run under the {k} preset" for k in THESIS_CLOUD if k not in cloud]
     d = {k: delays(cloud[k]) for k in names}
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
-    for ax, k, s in zip(axes, THESIS_CLOUD, "DE"):
+    for ax, k in zip(axes, THESIS_CLOUD):
         if k not in cloud:
             ax.set_visible(False)
             continue
@@ -491,16 +483,9 @@ def fig3_9(runs: RunSet, stem: Path) -> Figure:
             ax.plot(THESIS_CLOUD[k][path], (0.5, 0.9, 0.99), "x", color=color, ms=8,
                     label=f"{path.upper()} thesis p50/p90/p99 bounds")
         ax.set(xlabel="one-way delay (ms)", ylabel="CDF", title=k)
-        _letter(ax, s)
-    ax = axes[2]
-    _box(ax, [cloud[k].mae for k in names], names)
-    ax.set_ylabel("SNN position MAE (rad) per trial")
-    _letter(ax, "F")
-    for ax in axes:
-        ax.grid(alpha=0.3)
-        _legend(ax, 7)
-    fig.tight_layout()
-    png = save(fig, stem)
+    _box(axes[2], [cloud[k].mae for k in names], names)
+    axes[2].set_ylabel("SNN position MAE (rad) per trial")
+    png = _finish(fig, stem, dict(zip("DEF", axes)), 7)
 
     table = [HEADER]
     for k in names:
