@@ -9,7 +9,7 @@ import hydra
 from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
-from cerebx.config import to_plain
+from cerebx.config import to_plain, user_choices
 from cerebx.errors import ConfigError
 from cerebx.schema.experiment import validate
 
@@ -28,7 +28,7 @@ def run_app(cfg: DictConfig) -> float | None:
         for line in err.problems:
             print(line, file=sys.stderr)
         raise SystemExit(2) from None
-    choices = {k: v for k, v in hc.runtime.choices.items() if not k.startswith("hydra") and v is not None}
+    choices = user_choices(hc.runtime.choices)
     summary = run_experiment(exp, run_dir, plain, overrides=list(hc.overrides.task), choices=choices)
     print_summary(summary, run_dir)
     if summary["status"] == "failed":

@@ -55,18 +55,34 @@ def _hydra_lines(err: Exception) -> list[str]:
 
 def compose(overrides: list[str]) -> DictConfig:
     """Compose ``conf/config.yaml`` with command-line style overrides (no output folders)."""
+    return compose_with_choices(overrides)[0]
+
+
+def compose_with_choices(overrides: list[str]) -> tuple[DictConfig, dict[str, str]]:
+    """Compose, and return the option chosen in each config group (what ``cerebx run`` records as presets)."""
     from hydra import compose as hydra_compose
     from hydra import initialize_config_module
     from hydra.core.global_hydra import GlobalHydra
     from hydra.errors import HydraException
+    from omegaconf import open_dict
     from omegaconf.errors import OmegaConfBaseException
 
     GlobalHydra.instance().clear()
     try:
         with initialize_config_module(config_module="cerebx.conf", version_base="1.3"):
-            return hydra_compose(config_name="config", overrides=[o for o in overrides if not _is_hydra(o)])
+            cfg = hydra_compose(config_name="config", overrides=[o for o in overrides if not _is_hydra(o)],
+                                return_hydra_config=True)
     except (HydraException, OmegaConfBaseException, ValueError) as err:
         raise ConfigError(_hydra_lines(err)) from None
+    choices = user_choices(cfg.hydra.runtime.choices)
+    with open_dict(cfg):
+        del cfg["hydra"]
+    return cfg, choices
+
+
+def user_choices(choices: Any) -> dict[str, str]:
+    """The chosen option of each of cerebx's config groups (Hydra's own groups left out)."""
+    return {k: v for k, v in choices.items() if not k.startswith("hydra") and v is not None}
 
 
 def _is_hydra(override: str) -> bool:

@@ -19,7 +19,7 @@ from collections import defaultdict
 from pathlib import Path
 
 from cerebx.errors import CerebxError
-from cerebx.report.registry import Figure, MissingRuns, all_figures
+from cerebx.report.registry import Figure, MissingRuns, all_figures, fmt
 from cerebx.report.runs import RunSet, find_run_dirs, load_runs
 
 MAX_TRACKING_RUNS = 12  # per-run joint-tracking figures only for small run sets
@@ -43,17 +43,13 @@ def _write_table(out: Path, name: str, rows: list[list[str]]) -> None:
         csv.writer(fh).writerows(rows)
 
 
-def _fmt(x: float | None, nd: int = 4) -> str:
-    return "–" if x is None else f"{x:.{nd}f}"
-
-
 def _runs_table(runs: RunSet) -> list[list[str]]:
     rows = [["run", "status", "task", "controller", "plant", "delay", "network", "trials", "final MAE (rad)",
              "rt factor"]]
     for r in runs:
         s = r.summary
         rows.append([str(r.dir), s["status"], r.task, r.controller_preset, s["plant"], r.delay_preset, r.network,
-                     str(r.trials), _fmt(s.get("final_mae")), _fmt(s.get("rt_factor"), 1)])
+                     str(r.trials), fmt(s.get("final_mae"), 4), fmt(s.get("rt_factor"), 1)])
     return rows
 
 
@@ -134,7 +130,7 @@ def build(run_dirs: list[Path], out: Path, names: list[str] | None = None,
     _write_table(out, "paper_vs_cerebx", paper_rows)
     from cerebx.report.delays import delay_rows
 
-    _write_table(out, "delays", delay_rows([(r.dir, r.summary) for r in runs]))
+    _write_table(out, "delays", delay_rows(runs))
     miss = "".join(f"<li>{html.escape(m)}</li>" for m in missing)
     probs = "".join(f"<li>{html.escape(p)}</li>" for p in problems)
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>cerebx report</title>

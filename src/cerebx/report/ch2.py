@@ -4,9 +4,7 @@ Runs are chosen by content:
 
 - learning from scratch: snn controller, no delay, no ``init_from``, no plant events, one PF-PC kernel
   peaking at 150 ms (the thesis kernel; this keeps the multikernel and kernel-sweep runs out);
-- the factory position controller: controller kind ``position`` whose preset is ``position_factory``
-  or, for runs that recorded no preset, whose ``controller.velocity_feedforward`` is false (the factory
-  stand-in sends position-only commands; the stiff servo ``position`` sends velocity feed-forward);
+- the factory position controller: ``Run.is_factory_position``;
 - the PD baseline: controller preset ``pd`` (the launch gains), no delay.
 """
 
@@ -24,7 +22,7 @@ from matplotlib.patches import Patch  # noqa: E402
 
 from cerebx.metrics import final_mae  # noqa: E402
 from cerebx.report import stages  # noqa: E402
-from cerebx.report.registry import Figure, MissingRuns, figure, mean_std, save  # noqa: E402
+from cerebx.report.registry import Figure, MissingRuns, figure, mean_std, panel_letter, save  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
 
 THESIS_KERNEL_MS = 150.0
@@ -56,16 +54,11 @@ def from_scratch(runs: RunSet, task: str) -> Run | None:
                       task=task, controller="snn", delay="none").best()
 
 
-def is_factory(r: Run) -> bool:
-    return r.controller == "position" and (r.controller_preset == "position_factory"
-                                           or r.get("controller.velocity_feedforward") is False)
-
-
 def baselines(runs: RunSet, task: str) -> list[tuple[str, Run]]:
     """(label, run) of the PD and factory-position baselines on ``task`` without delay, those present."""
     none = runs.where(lambda r: r.trials > 0 and not r.events, task=task, delay="none")
     found = [("PD", none.where(controller="pd", controller_preset="pd").best()),
-             ("factory position", none.where(is_factory).best())]
+             ("factory position", none.where(lambda r: r.is_factory_position).best())]
     return [(name, r) for name, r in found if r is not None]
 
 
@@ -281,7 +274,7 @@ def fig2_9(runs: RunSet, stem: Path) -> Figure:
         t_end = e * run.period_s
         ax.set_title(f"before t = {t_end:.0f} s (trial {e}); density: {_trials(max(0, e - width), e)}",
                      fontsize=9)
-        stages.panel_letter(ax, "abc"[c])
+        panel_letter(ax, "abc"[c])
         ax.legend(fontsize=6, ncol=2, loc="upper right")
         ax = fig.add_subplot(gs[1, c])
         if star in lastk:
@@ -295,11 +288,11 @@ def fig2_9(runs: RunSet, stem: Path) -> Figure:
                     ha="center", fontsize=8)
         ax.set_xlabel("time in trial (s)")
         ax.set_ylabel("end-effector speed (m/s)")
-        stages.panel_letter(ax, "def"[c])
+        panel_letter(ax, "def"[c])
     ax = fig.add_subplot(gs[2, :])
     stages.mae_per_joint_axes(ax, run.summary, [b.summary for _, b in base], [name for name, _ in base], wins)
     ax.set_title(f"reaching / snn: MAE per joint, {n} trials (table windows shaded)", fontsize=10)
-    stages.panel_letter(ax, "g")
+    panel_letter(ax, "g")
     fig.tight_layout()
     files = [save(fig, stem)]
     notes = []
@@ -533,7 +526,7 @@ def fig3_5(runs: RunSet, stem: Path) -> Figure:
     if not any(slots.values()):
         raise MissingRuns(f"no pd / ann / snn runs under a constant {FIG3_5_DELAY_MS:.0f} ms delay "
                           "(studies fig3_5_*)")
-    refs = {task: runs.where(lambda r: is_factory(r) and r.trials > 0, task=task, delay="none").best()
+    refs = {task: runs.where(lambda r: r.is_factory_position and r.trials > 0, task=task, delay="none").best()
             for task in CH3_TASKS}
     data = {key: _sample_ee(r) for key, r in slots.items() if r is not None}
     colors = {"pd": "C3", "ann": "C1", "snn": "C0"}

@@ -10,7 +10,6 @@ from __future__ import annotations
 import re
 from collections import Counter
 from collections.abc import Callable, Iterable
-from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -19,15 +18,13 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-import yaml  # noqa: E402
 
-from cerebx.report.registry import Figure, MissingRuns, figure, fmt, mean_std, save  # noqa: E402
+from cerebx.report.delays import DELAY_TRIALS, delays  # noqa: E402
+from cerebx.report.registry import Figure, MissingRuns, figure, fmt, mean_std, panel_letter, save  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
 from cerebx.schema.network import KernelSTDP  # noqa: E402
 from cerebx.snn.topology import ltd_kernel_table  # noqa: E402
 
-DELAY_CONF = Path(__file__).resolve().parents[1] / "conf" / "delay"
-DELAY_TRIALS = 10  # trials of /control read per run for its realised delays (10k steps: stationary, fast)
 CONTROLLERS = {"pd": ("PD", "C3"), "ann": ("ANN", "C1"), "snn": ("SNN", "C0")}
 HEADER = ["quantity", "paper", "cerebx"]
 
@@ -42,36 +39,17 @@ THESIS_FIT = (0.000106, 0.0036)  # Fig. 3.6 C: MAE = slope * peak_ms + intercept
 
 
 # ---- selection helpers -------------------------------------------------------------------------------
-@lru_cache(maxsize=1)
-def _delay_presets() -> dict[str, dict[str, Any]]:
-    return {p.stem: yaml.safe_load(p.read_text()) or {} for p in sorted(DELAY_CONF.glob("*.yaml"))}
-
-
-def delay_preset_name(run: Run) -> str | None:
-    """The run's delay preset: from its summary, else the conf/delay file its delay config matches."""
-    name = (run.summary.get("presets") or {}).get("delay")
-    if name:
-        return name
-    cfg = run.get("delay") or {}
-    matches = [(len(d), n) for n, d in _delay_presets().items() if all(cfg.get(k) == v for k, v in d.items())]
-    return max(matches)[1] if matches else None
-
-
 def _delay_label(run: Run) -> str:
+    """The delay preset's name, or for a run that recorded none, its delay config in short."""
+    if "delay" in (run.summary.get("presets") or {}):
+        return run.delay_preset
     cfg = {k: v for k, v in (run.get("delay") or {}).items() if k != "kind"}
-    return delay_preset_name(run) or f"{run.delay} {cfg}"[:40]
+    return f"{run.delay} {cfg}"[:40]
 
 
 def _plain_circle(r: Run) -> bool:
     """A circle run with logged trials and no perturbation events."""
     return r.task == "circle" and not r.events and r.mae.size > 0
-
-
-def _total_ms(r: Run) -> float | None:
-    """The constant round-trip delay (0 without delay); None for random delays or an unreadable config."""
-    if r.delay == "constant" and r.get("delay.total_ms") is None:
-        return None
-    return r.delay_total_ms
 
 
 def _prefer_learned(rs: RunSet) -> Run | None:
@@ -85,10 +63,10 @@ def _sweep(runs: RunSet, controller: str, multikernel: bool = False) -> tuple[di
     started from the same state (the one most delays used); a note for each delay left out for that."""
     def ok(r: Run) -> bool:
         if not (_plain_circle(r) and r.delay == "constant" and r.controller == controller
-                and _total_ms(r) is not None):
+                and r.delay_total_ms is not None):
             return False
         return controller != "snn" or (len(r.kernel_peaks_ms) > 1) == multikernel and bool(r.kernel_peaks_ms)
-    picked = runs.where(ok).by(_total_ms, _prefer_learned)
+    picked = runs.where(ok).by(lambda r: r.delay_total_ms, _prefer_learned)
     origins = Counter(r.learned_from for r in picked.values())
     main = max(origins, key=lambda o: (origins[o], sum(r.trials for r in picked.values() if r.learned_from == o)),
                default=None)
@@ -99,9 +77,9 @@ def _sweep(runs: RunSet, controller: str, multikernel: bool = False) -> tuple[di
 
 def _reference(runs: RunSet, controller: str) -> Run | None:
     """A no-delay circle run of the PD (the fig3_4_pd δT = 0 run first) or factory position controller."""
-    rs = runs.where(lambda r: _plain_circle(r) and r.controller == controller and _total_ms(r) == 0)
+    rs = runs.where(lambda r: _plain_circle(r) and r.controller == controller and r.delay_total_ms == 0)
     if controller == "position":
-        rs = rs.where(lambda r: r.get("controller.velocity_feedforward") is False) or rs
+        rs = rs.where(lambda r: r.is_factory_position) or rs
     if controller == "pd":  # the launch gains (preset pd), and the δT = 0 run of the fig3_4 sweep first
         rs = rs.where(lambda r: r.controller_preset == "pd") or rs
         rs = rs.where(lambda r: r.delay == "constant") or rs
@@ -115,17 +93,6 @@ def _snn_delay_runs(runs: RunSet, pred: Callable[[Run], bool]) -> dict[str, Run]
 
 
 # ---- data helpers ------------------------------------------------------------------------------------
-@lru_cache(maxsize=64)
-def _read_delays(run_dir: str, t1: float) -> tuple[np.ndarray, np.ndarray]:
-    c = Run.load(run_dir).control(["r2c_ms", "c2r_ms"], t1=t1)
-    return c["r2c_ms"], c["c2r_ms"]
-
-
-def delays(run: Run) -> tuple[np.ndarray, np.ndarray]:
-    """R2C and C2R delays (ms) of every 2 ms step in the run's first DELAY_TRIALS trials."""
-    return _read_delays(str(run.dir), round(max(1, min(run.trials, DELAY_TRIALS)) * run.period_s, 6))
-
-
 def kernels(run: Run) -> list[tuple[str, KernelSTDP, np.ndarray, np.ndarray]]:
     """(projection, rule, t in ms, k(t)) of every PF-PC kernel of the run's network, as the SNN builds it."""
     dt = float(run.get("network.dt_ms", 0.5))
@@ -166,14 +133,10 @@ def _legend(ax, size: int = 8) -> None:
         ax.legend(fontsize=size)
 
 
-def _letter(ax, s: str) -> None:
-    ax.text(-0.14, 1.04, s, transform=ax.transAxes, fontsize=13, fontweight="bold", va="bottom")
-
-
 def _finish(fig, stem: Path, panels: dict[str, Any], legend_size: int = 8, others: Iterable[Any] = ()) -> Path:
     """Grid and legend on every axes, a letter on each of ``panels``; save PNG + SVG."""
     for s, ax in panels.items():
-        _letter(ax, s)
+        panel_letter(ax, s)
     for ax in (*panels.values(), *others):
         ax.grid(alpha=0.3)
         _legend(ax, legend_size)
@@ -275,7 +238,7 @@ def fig3_4(runs: RunSet, stem: Path) -> Figure:
 # ---- Fig. 3.6 ----------------------------------------------------------------------------------------
 @figure("fig3_6", "MAE vs PF-PC kernel peak", studies=("fig3_6_kernels", "fig3_4_pd"))
 def fig3_6(runs: RunSet, stem: Path) -> Figure:
-    rs = runs.where(lambda r: _plain_circle(r) and r.controller == "snn" and _total_ms(r) == 0
+    rs = runs.where(lambda r: _plain_circle(r) and r.controller == "snn" and r.delay_total_ms == 0
                     and len(r.kernel_peaks_ms) == 1)
     by_peak = rs.by(lambda r: r.kernel_peaks_ms[0])
     if not by_peak:
@@ -428,7 +391,7 @@ def _load_mbps(name: str) -> int | None:
 
 @figure("fig3_8", "SNN behind a Wi-Fi gateway", studies=("fig3_8_wifi",))
 def fig3_8(runs: RunSet, stem: Path) -> Figure:
-    wifi = _snn_delay_runs(runs, lambda r: _load_mbps(delay_preset_name(r) or "") is not None)
+    wifi = _snn_delay_runs(runs, lambda r: _load_mbps(r.delay_preset) is not None)
     if not wifi:
         raise MissingRuns("no SNN circle runs under the Wi-Fi delay presets wifi15/30/54 (study fig3_8_wifi)")
     loads = sorted(wifi, key=_load_mbps)
@@ -467,7 +430,7 @@ def fig3_8(runs: RunSet, stem: Path) -> Figure:
 # ---- Fig. 3.9 ----------------------------------------------------------------------------------------
 @figure("fig3_9", "SNN in cloud robotics", studies=("fig3_9_cloud",))
 def fig3_9(runs: RunSet, stem: Path) -> Figure:
-    cloud = _snn_delay_runs(runs, lambda r: delay_preset_name(r) in THESIS_CLOUD)
+    cloud = _snn_delay_runs(runs, lambda r: r.delay_preset in THESIS_CLOUD)
     if not cloud:
         raise MissingRuns("no SNN circle runs under the cloud / wifi_cloud delay presets (study fig3_9_cloud)")
     names = [k for k in THESIS_CLOUD if k in cloud]

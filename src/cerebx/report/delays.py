@@ -1,39 +1,41 @@
-"""Delay-study tables (thesis Fig. 3.4 / 3.7 / 3.8) from run logs: per run, the controller and delay
-presets, the realised round-trip delay (from the delays recorded in /control), MAE and torque
-variability (Eq. 3.14-3.15) over the run's trials."""
+"""Realised delays read back from run logs, and the delay-study table (thesis Fig. 3.4 / 3.7 / 3.8):
+per run, the controller and delay presets, the realised round trip, MAE and torque variability
+(Eq. 3.14-3.15) over the run's measured trials."""
 
 from __future__ import annotations
 
-from pathlib import Path
+from functools import lru_cache
 
 import numpy as np
 
-from cerebx.recording.reader import read_messages
+from cerebx.report.runs import Run, RunSet
+
+DELAY_TRIALS = 10  # trials of /control read per run for its realised delays (10k steps: stationary, fast)
 
 
-def realised_round_trip_ms(run_dir: Path, max_messages: int = 5000) -> float | None:
-    """Mean R2C + C2R delay sampled in the first ``max_messages`` steps."""
-    total, n = 0.0, 0
-    for _, _, msg in read_messages(run_dir, ["/control"]):
-        total += msg.get("r2c_ms", 0.0) + msg.get("c2r_ms", 0.0)
-        n += 1
-        if n >= max_messages:
-            break
-    return total / n if n else None
+@lru_cache(maxsize=64)
+def _read_delays(run_dir: str, t1: float) -> tuple[np.ndarray, np.ndarray]:
+    c = Run.load(run_dir).control(["r2c_ms", "c2r_ms"], t1=t1)
+    return c["r2c_ms"], c["c2r_ms"]
 
 
-def delay_rows(runs: list[tuple[Path, dict]]) -> list[list[str]]:
+def delays(run: Run) -> tuple[np.ndarray, np.ndarray]:
+    """R2C and C2R delays (ms) of every 2 ms step in the run's first DELAY_TRIALS trials."""
+    return _read_delays(str(run.dir), round(max(1, min(run.trials, DELAY_TRIALS)) * run.period_s, 6))
+
+
+def delay_rows(runs: RunSet) -> list[list[str]]:
     rows = [["task", "controller", "delay", "overrides", "realised round trip (ms)", "MAE mean ± std (rad)",
              "MAE last 10 trials", "torque variability (N·m/ms)", "run"]]
-    for d, s in runs:
-        mae = s.get("mae_per_trial") or []
-        if not mae or s.get("delay") == "none" and "delay" not in (s.get("presets") or {}):
+    for r in runs:
+        mae = r.mae
+        if not mae.size or r.delay == "none" and "delay" not in (r.summary.get("presets") or {}):
             continue
-        p = s.get("presets") or {}
-        tv = s.get("torque_variability_per_trial") or [float("nan")]
-        rt = realised_round_trip_ms(d)
-        delay_overrides = " ".join(o for o in s.get("overrides", []) if o.startswith("delay"))
-        rows.append([s["task"], p.get("controller", s["controller"]), p.get("delay", s["delay"]), delay_overrides,
-                     "–" if rt is None else f"{rt:.1f}", f"{np.mean(mae):.4f} ± {np.std(mae):.4f}",
-                     f"{np.mean(mae[-10:]):.4f}", f"{np.mean(tv):.4f}", d.name])
+        tv = r.series("torque_variability_per_trial")
+        r2c, c2r = delays(r)
+        rt = f"{np.mean(r2c + c2r):.1f}" if r2c.size else "–"
+        delay_overrides = " ".join(o for o in r.summary.get("overrides", []) if o.startswith("delay"))
+        rows.append([r.task, r.controller_preset, r.delay_preset, delay_overrides, rt,
+                     f"{np.mean(mae):.4f} ± {np.std(mae):.4f}", f"{np.mean(mae[-10:]):.4f}",
+                     f"{np.mean(tv):.4f}" if tv.size else "nan", r.name])
     return rows

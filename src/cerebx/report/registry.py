@@ -73,6 +73,12 @@ def save(fig, stem: Path) -> Path:
     return stem.with_suffix(".png")
 
 
+def panel_letter(ax, letter: str) -> None:
+    """A bold panel letter above the axes' top-left corner."""
+    ax.annotate(letter, (0, 1), xycoords="axes fraction", xytext=(-34, 8), textcoords="offset points",
+                fontsize=13, fontweight="bold", va="bottom")
+
+
 def fmt(x: float | None, nd: int = 3) -> str:
     return "–" if x is None else f"{x:.{nd}f}"
 

@@ -104,6 +104,13 @@ class Run:
         return self.get("events", []) or []
 
     @property
+    def is_factory_position(self) -> bool:
+        """The stand-in for the factory position controller: preset ``position_factory`` or, for a run that
+        recorded no preset, a position controller without velocity feed-forward (the stiff servo has it)."""
+        return self.controller == "position" and (self.controller_preset == "position_factory"
+                                                  or self.get("controller.velocity_feedforward") is False)
+
+    @property
     def completed(self) -> bool:
         return self.summary.get("status") == "completed"
 
@@ -155,8 +162,6 @@ class Run:
                 cols[k].append(msg[k])
         return {k: np.asarray(v, dtype=float) for k, v in cols.items()}
 
-    def describe(self) -> str:
-        return f"{self.dir} ({self.controller_preset}, {self.task}, delay {self.delay_preset}, {self.trials} trials)"
 
 
 class RunSet(list):

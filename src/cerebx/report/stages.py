@@ -14,7 +14,7 @@ import numpy as np  # noqa: E402
 from matplotlib.colors import PowerNorm  # noqa: E402
 
 from cerebx.recording.reader import read_messages  # noqa: E402
-from cerebx.report.registry import save  # noqa: E402
+from cerebx.report.registry import panel_letter, save  # noqa: E402
 
 # thesis stages for a 500-trial run: t1 = 18-20 s, t2 = 318-320 s, t3 = 998-1000 s
 STAGE_FRACTIONS = (0.02, 0.32, 1.0)
@@ -56,12 +56,6 @@ def density(ax, x: np.ndarray, y: np.ndarray, bins: int = 60, cmap: str = "Blues
     h, xe, ye = np.histogram2d(x, y, bins=bins)
     ax.imshow(np.ma.masked_equal(h.T, 0), origin="lower", extent=(xe[0], xe[-1], ye[0], ye[-1]), cmap=cmap,
               norm=PowerNorm(0.5), alpha=alpha, aspect="auto", interpolation="nearest")
-
-
-def panel_letter(ax, letter: str) -> None:
-    """A bold panel letter above the axes' top-left corner."""
-    ax.annotate(letter, (0, 1), xycoords="axes fraction", xytext=(-34, 8), textcoords="offset points",
-                fontsize=13, fontweight="bold", va="bottom")
 
 
 def stages_figure(run_dir: Path, summary: dict, out: Path) -> Path:

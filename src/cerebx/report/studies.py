@@ -168,11 +168,13 @@ _children: set[subprocess.Popen] = set()  # the `cerebx run` processes under way
 
 def in_process_runner(job: Job) -> int:
     """Run in this process (for tests: no interpreter start-up per job)."""
-    from cerebx.config import load
+    from cerebx.config import compose_with_choices, to_plain
     from cerebx.loop.runner import run_experiment
+    from cerebx.schema.experiment import validate
 
-    exp, plain = load(job.overrides())
-    s = run_experiment(exp, job.run_dir, plain, overrides=job.overrides())
+    cfg, choices = compose_with_choices(job.overrides())
+    plain = to_plain(cfg)
+    s = run_experiment(validate(plain), job.run_dir, plain, overrides=job.overrides(), choices=choices)
     return 0 if s["status"] == "completed" else 1
 
 
