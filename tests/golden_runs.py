@@ -1,0 +1,70 @@
+"""Golden runs: the recorded data of three fixed-seed experiments, reduced to digests.
+
+Regenerate (only in a commit that changes results on purpose, and say so):
+    .venv/bin/python tests/golden_runs.py
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import sys
+from pathlib import Path
+
+import orjson
+
+HERE = Path(__file__).resolve().parent
+GOLDEN = HERE / "golden" / "runs.json"
+
+# name -> overrides; small enough for `make test`, covering PD, the SNN, and the SNN with a gamma
+# delay through the Eq. 3.6 future/past filter (stamped torques)
+RUNS: dict[str, list[str]] = {
+    "pd_circle": ["+task=circle", "controller=pd", "trials=2", "seed=3", "plant.sensor_noise_rad=0.0005"],
+    "snn_small_circle": ["+task=circle", "+experiment=small_snn", "trials=2", "seed=5"],
+    "snn_small_gamma45_future_past": ["+task=circle", "+experiment=small_snn", "controller=snn_delays",
+                                      "controller.mf.fibers_per_signal=5",
+                                      "controller.decoder.alpha_Nm_per_spike=[7.5,11.0,3.75,6.3,0.78,0.78]",
+                                      "delay=gamma45", "trials=2", "seed=11"],
+}
+
+# summary fields that depend on the machine's clock, not on the simulation
+WALL_CLOCK = {"wall_seconds", "rt_factor", "started_at", "controller_info"}
+
+
+def digest(run_dir: Path) -> dict:
+    """Per-topic message count and sha256 of the canonical JSON of (time, message), plus the summary's
+    simulation fields."""
+    from cerebx.recording.reader import read_messages
+
+    hashes: dict[str, hashlib._Hash] = {}
+    counts: dict[str, int] = {}
+    for topic, t, msg in read_messages(run_dir):
+        h = hashes.setdefault(topic, hashlib.sha256())
+        h.update(orjson.dumps([t, msg], option=orjson.OPT_SORT_KEYS | orjson.OPT_SERIALIZE_NUMPY))
+        counts[topic] = counts.get(topic, 0) + 1
+    summary = json.loads((run_dir / "summary.json").read_text())
+    sim = {k: v for k, v in summary.items() if k not in WALL_CLOCK}
+    return {"topics": {k: {"count": counts[k], "sha256": hashes[k].hexdigest()} for k in sorted(hashes)},
+            "summary": sim}
+
+
+def record(name: str, out_dir: Path) -> dict:
+    from cerebx.config import load
+    from cerebx.loop.runner import run_experiment
+
+    cfg, _ = load(RUNS[name])
+    run_experiment(cfg, out_dir)
+    return digest(out_dir)
+
+
+if __name__ == "__main__":
+    import tempfile
+
+    data = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in RUNS:
+            data[name] = record(name, Path(tmp) / name)
+            print(name, data[name]["summary"]["mae_per_trial"], file=sys.stderr)
+    GOLDEN.parent.mkdir(exist_ok=True)
+    GOLDEN.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")
+    print(f"wrote {GOLDEN}", file=sys.stderr)
