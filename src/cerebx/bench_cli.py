@@ -34,34 +34,10 @@ def _one_network(name: str, seconds: float, warmup: float, parallel: bool) -> di
     return out
 
 
-def _tight_pd(seconds: float) -> dict[str, Any]:
-    """Plant + PD with nothing else: sensors -> PD -> apply -> physics (the floor the loop adds to)."""
-    import numpy as np
-
-    from cerebx.build import build_components
-    from cerebx.config import load
-    from cerebx.controllers.base import ControlInput, SensorMsg
-
-    exp, _ = load(["+task=circle", "controller=pd"])
-    ctx = build_components(exp)
-    plant, pd, ref = ctx.plant, ctx.extras["controller"], ctx.task.trial(0, np.random.default_rng(0))
-    plant.reset(ref.q[0], np.random.default_rng(0))
-    steps = int(seconds / 0.002)
-    t0 = time.perf_counter()
-    for k in range(steps):
-        i = k % ref.steps
-        q, qd = plant.sensors()
-        cmd = pd.step(ControlInput(k, k * 0.002, ref.q[i], ref.qd[i], SensorMsg(k * 0.002, q, qd)))
-        plant.apply(cmd.tau)
-        plant.step()
-    wall = time.perf_counter() - t0
-    return {"rt_factor": round(seconds / wall, 2), "us_per_step": round(wall / steps * 1e6, 1)}
-
-
 def _plant_pd(seconds: float) -> dict[str, Any]:
     from cerebx.loop.timing import closed_loop_rt
 
-    rows = {"baxter_pd_tight_loop": _tight_pd(seconds)}
+    rows = {}
     for label, extra in (("baxter_pd", []), ("baxter_pd_physics_1ms", ["plant.physics_dt_ms=1.0"]),
                          ("baxter_sea_pd", ["plant=baxter_sea"])):
         r = closed_loop_rt(["+task=circle", "controller=pd", *extra], seconds=seconds, warmup_s=1.0)

@@ -22,11 +22,11 @@ class TrialMetrics:
 class TrialAccumulator:
     """Collects one trial's rows (preallocated) and reduces them once at the end of the trial."""
 
-    def __init__(self, n_joints: int, steps: int, step_ms: float = 2.0):
+    def __init__(self, n_joints: int, steps: int, step_ms: float = 2.0, n_command: int | None = None):
         self.n, self.step_ms = n_joints, step_ms
         self.pos_err = np.zeros((steps, n_joints))
         self.vel_err = np.zeros((steps, n_joints))
-        self.tau = np.zeros((steps, n_joints))
+        self.tau = np.zeros((steps, n_joints if n_command is None else n_command))  # the applied command
         self.ee_err = np.full(steps, np.nan)
         self.i = 0
 

@@ -1,8 +1,15 @@
 """Named registries that map a config ``kind`` to its schema and builder.
 
-Built-in variants register here in code; third-party packages register through the
-``cerebx.plugins`` entry-point group (each entry point is a callable taking no arguments that
-registers its variants). Configuration only ever names a ``kind``: it cannot import anything.
+Groups: ``task``, ``plant``, ``controller`` (brain-side parts), ``stage`` (brain- or robot-side
+stages: torque filters, the supervisor, muscles, ...), ``delay`` (link delay models), ``event``
+(plant events) and ``encoder`` (cerebellar input codes). Built-in variants register in
+``schema/builtin.py``; third-party packages register through the ``cerebx.plugins`` entry-point
+group (each entry point is a callable taking no arguments that registers its variants).
+Configuration only ever names a ``kind``: it cannot import anything.
+
+A config field that holds "any registered kind of group G" is typed ``Plugin("G")``: the kind is
+looked up when the config is validated, so a plugin's kinds are accepted everywhere the built-in
+ones are.
 """
 
 from __future__ import annotations
@@ -11,9 +18,9 @@ import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
 from importlib.metadata import entry_points
-from typing import Any
+from typing import Annotated, Any
 
-from pydantic import BaseModel
+from pydantic import BaseModel, WrapValidator
 
 
 @dataclass(frozen=True)
@@ -65,11 +72,37 @@ class Registry:
     def build(self, cfg: BaseModel, *args: Any, **kwargs: Any) -> Any:
         return self[cfg.kind].resolve()(cfg, *args, **kwargs)  # type: ignore[attr-defined]
 
+    def parse(self, value: Any) -> BaseModel:
+        """Validate a mapping ``{kind: ..., ...}`` with the schema its ``kind`` names."""
+        if isinstance(value, BaseModel):
+            value = value.model_dump()
+        if not isinstance(value, dict):
+            raise ValueError(f"expected a mapping with a 'kind' ({self.group} kinds: {', '.join(self.kinds())})")
+        kind = value.get("kind")
+        if kind not in self._entries:
+            raise ValueError(f"unknown {self.group} kind {kind!r}; known: {', '.join(self.kinds())}")
+        return self._entries[kind].schema.model_validate(value)
+
 
 tasks = Registry("task")
 plants = Registry("plant")
 controllers = Registry("controller")
+stages = Registry("stage")
 delays = Registry("delay")
+events = Registry("event")
+encoders = Registry("encoder")
+
+GROUPS = {r.group: r for r in (tasks, plants, controllers, stages, delays, events, encoders)}
+
+
+def Plugin(group: str) -> Any:  # noqa: N802 - reads as a type in schemas
+    """The type of a config field holding any registered kind of ``group`` (looked up at validation)."""
+
+    def pick(value: Any, handler: Any) -> BaseModel:
+        load_plugins()
+        return GROUPS[group].parse(value)
+
+    return Annotated[Any, WrapValidator(pick)]
 
 _plugins_loaded = False
 

@@ -7,13 +7,15 @@ raised until a small step no longer dies out: the oscillation envelope (peak |er
 cycle) stops shrinking. K_u is the smallest such gain (found by bisection), T_u the oscillation
 period there, and the classic ZN PD rule gives kp = 0.8 K_u, kd = kp T_u / 8.
 
-The loop is the closed loop's own order (sensors -> R2C channel -> controller -> C2R channel ->
-plant), with the configured delay model, so a tuning with ``delay=...`` sees the same latency as a run.
+Each test steps the closed loop itself (``loop/loop.py``) with the test's torque law as the
+controller and the configured delay model on the link, so a tuning with ``delay=...`` sees the same
+latency as a run.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import datetime
 import math
 from dataclasses import dataclass
@@ -24,8 +26,12 @@ import numpy as np
 
 from cerebx.build import BuildContext, build_components
 from cerebx.config import load
-from cerebx.errors import CerebxError
-from cerebx.loop.delays import DelayChannel
+from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
+from cerebx.errors import CerebxError, Diverged
+from cerebx.loop.link import Link
+from cerebx.loop.loop import ClosedLoop
+from cerebx.stages.controllers import TorqueControllerStage
+from cerebx.stages.receivers import Hold
 
 STEP_S = 0.002
 DEFAULT_OUT = Path(__file__).resolve().parents[2] / "conf" / "controller" / "pd_zn.yaml"
@@ -77,14 +83,30 @@ def envelope(x: np.ndarray, dt_s: float = STEP_S, floor: float = 1e-5) -> Oscill
     return Oscillation(peaks[keep], np.diff(cross)[keep] * dt_s)
 
 
+class _Law(Controller):
+    """tau = tau_ff + kp (target - q) - kd qd from the newest delayed measurement (tau_ff before it)."""
+
+    def __init__(self, target: np.ndarray, tau_ff: np.ndarray, kp: np.ndarray, kd: np.ndarray):
+        self.target, self.tau_ff, self.kp, self.kd = target, tau_ff, kp, kd
+        self.n_joints = len(kp)
+
+    def reset(self, rng: np.random.Generator) -> None:
+        pass
+
+    def step(self, inp: ControlInput) -> TorqueMsg:
+        s = inp.sensor
+        if s is None:
+            return TorqueMsg(inp.t_s, self.tau_ff)
+        return TorqueMsg(inp.t_s, self.tau_ff + self.kp * (self.target - s.q) - self.kd * s.qd)
+
+
 class _Rig:
-    """The plant and delay channels of one config, stepped with a custom per-joint torque law."""
+    """The plant and link of one config, stepped by the closed loop with a custom per-joint torque law."""
 
     def __init__(self, ctx: BuildContext, hold_kp: np.ndarray, hold_kd: np.ndarray):
         self.ctx, self.plant = ctx, ctx.plant
         self.n = self.plant.n_joints
         self.hold_kp, self.hold_kd = hold_kp, hold_kd
-        self._delay = ctx.extras["delay"]
 
     def simulate(
         self,
@@ -99,24 +121,19 @@ class _Rig:
 
         Returns the true joint positions (steps, n) and the last applied torque.
         """
-        plant = self.plant
-        plant.reset(q0, self.ctx.rng("tuning.plant"))
-        r2c, c2r = DelayChannel(self._delay.r2c), DelayChannel(self._delay.c2r)
-        sensor = None
-        tau = np.zeros(self.n)
-        qs = np.empty((steps, self.n))
+        ctx, plant = self.ctx, self.plant
+        law = TorqueControllerStage(_Law(target, tau_ff, kp, kd), "tuning", self.n)
+        link = Link(ctx.link.r2c.sampler, ctx.link.c2r.sampler)  # fresh queues, the run's delay model
+        loop = ClosedLoop(dataclasses.replace(ctx, brain=[law], link=link, receiver=Hold(ctx.sent), robot=[]), None)
+        plant.reset(q0, ctx.rng("tuning.plant"))
+        zeros = np.zeros(self.n)
+        applied = np.zeros(self.n)
+        qs = np.full((steps, self.n), np.nan)
         for tick in range(steps):
-            r2c.send(plant.sensors(), tick)
-            got = r2c.receive(tick)
-            if got:
-                sensor = got[-1]
-            cmd = tau_ff + kp * (target - sensor[0]) - kd * sensor[1] if sensor is not None else tau_ff
-            c2r.send(cmd, tick)
-            got = c2r.receive(tick)
-            if got:
-                tau = got[-1]
-            applied = plant.apply(tau)
-            plant.step()
+            try:
+                applied = loop.step(target, zeros)
+            except Diverged:
+                break
             qs[tick] = plant.true_state()[0]
             if not np.all(np.isfinite(qs[tick])):
                 qs[tick:] = np.nan
@@ -242,6 +259,7 @@ def write_preset(
 ) -> None:
     """Write a ``controller`` preset whose header records K_u and T_u per joint and the date."""
     lines = [
+        "# @package _global_",
         "# PD gains from Ziegler-Nichols tuning on the simulated plant (cerebx.tuning.tune_pd,",
         f"# {datetime.date.today().isoformat()}). Overrides: {' '.join(overrides) or '(none)'}.",
         f"# Settled posture under the hold PD (rad): [{', '.join(f'{v:.3f}' for v in posture)}].",
@@ -251,12 +269,13 @@ def write_preset(
     lines += [f"# {r.joint:<7} {r.k_u:12.2f} {r.t_u:9.4f} {r.kp:9.2f} {r.kd:9.4f}" for r in results]
     fmt = lambda xs: "[" + ", ".join(str(float(x)) for x in xs) + "]"  # noqa: E731
     lines += [
-        "kind: pd",
-        f"kp: {fmt(pd.kp)}",
-        f"kd: {fmt(pd.kd)}",
-        f"tau_max_Nm: {fmt(pd.tau_max_Nm)}",
-        "output_filter: {kind: none}",
-        "supervisor: null",
+        "controller:",
+        "  kind: pd",
+        f"  kp: {fmt(pd.kp)}",
+        f"  kd: {fmt(pd.kd)}",
+        f"  tau_max_Nm: {fmt(pd.tau_max_Nm)}",
+        "robot:",
+        "  - {kind: hold}",
     ]
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(lines) + "\n")

@@ -1,4 +1,9 @@
-"""The controller contract and the small per-step records that flow through the loop."""
+"""The joint-torque controller contract and its small per-step records.
+
+A :class:`Controller` maps the desired joint state and the newest delayed joint measurement to a
+joint torque stamped with its application time. The loop runs it as a brain-side stage
+(``stages/controllers.py``); controllers with other inputs or outputs are stages themselves.
+"""
 
 from __future__ import annotations
 
@@ -35,9 +40,9 @@ class ControlInput:
     """What a controller sees at one control step.
 
     ``t_s`` is the controller's current time; ``q_des``/``qd_des`` the desired state at ``t_s``;
-    ``sensor`` the newest sensor message that has arrived through the R2C channel (None before
-    the first one arrives); ``ref_at`` gives the desired state at any earlier tick so a controller
-    can pair a delayed measurement with the desired sample of its own time stamp.
+    ``sensor`` the newest sensor message that has arrived through the R2C link (None before
+    the first one arrives). A controller that pairs a delayed measurement with the desired sample
+    of the measurement's own stamp keeps the recent desired samples itself (as the SNN and ANN do).
     """
 
     tick: int

@@ -27,11 +27,11 @@ import numpy as np
 
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
+from cerebx import registry
 from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
 from cerebx.schema.controller import SNNController
 from cerebx.snn.decoder import DCNDecoder
-from cerebx.snn.encoders import ClimbingEncoder, MossyEncoder
 from cerebx.snn.network import Network
 
 STEP_S = 0.002
@@ -71,13 +71,13 @@ class SNNControllerImpl(Controller):
             raise ValueError(f"network: {io.output} ({n_dcn}) and {io.climbing} ({n_cf}) must split "
                              f"evenly into {nj} joints")
         lo, hi = encoder_ranges(cfg, nj, getattr(ctx, "task", None))
-        self.mf = MossyEncoder(cfg.mf, lo, hi)
+        self.mf = registry.encoders.build(cfg.mf, lo, hi)
         if self.mf.n_fibers != self.sl_mf.stop - self.sl_mf.start:
             raise ValueError(f"network: {io.mossy} has {self.sl_mf.stop - self.sl_mf.start} fibres, the "
                              f"encoder needs {self.mf.n_fibers} ({nj} joints x 4 signals x "
                              f"{cfg.mf.fibers_per_signal})")
         self._rng_seed = ctx.rng("controller.snn.cf")
-        self.cf = ClimbingEncoder(cfg.cf, nj, n_cf // nj, cfg.error.kpos, cfg.error.kvel, self._rng_seed)
+        self.cf = registry.encoders.build(cfg.cf, nj, n_cf // nj, cfg.error.kpos, cfg.error.kvel, self._rng_seed)
         self.decoder = DCNDecoder(cfg.decoder.alpha_Nm_per_spike, nj, n_dcn // nj)
         self.recorder = None
         self.record = {name: self.net.index(name) for name in cfg.record_spikes}

@@ -1,16 +1,14 @@
-"""Delay models and the timestamped channels that carry messages between robot and controller.
+"""Delay models: per-message delay samplers for the two directions of the link (``loop/link.py``).
 
-A message sent at tick k with sampled delay d is released at the first tick whose time is at
-least stamp + d; a later message is never released before an earlier one (facts §7).
+Each delay kind has its own builder, registered with its schema in ``schema/builtin.py``; a plugin
+adds a kind the same way.
 """
 
 from __future__ import annotations
 
-import math
-from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
@@ -18,11 +16,6 @@ from cerebx.errors import CerebxError
 from cerebx.schema import delay as schema
 
 STEP_MS = 2.0
-
-
-class DelaySampler(Protocol):
-    def next_ms(self) -> float:
-        """The delay (ms) for the next message on this path."""
 
 
 @dataclass
@@ -119,49 +112,30 @@ def load_trace(path: str) -> np.ndarray:
     return data
 
 
-def build_delay(cfg: Any, ctx: Any) -> DelayModel:
+def no_delay(cfg: schema.NoDelay, ctx: Any) -> DelayModel:
+    return DelayModel(Constant(0.0), Constant(0.0))
+
+
+def constant_delay(cfg: schema.ConstantDelay, ctx: Any) -> DelayModel:
+    r2c, c2r = cfg.per_direction()
+    return DelayModel(Constant(r2c), Constant(c2r))
+
+
+def gamma_delay(cfg: schema.GammaDelay, ctx: Any) -> DelayModel:
     rng_r2c, rng_c2r = ctx.rng("delay.r2c"), ctx.rng("delay.c2r")
-    if isinstance(cfg, schema.NoDelay):
-        return DelayModel(Constant(0.0), Constant(0.0))
-    if isinstance(cfg, schema.ConstantDelay):
-        r2c, c2r = cfg.per_direction()
-        return DelayModel(Constant(r2c), Constant(c2r))
-    if isinstance(cfg, schema.GammaDelay):
-        if cfg.symmetric:
-            shared = HalfRoundTrip(Gamma(cfg.r2c, cfg.monotonic, rng_r2c))
-            return DelayModel(_View(shared, draws=True), _View(shared, draws=False))
-        return DelayModel(Gamma(cfg.r2c, cfg.monotonic, rng_r2c), Gamma(cfg.c2r, cfg.monotonic, rng_c2r))
-    if isinstance(cfg, schema.TraceDelay):
-        data = load_trace(cfg.path)
-        r2c = data[:, 0]
-        c2r = data[:, 1] if data.shape[1] > 1 else data[:, 0]
-        return DelayModel(Trace(r2c, cfg.loop), Trace(c2r, cfg.loop))
-    if isinstance(cfg, schema.PercentileDelay):
-        return DelayModel(Percentiles(cfg.r2c_percentiles, rng_r2c), Percentiles(cfg.c2r_percentiles, rng_c2r))
-    raise TypeError(f"no delay builder for {type(cfg).__name__}")
+    if cfg.symmetric:
+        shared = HalfRoundTrip(Gamma(cfg.r2c, cfg.monotonic, rng_r2c))
+        return DelayModel(_View(shared, draws=True), _View(shared, draws=False))
+    return DelayModel(Gamma(cfg.r2c, cfg.monotonic, rng_r2c), Gamma(cfg.c2r, cfg.monotonic, rng_c2r))
 
 
-class DelayChannel:
-    """FIFO of in-flight messages on the tick grid; releases in order, never overtaking."""
+def trace_delay(cfg: schema.TraceDelay, ctx: Any) -> DelayModel:
+    data = load_trace(cfg.path)
+    r2c = data[:, 0]
+    c2r = data[:, 1] if data.shape[1] > 1 else data[:, 0]
+    return DelayModel(Trace(r2c, cfg.loop), Trace(c2r, cfg.loop))
 
-    def __init__(self, sampler: DelaySampler, step_ms: float = STEP_MS):
-        self.sampler = sampler
-        self.step_ms = step_ms
-        self._queue: deque[tuple[int, Any]] = deque()
-        self._last_release = -1
-        self.last_delay_ms = 0.0
 
-    def send(self, msg: Any, tick: int) -> None:
-        d = self.sampler.next_ms()
-        self.last_delay_ms = d
-        release = tick + math.ceil(d / self.step_ms - 1e-9)
-        release = max(release, self._last_release)
-        self._last_release = release
-        self._queue.append((release, msg))
-
-    def receive(self, tick: int) -> list[Any]:
-        out = []
-        q = self._queue
-        while q and q[0][0] <= tick:
-            out.append(q.popleft()[1])
-        return out
+def percentile_delay(cfg: schema.PercentileDelay, ctx: Any) -> DelayModel:
+    return DelayModel(Percentiles(cfg.r2c_percentiles, ctx.rng("delay.r2c")),
+                      Percentiles(cfg.c2r_percentiles, ctx.rng("delay.c2r")))

@@ -8,7 +8,7 @@ from typing import Any
 
 from cerebx.build import build_components
 from cerebx.config import load
-from cerebx.loop.runner import ClosedLoop
+from cerebx.loop.loop import ClosedLoop
 from cerebx.recording.recorder import Recorder
 
 

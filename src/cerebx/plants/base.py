@@ -1,9 +1,13 @@
 """The plant contract every registered plant satisfies (checked by :func:`check_plant`).
 
-A plant owns a MuJoCo model. The loop calls, once per 2 ms control step and in this order:
-``sensors()`` -> (controller work) -> ``apply(tau)`` -> ``step()``. ``step`` advances
-``control_dt_s`` in ``substeps`` physics steps with the torque held constant (zero-order hold).
-Units are SI: rad, rad/s, N·m, m, s.
+A plant owns a MuJoCo model and declares its signals: what it senses (``sensor_signals``, by
+default ``joint.q`` and ``joint.qd``) and what it is commanded with (``command_signals``, by
+default ``joint.torque``). The loop calls, once per 2 ms control step and in this order:
+``sense()`` -> (brain side, link, robot-side stages) -> ``actuate(command)`` -> ``step()``.
+``step`` advances ``control_dt_s`` in ``substeps`` physics steps with the command held constant
+(zero-order hold). A joint-torque plant only implements ``sensors()`` and ``apply(tau)``; a plant
+with other signals (muscle activations, muscle lengths) overrides the four signal methods.
+Units are SI unless a signal declares otherwise: rad, rad/s, N·m, m, s.
 """
 
 from __future__ import annotations
@@ -12,6 +16,8 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from cerebx.loop.signals import Signal, joint_signals
 
 
 @dataclass(frozen=True)
@@ -71,9 +77,42 @@ class Plant(ABC):
         """Cartesian end-effector position (m) in the world frame, if the plant has one."""
         return None
 
+    # ---- signals --------------------------------------------------------------------------
+    def torque_limits(self) -> np.ndarray | None:
+        """Per-joint torque saturation (N·m), if the plant has one."""
+        return None
+
+    def sensor_signals(self) -> dict[str, Signal]:
+        """What :meth:`sense` returns, by name."""
+        s = joint_signals(self.n_joints)
+        return {"joint.q": s["joint.q"], "joint.qd": s["joint.qd"]}
+
+    def command_signals(self) -> dict[str, Signal]:
+        """What :meth:`actuate` needs, by name."""
+        return {"joint.torque": joint_signals(self.n_joints, self.torque_limits())["joint.torque"]}
+
+    def sense(self) -> dict[str, np.ndarray]:
+        """This step's sensor readings (measured: possibly noisy)."""
+        q, qd = self.sensors()
+        return {"joint.q": q, "joint.qd": qd}
+
+    def actuate(self, command: dict[str, np.ndarray]) -> np.ndarray:
+        """Set the command for the next step; returns what is actually applied (saturated)."""
+        return self.apply(command["joint.torque"])
+
     def handle_event(self, event: PlantEvent) -> None:
-        """Apply a scheduled plant event; plants without events refuse them."""
-        raise ValueError(f"{type(self).__name__} does not support event {event.kind!r}")
+        """Apply a plant event through the event registry; an unknown or unsupported kind raises ValueError."""
+        from pydantic import ValidationError
+
+        from cerebx import registry
+        from cerebx.errors import CerebxError
+
+        registry.load_plugins()
+        try:
+            fire = registry.events.build(registry.events.parse({"kind": event.kind, **event.params}), self)
+        except (ValidationError, CerebxError) as err:
+            raise ValueError(f"{type(self).__name__}: event {event.kind!r}: {str(err).splitlines()[0]}") from None
+        fire()
 
     def is_diverged(self) -> str | None:
         """A reason string when the state is non-finite or far outside the joint limits."""

@@ -26,7 +26,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from cerebx.plants.base import Plant, PlantEvent
+from cerebx.plants.base import Plant
 from cerebx.schema.plant import BaxterConfig
 
 JOINTS = ("s0", "s1", "e0", "e1", "w0", "w1")
@@ -235,7 +235,6 @@ class BaxterArm(Plant):
 
     joint_names = JOINTS
     control_dt_s = CONTROL_DT_S
-    supported_events = ("attach_payload", "detach_payload", "elastic_band", "remove_band", "force_pulse")
 
     def __init__(self, cfg: BaxterConfig | None = None, ctx: Any = None):
         self.cfg = cfg if cfg is not None else BaxterConfig()
@@ -344,30 +343,11 @@ class BaxterArm(Plant):
     def joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
         return self._lo.copy(), self._hi.copy()
 
+    def torque_limits(self) -> np.ndarray:
+        return self._tau_max.copy()
+
     def end_effector(self) -> np.ndarray:
         return self.data.site_xpos[self._ee_site].copy()
-
-    def handle_event(self, event: PlantEvent) -> None:
-        p = event.params
-        if event.kind == "attach_payload":
-            self._attach_payload(float(p["mass_kg"]), float(p.get("rod_length_m", 0.0)))
-        elif event.kind == "detach_payload":
-            self._restore_payload()
-        elif event.kind == "elastic_band":
-            anchor = self._ee_start + np.asarray(p.get("anchor_offset_m", (0.0, 0.0, -0.3)), dtype=float)
-            self.model.site_pos[self._band_anchor] = anchor
-            self.model.tendon_stiffness[self._band] = float(p["stiffness_N_per_m"])
-            self.model.tendon_lengthspring[self._band] = (0.0, float(p.get("rest_length_m", 0.0)))
-        elif event.kind == "remove_band":
-            self.model.tendon_stiffness[self._band] = 0.0
-        elif event.kind == "force_pulse":
-            self._start_pulse(
-                np.asarray(p["force_N"], dtype=float),
-                float(p.get("duration_ms", 50.0)),
-                str(p.get("body", "end_effector")),
-            )
-        else:
-            raise ValueError(f"BaxterArm does not support event {event.kind!r}")
 
     # ---- model queries --------------------------------------------------------------------
     def gravity_torque(self, q: np.ndarray) -> np.ndarray:
@@ -408,7 +388,24 @@ class BaxterArm(Plant):
         pend = self.model.body_mass[self._pend] if self.has_pendulum else 0.0
         return float(self.model.body_mass[self._point] + pend)
 
-    # ---- events ---------------------------------------------------------------------------
+    # ---- events (bound to event kinds in plants/events.py) --------------------------------
+    def detach_payload(self) -> None:
+        """Back to the arm's own masses."""
+        self._restore_payload()
+
+    def elastic_band(self, stiffness_N_per_m: float, anchor_offset_m: np.ndarray, rest_length_m: float) -> None:
+        """A spring from the end-effector to an anchor offset from the run's start position."""
+        self.model.site_pos[self._band_anchor] = self._ee_start + anchor_offset_m
+        self.model.tendon_stiffness[self._band] = float(stiffness_N_per_m)
+        self.model.tendon_lengthspring[self._band] = (0.0, float(rest_length_m))
+
+    def remove_band(self) -> None:
+        self.model.tendon_stiffness[self._band] = 0.0
+
+    def force_pulse(self, force_N: np.ndarray, duration_ms: float, body: str = "end_effector") -> None:
+        """A force on a body (at the end-effector point by default) for ``duration_ms``."""
+        self._start_pulse(np.asarray(force_N, dtype=float), float(duration_ms), str(body))
+
     def _restore_payload(self) -> None:
         m = self.model
         for b in (self._point, self._pend) if self.has_pendulum else (self._point,):
@@ -417,7 +414,8 @@ class BaxterArm(Plant):
             m.body_inertia[b] = self._inertia0[b]
         self._set_const()
 
-    def _attach_payload(self, mass: float, rod: float) -> None:
+    def attach_payload(self, mass: float, rod: float = 0.0) -> None:
+        """A point mass at the end-effector, or hanging from a rod of ``rod`` m (conical pendulum)."""
         if mass <= 0 or rod < 0:
             raise ValueError("attach_payload needs mass_kg > 0 and rod_length_m >= 0")
         m, d = self.model, self.data

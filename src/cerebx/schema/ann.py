@@ -7,14 +7,14 @@ from typing import Annotated, Literal
 from pydantic import Field, model_validator
 
 from cerebx.schema.base import NonNegFloat, PositiveFloat
-from cerebx.schema.controller import GivenRanges, TaskRanges, _ControllerCommon
+from cerebx.schema.controller import GivenRanges, TaskRanges, ControllerConfig
 
 CIRCLE_K_POS = (2.0, 6.0, 6.66, 8.0, 8.0, 6.0)
 CIRCLE_K_VEL = (2.0, 1.66, 0.66, 0.66, 1.33, 0.66)
 CIRCLE_GAIN_NM = (10.0, 22.0, 3.0, 15.0, 2.0, 3.5)
 
 
-class ANNController(_ControllerCommon):
+class ANNController(ControllerConfig):
     """Analog cerebellum (facts §6): a state-table granular layer, PC/IO/DCN agonist-antagonist pairs
     per joint and PF-PC plasticity dw = (LTP (1 - IO) - LTD IO) |e|.
 

@@ -4,7 +4,9 @@ code (never in configuration) so heavy modules (MuJoCo, numba kernels) load only
 from cerebx import registry
 from cerebx.schema import controller as c
 from cerebx.schema import delay as d
+from cerebx.schema import events as e
 from cerebx.schema import plant as p
+from cerebx.schema import stages as s
 from cerebx.schema import task as t
 from cerebx.schema.ann import ANNController
 
@@ -22,9 +24,27 @@ registry.controllers.register(c.PDController, "cerebx.controllers.pd:PD")
 registry.controllers.register(c.PositionController, "cerebx.controllers.position:PositionServo")
 registry.controllers.register(c.SNNController, "cerebx.controllers.snn:SNNControllerImpl")
 registry.controllers.register(ANNController, "cerebx.controllers.ann:ANN")
+registry.controllers.register(c.CompositeController, "cerebx.build:build_composite")
 
-registry.delays.register(d.NoDelay, "cerebx.loop.delays:build_delay")
-registry.delays.register(d.ConstantDelay, "cerebx.loop.delays:build_delay")
-registry.delays.register(d.GammaDelay, "cerebx.loop.delays:build_delay")
-registry.delays.register(d.TraceDelay, "cerebx.loop.delays:build_delay")
-registry.delays.register(d.PercentileDelay, "cerebx.loop.delays:build_delay")
+# receivers take (cfg, ctx, signals the link delivers); other stages (cfg, ctx)
+registry.stages.register(s.HoldConfig, "cerebx.stages.receivers:build_hold")
+registry.stages.register(s.MeanFilterConfig, "cerebx.stages.receivers:build_mean")
+registry.stages.register(s.FuturePastFilterConfig, "cerebx.stages.receivers:build_future_past")
+registry.stages.register(s.SupervisorConfig, "cerebx.stages.supervisor:build_supervisor")
+
+registry.delays.register(d.NoDelay, "cerebx.loop.delays:no_delay")
+registry.delays.register(d.ConstantDelay, "cerebx.loop.delays:constant_delay")
+registry.delays.register(d.GammaDelay, "cerebx.loop.delays:gamma_delay")
+registry.delays.register(d.TraceDelay, "cerebx.loop.delays:trace_delay")
+registry.delays.register(d.PercentileDelay, "cerebx.loop.delays:percentile_delay")
+
+# event builders take (cfg, plant) and return the function that fires the event
+registry.events.register(e.AttachPayload, "cerebx.plants.events:attach_payload")
+registry.events.register(e.DetachPayload, "cerebx.plants.events:detach_payload")
+registry.events.register(e.ElasticBand, "cerebx.plants.events:elastic_band")
+registry.events.register(e.RemoveBand, "cerebx.plants.events:remove_band")
+registry.events.register(e.ForcePulse, "cerebx.plants.events:force_pulse")
+
+# mossy encoders take (cfg, lo, hi); climbing encoders (cfg, n_joints, fibres_per_joint, kpos, kvel, rng)
+registry.encoders.register(c.BoxEncoder, "cerebx.snn.encoders:MossyEncoder")
+registry.encoders.register(c.CFEncoder, "cerebx.snn.encoders:ClimbingEncoder")

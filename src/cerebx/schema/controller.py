@@ -1,60 +1,26 @@
 """Controller schemas: baselines, the spiking cerebellum and its encoders/decoders, and the
-plant-side torque filter and watchdog supervisor that every controller may use."""
+composite controller whose parts' outputs add up. The robot-side torque filters and the supervisor
+are stages (``schema/stages.py``)."""
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import Field, model_validator
 
+from cerebx.registry import Plugin
 from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
 
 
-class NoFilter(Strict):
-    """Apply the newest torque sample as it is."""
+class ControllerConfig(Strict):
+    """Base of every controller schema (a brain-side part of the loop)."""
 
-    kind: Literal["none"] = "none"
-
-
-class MeanFilter(Strict):
-    """Mean of the last ``taps`` torque samples (thesis Eq. 2.18: 15 taps = 30 ms)."""
-
-    kind: Literal["mean"] = "mean"
-    taps: int = Field(15, gt=0)
+    def cross_check(self, exp: Any) -> list[str]:
+        """Problems that involve other parts of the experiment (one ``path: message`` line each)."""
+        return []
 
 
-class FuturePastFilter(Strict):
-    """Mean over future and past stamped samples with a decaying safe stop (Eq. 3.6, facts §7)."""
-
-    kind: Literal["future_past"] = "future_past"
-    past_samples: int = Field(10, gt=0)
-    min_future_samples: int = Field(2, ge=0)
-    decay_per_step: float = Field(0.998, gt=0, le=1)
-
-
-TorqueFilter = Annotated[NoFilter | MeanFilter | FuturePastFilter, Field(discriminator="kind")]
-
-
-class Supervisor(Strict):
-    """Watchdog PD acting only outside the joint bounds (thesis §2.2.8, facts §4):
-    tau = kp (bound - q) - s kd qd, s ramping by ``ramp_per_step`` to 1 while outside."""
-
-    enabled: bool = True
-    kp: tuple[float, ...] = (20.0, 20.0, 20.0, 20.0, 3.0, 3.0)
-    kd: tuple[float, ...] = (5.0, 5.0, 5.0, 5.0, 1.0, 1.0)
-    ramp_per_step: float = Field(0.02, gt=0, le=1)
-    bounds: Literal["encoder", "plant"] = Field(
-        "encoder", description="'encoder': the MF position ranges (as the original); 'plant': joint limits"
-    )
-    margin_rad: NonNegFloat = 0.0
-
-
-class _ControllerCommon(Strict):
-    output_filter: TorqueFilter = NoFilter()
-    supervisor: Supervisor | None = None
-
-
-class PDController(_ControllerCommon):
+class PDController(ControllerConfig):
     """tau = kp (q_d - q) + kd (qd_d - qd), saturated at +-tau_max (facts §6)."""
 
     kind: Literal["pd"] = "pd"
@@ -73,7 +39,7 @@ class PDController(_ControllerCommon):
         return len(self.kp)
 
 
-class PositionController(_ControllerCommon):
+class PositionController(ControllerConfig):
     """Stiff position servo with gravity compensation (stands in for Baxter's factory controller)."""
 
     kind: Literal["position"] = "position"
@@ -125,6 +91,8 @@ class BoxEncoder(Strict):
     """MF interval coding (Eq. 2.12-2.15): per signal, 10 fibres with box receptive fields;
     the active fibre fires once per 2 ms step."""
 
+    role: ClassVar[str] = "mossy"
+
     kind: Literal["box"] = "box"
     fibers_per_signal: int = Field(10, gt=1)
     width_factor: PositiveFloat = Field(0.500000000001, description="half-width in units of the centre step")
@@ -134,6 +102,8 @@ class BoxEncoder(Strict):
 class CFEncoder(Strict):
     """CF stochastic error coding (facts §3): agonist/antagonist split by error sign;
     rate = r_min + (r_max - r_min)(tanh((|e| - c_k)/w) + 1)/2, Bernoulli per 2 ms, bursts."""
+
+    role: ClassVar[str] = "climbing"
 
     kind: Literal["tanh_bernoulli"] = "tanh_bernoulli"
     rate_min_hz: NonNegFloat = 1.0
@@ -158,21 +128,21 @@ class ErrorGains(Strict):
     kvel: tuple[float, ...] = (1.5, 1.0, 3.0, 1.0, 2.0, 1.5)
 
 
-class DCNDecoder(Strict):
+class DCNDecoderConfig(Strict):
     """Torque = alpha_j (agonist - antagonist DCN spikes per 2 ms) (Eq. 2.16-2.17, 3.5)."""
 
     alpha_Nm_per_spike: tuple[PositiveFloat, ...] = (0.75, 1.1, 0.375, 0.63, 0.078, 0.078)
 
 
-class SNNController(_ControllerCommon):
+class SNNController(ControllerConfig):
     """The cerebellar spiking network (thesis §2.2.3-2.2.7, §3.2.2-3.2.4). The topology comes
     from the top-level ``network`` group."""
 
     kind: Literal["snn"] = "snn"
-    mf: BoxEncoder = BoxEncoder()
-    cf: CFEncoder = CFEncoder()
+    mf: Plugin("encoder") = Field(BoxEncoder(), description="mossy-fibre encoder (registered kind, role mossy)")
+    cf: Plugin("encoder") = Field(CFEncoder(), description="climbing-fibre encoder (registered kind, role climbing)")
     error: ErrorGains = ErrorGains()
-    decoder: DCNDecoder = DCNDecoder()
+    decoder: DCNDecoderConfig = DCNDecoderConfig()
     pathway_delay_ms: NonNegFloat = Field(50.0, description="afferent = efferent sensorimotor delay D")
     efferent: Literal["hold", "stamp"] = Field(
         "hold",
@@ -187,13 +157,48 @@ class SNNController(_ControllerCommon):
         description="simulate the network one pathway-delay chunk ahead on a second thread "
         "(identical results; needs pathway_delay_ms > 0)",
     )
-    output_filter: TorqueFilter = MeanFilter()
-    supervisor: Supervisor | None = Supervisor()
     record_spikes: list[str] = Field(default_factory=lambda: ["dcn"])
     weight_summary_every_trials: int = Field(
         10, ge=0, description="plastic-weight statistics every n trials (a pass over all weights); 0 = never"
     )
 
+    @model_validator(mode="after")
+    def _encoder_roles(self) -> SNNController:
+        for field, role in (("mf", "mossy"), ("cf", "climbing")):
+            got = getattr(getattr(self, field), "role", None)
+            if got != role:
+                raise ValueError(f"{field}: kind {getattr(self, field).kind!r} is a {got} encoder, not a {role} one")
+        return self
+
     @property
     def n_joints(self) -> int:
         return len(self.decoder.alpha_Nm_per_spike)
+
+    def cross_check(self, exp: Any) -> list[str]:
+        """The encoders and decoder must match the population sizes they drive and read."""
+        out = []
+        n_joints = exp.plant.n_joints
+        pops, io = exp.network.populations, exp.network.io
+        mf = pops.get(io.mossy)
+        fibres = getattr(self.mf, "fibers_per_signal", None)
+        need = n_joints * 4 * fibres if fibres else None
+        if mf is not None and need is not None and mf.size != need:
+            out.append(f"controller.mf.fibers_per_signal: {fibres} fibres x 4 signals x {n_joints} joints = {need}, "
+                       f"but network population {io.mossy!r} has {mf.size}")
+        for name in (io.climbing, io.output):
+            p = pops.get(name)
+            if p is not None and p.size % (2 * n_joints):
+                out.append(f"network.populations.{name}.size: {p.size} is not an agonist/antagonist pair per joint "
+                           f"({n_joints} joints)")
+        return out
+
+
+class CompositeController(ControllerConfig):
+    """Several brain-side parts run in order each tick; signals written by more than one part add up
+    (e.g. a feed-forward torque plus a corrective one). Each part keeps its own learned state."""
+
+    kind: Literal["composite"] = "composite"
+    parts: list[Plugin("controller")] = Field(min_length=1, description="controller parts, in order")
+
+    def cross_check(self, exp: Any) -> list[str]:
+        return [f"controller.parts.{i}.{line}" for i, p in enumerate(self.parts) for line in p.cross_check(exp)]

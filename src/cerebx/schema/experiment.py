@@ -8,48 +8,10 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, Field, ValidationError, create_model, model_validator
 
 from cerebx import registry
+from cerebx.registry import Plugin
 from cerebx.errors import ConfigError
-from cerebx.schema.base import CONTROL_DT_MS, NonNegFloat, PositiveFloat, Strict
+from cerebx.schema.base import CONTROL_DT_MS, NonNegFloat, Strict
 from cerebx.schema.network import NetworkConfig
-
-
-class AttachPayload(Strict):
-    """Attach a mass at the end-effector; with ``rod_length_m`` it hangs from a rod (conical pendulum)."""
-
-    kind: Literal["attach_payload"] = "attach_payload"
-    mass_kg: PositiveFloat
-    rod_length_m: NonNegFloat = 0.0
-
-
-class DetachPayload(Strict):
-    kind: Literal["detach_payload"] = "detach_payload"
-
-
-class ElasticBand(Strict):
-    """A spring from the end-effector to a world anchor (offset from the start position)."""
-
-    kind: Literal["elastic_band"] = "elastic_band"
-    stiffness_N_per_m: PositiveFloat
-    anchor_offset_m: tuple[float, float, float] = (0.0, 0.0, -0.3)
-    rest_length_m: NonNegFloat = 0.0
-
-
-class RemoveBand(Strict):
-    kind: Literal["remove_band"] = "remove_band"
-
-
-class ForcePulse(Strict):
-    """A force on a body for a while (e.g. 20 N for 50 ms)."""
-
-    kind: Literal["force_pulse"] = "force_pulse"
-    force_N: tuple[float, float, float]
-    duration_ms: PositiveFloat = 50.0
-    body: str = "end_effector"
-
-
-EventAction = Annotated[
-    AttachPayload | DetachPayload | ElasticBand | RemoveBand | ForcePulse, Field(discriminator="kind")
-]
 
 
 class ScheduledEvent(Strict):
@@ -57,7 +19,7 @@ class ScheduledEvent(Strict):
 
     at_s: NonNegFloat | None = None
     at_trial: int | None = Field(None, ge=0)
-    action: EventAction
+    action: Plugin("event") = Field(description="what happens (a registered event kind)")
 
     @model_validator(mode="after")
     def _one_time(self) -> ScheduledEvent:
@@ -101,6 +63,11 @@ class _ExperimentBase(Strict):
     network: NetworkConfig
     recording: RecordingConfig = RecordingConfig()
     events: list[ScheduledEvent] = Field(default_factory=list)
+    brain: list[Plugin("stage")] = Field(
+        default_factory=list, description="brain-side stages after the controller, in order (before the link)")
+    robot: list[Plugin("stage")] = Field(
+        default_factory=list, description="robot-side stages after the link, in order; the first may be a receiver "
+        "(hold, mean, future_past: what to apply from the samples that arrived), else the newest sample is held")
     init_from: str | None = Field(None, description="run folder whose learned state starts this run")
     warmup_trials: int = Field(
         0, ge=0, description="the first trials let a learned controller settle onto the path; they are run and "
@@ -120,8 +87,14 @@ class _ExperimentBase(Strict):
         if getattr(task, "n_joints", n) != n:
             problems.append(f"task: has {task.n_joints} joints but plant {plant.kind} has {n}")
         problems += _per_joint_lengths(controller, "controller", n)
-        if controller.kind == "snn":
-            problems += _snn_fits_network(controller, self.network, n)
+        problems += controller.cross_check(self)
+        for side in ("brain", "robot"):
+            for i, st in enumerate(getattr(self, side)):
+                problems += _per_joint_lengths(st, f"{side}.{i}", n)
+                if side not in st.sides:
+                    problems.append(f"{side}.{i}: stage {st.kind!r} runs on the {' or '.join(st.sides)} side")
+                elif st.receiver and not (side == "robot" and i == 0):
+                    problems.append(f"{side}.{i}: {st.kind!r} is a receiver; it can only be the first robot stage")
         if self.warmup_trials >= self.trials:
             problems.append(f"warmup_trials: {self.warmup_trials} leaves no measured trial of {self.trials}")
         if self.init_from is not None:
@@ -133,23 +106,6 @@ class _ExperimentBase(Strict):
         if problems:
             raise ValueError("; ".join(problems))
         return self
-
-
-def _snn_fits_network(controller: Any, net: NetworkConfig, n_joints: int) -> list[str]:
-    """The encoders and decoder must match the population sizes they drive and read."""
-    out = []
-    pops, io = net.populations, net.io
-    mf = pops.get(io.mossy)
-    need = n_joints * 4 * controller.mf.fibers_per_signal
-    if mf is not None and mf.size != need:
-        out.append(f"controller.mf.fibers_per_signal: {controller.mf.fibers_per_signal} fibres x 4 signals x "
-                   f"{n_joints} joints = {need}, but network population {io.mossy!r} has {mf.size}")
-    for name in (io.climbing, io.output):
-        p = pops.get(name)
-        if p is not None and p.size % (2 * n_joints):
-            out.append(f"network.populations.{name}.size: {p.size} is not an agonist/antagonist pair per joint "
-                       f"({n_joints} joints)")
-    return out
 
 
 def _per_joint_lengths(model: BaseModel, path: str, n: int) -> list[str]:
@@ -166,7 +122,8 @@ def _per_joint_lengths(model: BaseModel, path: str, n: int) -> list[str]:
 
 @functools.cache
 def experiment_model() -> type[_ExperimentBase]:
-    """The experiment schema with every registered task/plant/controller/delay variant."""
+    """The experiment schema with every registered task/plant/controller/delay variant (stages, events
+    and encoders are looked up by kind where they are used, through ``Plugin`` fields)."""
     registry.load_plugins()
     return create_model(
         "ExperimentConfig",
@@ -201,8 +158,7 @@ def format_errors(err: ValidationError) -> list[str]:
 
 
 _INNER_TAGS = {"lif_cond", "input", "all_to_all", "one_to_one", "joint_combinations", "kernel_stdp",
-               "box", "given", "from_task", "mean", "future_past", "tanh_bernoulli", "attach_payload",
-               "detach_payload", "elastic_band", "remove_band", "force_pulse"}
+               "given", "from_task"}
 
 
 def validate(data: dict[str, Any]) -> _ExperimentBase:

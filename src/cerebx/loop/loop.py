@@ -1,0 +1,182 @@
+"""The closed loop: one tick order for every experiment (SPEC §1), stepped by ``cerebx run``,
+``cerebx tune`` and ``cerebx bench`` alike.
+
+One tick (2 ms, integer tick counter, simulated time = tick x control step):
+
+====================  ========================================================================
+phase                 what happens
+====================  ========================================================================
+events                scheduled plant events whose time has come fire
+sense                 the plant's sensor signals are read (measured, possibly noisy)
+uplink                they go into the link's robot-to-controller channel; what has arrived
+                      leaves it, the newest message is what the brain side sees
+brain                 brain stages in order (the controller's parts first) write their outputs
+downlink              the signals the robot side needs go into the controller-to-robot channel
+robot                 the receiver turns what arrived into this tick's command; robot stages in
+                      order (supervisor, muscles, ...) read it and the plant's readings
+actuate               the plant takes its command signals (saturated)
+measure               true state, end-effector and command into the trial's metrics
+record                one ``/control`` and two joint-state messages (every ``decimation`` ticks)
+physics               the plant advances one control step
+====================  ========================================================================
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from cerebx.build import BuildContext
+from cerebx.errors import Diverged
+from cerebx.loop.signals import Frame, Message
+from cerebx.metrics import TrialAccumulator, TrialMetrics
+from cerebx.plants.base import PlantEvent
+from cerebx.recording.recorder import Recorder
+
+PHASES = ("events", "sense", "uplink", "brain", "downlink", "robot", "actuate", "measure", "record", "physics")
+
+# how brain-side output signals are named in /control (kept from the first recordings)
+RECORD_AS = {"joint.torque": "tau_controller"}
+
+
+class ClosedLoop:
+    """Steps the parts of a :class:`BuildContext` in the fixed phase order."""
+
+    def __init__(self, ctx: BuildContext, recorder: Recorder | None):
+        cfg = ctx.cfg
+        self.cfg, self.ctx, self.rec = cfg, ctx, recorder
+        self.plant, self.task = ctx.plant, ctx.task
+        self.brain, self.receiver, self.robot, self.link = ctx.brain, ctx.receiver, ctx.robot, ctx.link
+        self.controller = ctx.brain[0]
+        self._sent = tuple(s.name for s in ctx.sent)
+        self._commands = tuple(ctx.plant.command_signals())
+        self._record_as = tuple((name, RECORD_AS.get(name, name)) for name in self._sent)
+        self._n_command = ctx.plant.command_signals()[self._commands[0]].size  # what actuate() returns
+        self.dt_s = cfg.control_dt_ms / 1000.0
+        self.decimation = cfg.recording.decimation
+        self.record_joints = recorder is not None and cfg.recording.joint_states
+        self.metrics: list[TrialMetrics] = []
+        self.trials_done = 0
+        self.tick = 0
+        self._sensed: Message | None = None  # newest sensor message delivered to the brain side
+        self._task_rng = ctx.rng("task")
+        self._events = sorted([(e, f) for e, f in ctx.events if e.at_s is not None], key=lambda ef: ef[0].at_s)
+        self._trial_events = [(e, f) for e, f in ctx.events if e.at_trial is not None]
+
+    def start(self) -> None:
+        q0 = self.task.first_sample() if self.cfg.start_at == "path" else self.task.start_position()
+        self.plant.reset(np.asarray(q0, float), self.ctx.rng("plant"))
+        for i, st in enumerate(self.brain):
+            st.reset(self.ctx.rng("controller" if i == 0 else f"brain.{i}"))
+        self.receiver.reset(self.ctx.rng("robot.receiver"))
+        for i, st in enumerate(self.robot):
+            st.reset(self.ctx.rng(f"robot.{i}"))
+        if self.rec is not None:
+            for st in self.brain:
+                st.attach_recorder(self.rec)
+
+    def _fire(self, event: Any, fire: Any, t_s: float) -> None:
+        action = event.action
+        fire()
+        if self.rec is not None:
+            params = action.model_dump(exclude={"kind"})
+            self.rec.write("/events", "cerebx.PlantEvent", t_s, {"t": t_s, "kind": action.kind, "params": params})
+
+    def step(self, q_des: np.ndarray, qd_des: np.ndarray, acc: TrialAccumulator | None = None, trial: int = 0,
+             ee_des: np.ndarray | None = None) -> np.ndarray:
+        """One tick, every phase in the order of :data:`PHASES`; returns the applied command."""
+        plant, link, rec = self.plant, self.link, self.rec
+        tick = self.tick
+        t = tick * self.dt_s
+        while self._events and self._events[0][0].at_s <= t + 1e-12:
+            self._fire(*self._events.pop(0), t)
+        # sense, uplink
+        sensed = plant.sense()
+        link.r2c.send(Message(t, sensed), tick)
+        arrived = link.r2c.receive(tick)
+        if arrived:
+            self._sensed = arrived[-1]
+        # brain
+        signals = {"ref.q": q_des, "ref.qd": qd_des}
+        if self._sensed is not None:
+            signals.update(self._sensed.values)
+        frame = Frame(tick, t, signals, self._sensed)
+        for st in self.brain:
+            st.step(frame)
+        # downlink
+        out = {name: signals[name] for name in self._sent}
+        link.c2r.send(Message(frame.stamp_s, out), tick)
+        # robot
+        robot = dict(self.receiver.receive(link.c2r.receive(tick), t))
+        robot.update(sensed)
+        rframe = Frame(tick, t, robot)
+        for st in self.robot:
+            st.step(rframe)
+        command = {name: robot[name] for name in self._commands}
+        for name, v in command.items():
+            if not np.isfinite(v).all():
+                raise Diverged(f"trial {trial}, t = {t:.3f} s: non-finite {name} command {v.tolist()}")
+        # actuate, measure
+        applied = plant.actuate(command)
+        q, qd = plant.true_state()
+        ee = plant.end_effector()
+        if acc is not None:
+            acc.add(q_des, q, qd_des, qd, applied, ee_des, ee)
+        # record
+        if rec is not None and tick % self.decimation == 0:
+            if self.record_joints:
+                rec.joint_states("/joint_states/desired", t, q_des, qd_des)
+                rec.joint_states("/joint_states/actual", t, q, qd, applied if applied.size == q.size else None)
+            msg: dict[str, Any] = {"t": t, "trial": trial}
+            for name, field in self._record_as:
+                msg[field] = out[name]
+            msg.update({"error": q_des - q, "r2c_ms": link.r2c.last_delay_ms, "c2r_ms": link.c2r.last_delay_ms})
+            for st in self.robot:
+                msg.update(st.record())
+            if ee is not None:
+                msg["ee"] = ee
+            if ee_des is not None:
+                msg["ee_des"] = ee_des
+            rec.write("/control", "cerebx.Control", t, msg)
+        # physics
+        plant.step()
+        self.tick += 1
+        if tick % 50 == 0:
+            why = plant.is_diverged()
+            if why:
+                raise Diverged(f"trial {trial}, t = {t:.3f} s: {why}")
+        return applied
+
+    def run_trial(self, trial: int) -> TrialMetrics:
+        ref = self.task.trial(trial, self._task_rng)
+        rec = self.rec
+        acc = TrialAccumulator(self.plant.n_joints, ref.steps, self.cfg.control_dt_ms, n_command=self._n_command)
+        for e, fire in self._trial_events:
+            if e.at_trial == trial:
+                self._fire(e, fire, self.tick * self.dt_s)
+        if rec is not None and trial == 0 and ref.xyz is not None:
+            rec.write("/task/cartesian_path", "cerebx.CartesianPath", 0.0,
+                      {"x": ref.xyz[:, 0].copy(), "y": ref.xyz[:, 1].copy(), "z": ref.xyz[:, 2].copy()})
+        xyz = ref.xyz
+        for i in range(ref.steps):
+            self.step(ref.q[i], ref.qd[i], acc, trial, xyz[i] if xyz is not None else None)
+        why = self.plant.is_diverged()
+        if why:
+            raise Diverged(f"trial {trial}: {why}")
+        m = acc.finish(trial)
+        self.metrics.append(m)
+        self.trials_done = trial + 1
+        extra: dict[str, float] = {}
+        for st in self.brain:
+            extra.update(st.end_trial(trial))
+        if rec is not None:
+            rec.write("/trial_metrics", "cerebx.TrialMetrics", self.tick * self.dt_s,
+                      {**m.__dict__, "label": ref.label})
+            if extra:
+                rec.write("/weights", "cerebx.WeightSummary", self.tick * self.dt_s, {"trial": trial, **extra})
+        return m
+
+    @property
+    def sim_seconds(self) -> float:
+        return self.tick * self.dt_s

@@ -1,0 +1,76 @@
+"""Named signals: what a plant senses and is commanded with, what a stage reads and writes.
+
+A :class:`Signal` declares one named array (shape, unit, bounds), like a dm_env spec. A
+:class:`Message` carries named arrays with the time stamp they were made for; it is what crosses the
+link between the brain side and the robot side. A :class:`Frame` is one side's working set during
+one tick: the signals that arrived, the plant's readings and what earlier stages wrote.
+
+Names are dotted nouns: ``joint.q`` (rad), ``joint.qd`` (rad/s), ``joint.torque`` (N·m),
+``muscle.activation`` (0-1), ``muscle.length`` (mm), ``ref.q``/``ref.qd`` (the task's desired state).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Signal:
+    """One named array: ``size`` values in ``unit``, each within [low, high]."""
+
+    name: str
+    size: int
+    unit: str = ""
+    low: float | tuple[float, ...] = -math.inf
+    high: float | tuple[float, ...] = math.inf
+
+    def __str__(self) -> str:
+        return f"{self.name}[{self.size}]"
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        lo = np.broadcast_to(np.asarray(self.low, float), (self.size,))
+        hi = np.broadcast_to(np.asarray(self.high, float), (self.size,))
+        return lo, hi
+
+
+def joint_signals(n: int, tau_max: np.ndarray | None = None) -> dict[str, Signal]:
+    """The joint-space signals of an ``n``-joint torque-controlled plant."""
+    hi = math.inf if tau_max is None else tuple(float(t) for t in tau_max)
+    lo = -math.inf if tau_max is None else tuple(-float(t) for t in tau_max)
+    return {"joint.q": Signal("joint.q", n, "rad"), "joint.qd": Signal("joint.qd", n, "rad/s"),
+            "joint.torque": Signal("joint.torque", n, "N·m", lo, hi)}
+
+
+class Message:
+    """Named arrays stamped with the time they are meant for (sensor: measured at; command: apply at)."""
+
+    __slots__ = ("stamp_s", "values")
+
+    def __init__(self, stamp_s: float, values: dict[str, np.ndarray]):
+        self.stamp_s = stamp_s
+        self.values = values
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.values[name]
+
+    def __repr__(self) -> str:
+        return f"Message({self.stamp_s:.4f} s, {sorted(self.values)})"
+
+
+class Frame:
+    """One side's signals during one tick. Stages read ``signals`` and write their outputs into it.
+
+    On the brain side ``sensed`` is the newest sensor message that has arrived through the link
+    (None before the first) and its values are also in ``signals``; ``stamp_s`` is the time the
+    outgoing command is meant for (the tick's own time unless a stage stamps it later).
+    """
+
+    __slots__ = ("tick", "t_s", "stamp_s", "signals", "sensed")
+
+    def __init__(self, tick: int, t_s: float, signals: dict[str, np.ndarray], sensed: Message | None = None):
+        self.tick, self.t_s, self.stamp_s = tick, t_s, t_s
+        self.signals = signals
+        self.sensed = sensed

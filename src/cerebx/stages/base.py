@@ -1,0 +1,119 @@
+"""The stage contract and the build-time check that neighbouring stages agree on signals."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+
+from cerebx.errors import ConfigError
+from cerebx.loop.signals import Frame, Message, Signal
+
+if TYPE_CHECKING:
+    from cerebx.recording.recorder import Recorder
+
+Side = Literal["brain", "robot"]
+
+
+class Stage(ABC):
+    """Maps the signals of one tick to more (or changed) signals, and may keep state.
+
+    ``reads`` names the signals it needs; ``writes`` declares what it produces. A signal it writes
+    that is already present is replaced, unless the stage declares it in ``adds`` (then its output
+    is added to the present value: combined controllers, the supervisor's correction).
+    """
+
+    name: str = "stage"
+    reads: tuple[str, ...] = ()
+    writes: tuple[Signal, ...] = ()
+    adds: frozenset[str] = frozenset()
+
+    def reset(self, rng: np.random.Generator) -> None:
+        """Prepare for a run (called once, before the first tick)."""
+
+    @abstractmethod
+    def step(self, frame: Frame) -> None:
+        """Read from ``frame.signals`` and write this stage's outputs into it."""
+
+    def emit(self, frame: Frame, name: str, value: np.ndarray) -> None:
+        """Write ``value`` as signal ``name`` (added to the present value when declared in ``adds``)."""
+        signals = frame.signals
+        if name in self.adds and name in signals:
+            signals[name] = signals[name] + value
+        else:
+            signals[name] = value
+
+    def record(self) -> dict[str, Any]:
+        """Extra fields for this tick's ``/control`` message (e.g. the supervisor's torque)."""
+        return {}
+
+    def end_trial(self, trial: int) -> dict[str, float]:
+        """Called after each trial; may return scalars to record (e.g. weight summaries)."""
+        return {}
+
+    def attach_recorder(self, recorder: Recorder) -> None:
+        """Register extra MCAP channels (spikes, weights) before the run starts."""
+
+    def save_state(self, path: Path) -> bool:
+        """Write the learned state to ``path``; return False when there is none."""
+        return False
+
+    def load_state(self, path: Path) -> None:
+        """Restore a state written by :meth:`save_state` (clear error on mismatch)."""
+
+    def describe(self) -> dict[str, Any]:
+        """Static facts for the run summary (sizes, gains)."""
+        return {}
+
+
+class Receiver(ABC):
+    """First robot-side stage: turns the command messages that arrived this tick (zero or more)
+    into the command values to apply now."""
+
+    name: str = "receiver"
+
+    def __init__(self, signals: tuple[Signal, ...]):
+        self.signals = signals
+
+    @abstractmethod
+    def receive(self, arrived: list[Message], t_s: float) -> dict[str, np.ndarray]:
+        """The command values for this tick."""
+
+    def reset(self, rng: np.random.Generator) -> None:
+        """Prepare for a run."""
+
+
+def _fmt(signals: dict[str, Signal]) -> str:
+    return ", ".join(str(s) for s in signals.values()) or "nothing"
+
+
+def check_chain(side: Side, source: str, available: dict[str, Signal], stages: list[Stage]) -> dict[str, Signal]:
+    """Walk ``stages`` in order from the signals ``source`` provides; return what the chain ends
+    with. A stage that reads a signal nobody before it wrote, or of another size, is refused with
+    one line naming both neighbours."""
+    have = dict(available)
+    prev = source
+    for i, st in enumerate(stages):
+        here = f"{side} stage {i} ({st.name})"
+        for name in st.reads:
+            if name not in have:
+                raise ConfigError(f"{here}: reads {name}, but {prev} provides only {_fmt(have)}")
+        for sig in st.writes:
+            old = have.get(sig.name)
+            if old is not None and old.size != sig.size:
+                raise ConfigError(f"{here}: writes {sig}, but {prev} provides {old}")
+            if sig.name in st.adds and old is None:
+                raise ConfigError(f"{here}: adds to {sig.name}, but {prev} provides no {sig.name}")
+            have[sig.name] = sig
+        prev = here
+    return have
+
+
+def check_feeds_plant(last: str, have: dict[str, Signal], plant_name: str, commands: dict[str, Signal]) -> None:
+    """The robot side must end with every command signal the plant declares, of the declared size."""
+    for name, sig in commands.items():
+        got = have.get(name)
+        if got is None or got.size != sig.size:
+            raise ConfigError(f"plant {plant_name}: is commanded with {sig}, but {last} provides {_fmt(have)}")
