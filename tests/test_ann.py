@@ -10,7 +10,7 @@ from cerebx.build import build_components
 from cerebx.controllers.ann import ANN
 from cerebx.controllers.base import ControlInput, SensorMsg
 from cerebx.errors import StateMismatchError
-from cerebx.loop.runner import ClosedLoop
+from cerebx.loop.loop import ClosedLoop
 from cerebx.schema.ann import ANNController
 from cerebx.schema.controller import GivenRanges
 

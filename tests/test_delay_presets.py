@@ -8,8 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cerebx import registry
 from cerebx.build import BuildContext
-from cerebx.loop.delays import DelayChannel, Percentiles, build_delay
+from cerebx.loop.delays import Percentiles
+from cerebx.loop.link import DelayChannel
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -50,7 +52,7 @@ def _at_root(monkeypatch):
 
 def _model(load, name: str, seed: int = 0):
     cfg = load(["+experiment=demo", f"delay={name}", f"seed={seed}"])
-    return cfg.delay, build_delay(cfg.delay, BuildContext(cfg=cfg))
+    return cfg.delay, registry.delays.build(cfg.delay, BuildContext(cfg=cfg))
 
 
 def _samples(model, n: int = 10_000) -> tuple[np.ndarray, np.ndarray]:

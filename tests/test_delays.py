@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cerebx.loop.delays import Constant, DelayChannel, Gamma
+from cerebx.loop.delays import Constant, Gamma
+from cerebx.loop.link import DelayChannel
 from cerebx.schema.delay import ConstantDelay, GammaParams
 
 

@@ -7,7 +7,6 @@ from __future__ import annotations
 import json
 
 import pytest
-
 from golden_runs import GOLDEN, RUNS, record
 
 

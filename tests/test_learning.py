@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from cerebx.build import build_components
-from cerebx.loop.runner import ClosedLoop
+from cerebx.loop.loop import ClosedLoop
 
 
 def test_snn_learning_reduces_error_on_small_network(load):
@@ -16,7 +16,7 @@ def test_snn_learning_reduces_error_on_small_network(load):
     mae = np.array([loop.run_trial(i).mae for i in range(30)])
     early, late = mae[:5].mean(), mae[-5:].mean()
     assert late < 0.8 * early, mae.round(3)
-    w = ctx.extras["controller"].net.weights("pf_pc")
+    w = ctx.controller.net.weights("pf_pc")
     assert 0.0 <= w.min() < w.max() <= 5.0
 
 
@@ -26,7 +26,7 @@ def test_plasticity_off_does_not_learn(load):
     loop = ClosedLoop(ctx, None)
     loop.start()
     mae = np.array([loop.run_trial(i).mae for i in range(8)])
-    w = ctx.extras["controller"].net.weights("pf_pc")
+    w = ctx.controller.net.weights("pf_pc")
     assert w.min() == w.max() == 2.0
     assert mae[-3:].mean() > 0.9 * mae[:3].mean()
 
@@ -40,7 +40,7 @@ def test_pipelined_network_gives_identical_results(load):
         loop = ClosedLoop(ctx, None)
         loop.start()
         m = loop.run_trial(0)
-        runs[pipeline] = (m.mae_per_joint, ctx.extras["controller"].net.weights("pf_pc").copy())
+        runs[pipeline] = (m.mae_per_joint, ctx.controller.net.weights("pf_pc").copy())
     assert runs[True][0] == runs[False][0]
     np.testing.assert_array_equal(runs[True][1], runs[False][1])
 

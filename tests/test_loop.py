@@ -93,7 +93,7 @@ def test_diverging_run_stops_cleanly(load, tmp_path, monkeypatch):
     monkeypatch.setattr(PD, "step", nan_after_a_while)
     s = run_experiment(load([*DEMO, "trials=3"]), tmp_path)
     assert s["status"] == "diverged", s
-    assert "non-finite torque" in s["error"]
+    assert "non-finite joint.torque command" in s["error"]
     assert s["trials_completed"] == 1
     assert channel_counts(tmp_path)["/control"] == 1200
 

@@ -1,7 +1,9 @@
 """cerebx: declarative cerebellar motor-control experiments.
 
-Data flow (one control step = 2 ms): task reference -> plant sensors -> R2C delay channel ->
-controller -> C2R delay channel -> plant-side torque filter + supervisor -> physics -> recorder.
+Data flow (one control step = 2 ms, ``loop/loop.py``): task reference + plant sensors -> link (R2C)
+-> brain-side stages (the controller's parts) -> link (C2R) -> robot-side stages (receiver filter,
+supervisor, ...) -> plant command -> physics -> recorder. Signals are named arrays that plants and
+stages declare (``loop/signals.py``).
 """
 
 __version__ = "0.1.0"

@@ -22,8 +22,8 @@ from cerebx import registry
 from cerebx.controllers.base import Controller
 from cerebx.errors import ConfigError
 from cerebx.loop.link import Link
-from cerebx.loop.signals import Signal
-from cerebx.stages.base import Receiver, Stage, check_chain, check_feeds_plant
+from cerebx.signals import Signal
+from cerebx.stages.base import Receiver, Stage, wire
 from cerebx.stages.controllers import Composite, TorqueControllerStage
 
 
@@ -64,20 +64,23 @@ class BuildContext:
         return cache_dir()
 
 
-def as_stage(obj: Any, kind: str, n_joints: int) -> Stage:
-    """A controller as a brain-side stage (joint-torque controllers run behind an adapter)."""
-    if isinstance(obj, Stage):
-        obj.name = kind
-        return obj
+def as_stage(obj: Any, cfg: Any, n_joints: int) -> Stage:
+    """A controller as a brain-side stage (joint-torque controllers run behind an adapter); its signals
+    are the ones its schema declares."""
     if isinstance(obj, Controller):
-        return TorqueControllerStage(obj, kind, n_joints)
-    raise TypeError(f"controller {kind!r}: builder returned {type(obj).__name__}, neither a Controller nor a Stage")
+        obj = TorqueControllerStage(obj, cfg.kind, n_joints)
+    if not isinstance(obj, Stage):
+        raise TypeError(f"controller {cfg.kind!r}: builder returned {type(obj).__name__}, neither a Controller "
+                        "nor a Stage")
+    io = cfg.io(n_joints)
+    obj.name, obj.reads, obj.writes, obj.adds = cfg.kind, io.reads, io.writes, io.adds | obj.adds
+    return obj
 
 
 def build_composite(cfg: Any, ctx: BuildContext) -> Composite:
     """Each part is built by its own registry entry; parts keep their own state."""
     n = ctx.plant.n_joints
-    return Composite([as_stage(registry.controllers.build(p, ctx), p.kind, n) for p in cfg.parts])
+    return Composite([as_stage(registry.controllers.build(p, ctx), p, n) for p in cfg.parts])
 
 
 def _check_step(ctx: BuildContext) -> None:
@@ -90,41 +93,25 @@ def _check_step(ctx: BuildContext) -> None:
 
 
 def build_components(cfg: Any, run_dir: Path | None = None) -> BuildContext:
-    """Build and connect every part of the loop of ``cfg``."""
+    """Build and connect every part of the loop of ``cfg`` (its signals were checked by :func:`wire`
+    when the config was validated; the built plant must declare the same signals as its schema)."""
+    wiring = wire(cfg)
     ctx = BuildContext(cfg=cfg, run_dir=run_dir)
     ctx.plant = registry.plants.build(cfg.plant, ctx)
     ctx.task = registry.tasks.build(cfg.task, ctx)
     _check_step(ctx)
-    plant, n = ctx.plant, ctx.plant.n_joints
-    sensors, commands = plant.sensor_signals(), plant.command_signals()
-
-    # brain side: the task's reference and the (delayed) sensor signals, then the stages in order
+    n = ctx.plant.n_joints
+    for what in ("sensor_signals", "command_signals"):
+        built, declared = getattr(ctx.plant, what)(), getattr(cfg.plant, what)()
+        if {k: v.size for k, v in built.items()} != {k: v.size for k, v in declared.items()}:
+            raise ConfigError(f"plant {cfg.plant.kind}: {what} of the built plant differ from its schema's")
     ctx.controller = registry.controllers.build(cfg.controller, ctx)
-    ctx.brain = [as_stage(ctx.controller, cfg.controller.kind, n)]
+    ctx.brain = [as_stage(ctx.controller, cfg.controller, n)]
     ctx.brain += [registry.stages.build(s, ctx) for s in cfg.brain]
-    ref = {"ref.q": Signal("ref.q", n, "rad"), "ref.qd": Signal("ref.qd", n, "rad/s")}
-    have = check_chain("brain", "the task and the link", {**ref, **sensors}, ctx.brain)
-    written = {s.name: s for st in ctx.brain for s in st.writes}
-
-    # robot side: what it needs from the brain crosses the link
-    robot_cfg = list(cfg.robot)
-    first = robot_cfg[0] if robot_cfg and robot_cfg[0].receiver else registry.stages.parse({"kind": "hold"})
-    if robot_cfg and robot_cfg[0].receiver:
-        robot_cfg = robot_cfg[1:]
-    ctx.robot = [registry.stages.build(s, ctx) for s in robot_cfg]
-    needed = set(commands) | {r for st in ctx.robot for r in st.reads}
-    ctx.sent = tuple(have[name] for name in written if name in needed and name not in sensors)
-    if not ctx.sent:
-        raise ConfigError(f"controller: {cfg.controller.kind} writes "
-                          f"{', '.join(str(s) for s in written.values()) or 'nothing'}, but neither the robot "
-                          f"stages nor plant {cfg.plant.kind} ({', '.join(str(s) for s in commands.values())}) use it")
-    ctx.receiver = registry.stages.build(first, ctx, ctx.sent)
+    ctx.sent = wiring.sent
+    ctx.receiver = registry.stages.build(wiring.receiver, ctx, ctx.sent)
+    ctx.robot = [registry.stages.build(s, ctx) for s in wiring.robot]
     delay = registry.delays.build(cfg.delay, ctx)
     ctx.link = Link(delay.r2c, delay.c2r, cfg.control_dt_ms)
-    source = f"the link ({first.kind}: {', '.join(str(s) for s in ctx.sent)}) and plant {cfg.plant.kind}"
-    have = check_chain("robot", source, {**{s.name: s for s in ctx.sent}, **sensors}, ctx.robot)
-    last = f"robot stage {len(ctx.robot) - 1} ({ctx.robot[-1].name})" if ctx.robot else source
-    check_feeds_plant(last, have, cfg.plant.kind, commands)
-
-    ctx.events = [(ev, registry.events.build(ev.action, plant)) for ev in cfg.events]
+    ctx.events = [(ev, registry.events.build(ev.action, ctx.plant)) for ev in cfg.events]
     return ctx

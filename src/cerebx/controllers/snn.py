@@ -25,9 +25,9 @@ from typing import Any
 
 import numpy as np
 
+from cerebx import registry
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
-from cerebx import registry
 from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
 from cerebx.schema.controller import SNNController

@@ -23,16 +23,17 @@ physics               the plant advances one control step
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from cerebx.build import BuildContext
 from cerebx.errors import Diverged
-from cerebx.loop.signals import Frame, Message
 from cerebx.metrics import TrialAccumulator, TrialMetrics
-from cerebx.plants.base import PlantEvent
 from cerebx.recording.recorder import Recorder
+from cerebx.signals import Frame, Message
+
+if TYPE_CHECKING:
+    from cerebx.build import BuildContext
 
 PHASES = ("events", "sense", "uplink", "brain", "downlink", "robot", "actuate", "measure", "record", "physics")
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cerebx.loop.signals import Signal, joint_signals
+from cerebx.signals import Signal, joint_signals
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from cerebx.plants.base import Plant, PlantEvent
-from cerebx.schema.experiment import AttachPayload, DetachPayload, ElasticBand, ForcePulse, RemoveBand
+from cerebx.schema.events import AttachPayload, DetachPayload, ElasticBand, ForcePulse, RemoveBand
 
 ROLLOUT_STEPS = 100
 

@@ -18,7 +18,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.colors import to_rgb  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
 
+from cerebx.metrics import final_mae  # noqa: E402
+from cerebx.report.ch2 import TASK_NAMES, THESIS_KERNEL_MS, _rel, from_scratch  # noqa: E402
 from cerebx.report.delays import DELAY_TRIALS, delays  # noqa: E402
 from cerebx.report.registry import Figure, MissingRuns, figure, fmt, mean_std, panel_letter, save  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
@@ -39,6 +43,13 @@ THESIS_FIT = (0.000106, 0.0036)  # Fig. 3.6 C: MAE = slope * peak_ms + intercept
 
 
 # ---- selection helpers -------------------------------------------------------------------------------
+CH3_TASKS = ("circle", "inclined_circle", "circle_eight")
+# Chapter 3 text: factory-default position controller MAE without delay (rad)
+PAPER_FACTORY_CH3 = {"circle": "0.077", "inclined_circle": "0.055", "circle_eight": "0.068"}
+FIG3_5_DELAY_MS = 50.0
+FIG3_5_TRIALS = 16  # trials read per run for the densities (evenly spaced)
+CONVERGENCE_TOL = 0.10
+
 def _delay_label(run: Run) -> str:
     """The delay preset's name, or for a run that recorded none, its delay config in short."""
     if "delay" in (run.summary.get("presets") or {}):
@@ -539,3 +550,200 @@ def fig3_10(runs: RunSet, stem: Path) -> Figure:
                "machine's load); the thesis reports the share of time EDLUT ran at full real-time capacity, a "
                "different measure.")
     return Figure([png], caption, table, notes)
+
+
+# ---- Fig. 3.3: convergence -------------------------------------------------------------------------
+def convergence_trial(mae: np.ndarray, tol: float = CONVERGENCE_TOL) -> tuple[int | None, int, float | None]:
+    """(first trial where the trailing running mean is within ``tol`` of the final level, window, level).
+
+    Running mean over a trailing window of max(5, n/50) trials (10 of 500; at most n); the final level is
+    the mean of the last 10 % of trials.
+    """
+    n = len(mae)
+    level = final_mae(list(mae))
+    w = max(1, min(n, max(5, n // 50)))
+    if level is None:
+        return None, w, None
+    run_mean = np.convolve(mae, np.ones(w) / w, mode="valid")
+    hits = np.nonzero(run_mean <= (1 + tol) * level)[0]
+    return (int(hits[0]) + w - 1 if hits.size else None), w, level
+
+
+@figure("fig3_3", "Trajectory learning convergence curves (Fig. 3.3)",
+        studies=("learn_circle", "learn_inclined_circle", "learn_circle_eight"))
+def fig3_3(runs: RunSet, stem: Path) -> Figure:
+    found = {task: from_scratch(runs, task) for task in CH3_TASKS}
+    if not any(found.values()):
+        raise MissingRuns("no snn runs learning circle / inclined_circle / circle_eight from scratch "
+                          "(studies learn_circle, learn_inclined_circle, learn_circle_eight)")
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.3))
+    table = [["quantity", "paper", "cerebx"]]
+    notes, used = [], []
+    for ax, letter, task in zip(axes, "ABC", CH3_TASKS, strict=True):
+        ax.set_title(f"{letter}  {TASK_NAMES[task]}", loc="left", fontweight="bold", fontsize=10, pad=30)
+        run = found[task]
+        if run is None:
+            notes.append(f"no {task} run of snn learning from scratch: panel {letter} empty")
+            ax.text(0.5, 0.5, "no run", transform=ax.transAxes, ha="center")
+            continue
+        mae, period = run.mae, run.period_s
+        k, w, level = convergence_trial(mae)
+        ax.plot(mae, color="0.6", lw=0.7, label="MAE per trial")
+        ax.plot(np.arange(w - 1, len(mae)), np.convolve(mae, np.ones(w) / w, mode="valid"), "C0", lw=1.5,
+                label=f"running mean ({w} trials)")
+        if level is not None:
+            ax.axhline(level, color="C3", ls="--", lw=1, label="final level (last 10 %)")
+        if k is not None:
+            ax.axvline(k, color="C2", lw=1.2, label=f"within {CONVERGENCE_TOL:.0%}: trial {k}")
+        ax.set_yscale("log")
+        ax.set_xlabel("trial")
+        ax.set_ylabel("position MAE (rad)")
+        ax.secondary_xaxis("top", functions=(lambda x, p=period: x * p, lambda s, p=period: s / p)).set_xlabel(
+            "time (s)", fontsize=8)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+        name, secs = TASK_NAMES[task], 500 * (4 if task == "circle_eight" else 2)
+        table += [[f"{name}: MAE first 10 trials (rad)", "figure only", f"{mae[:10].mean():.3f}"],
+                  [f"{name}: MAE last 10 trials (rad)", "figure only", f"{mae[-10:].mean():.3f}"],
+                  [f"{name}: trials to stabilize", f"about 500 trials ({secs} s)",
+                   "not reached" if k is None else f"{k} ({k * period:.0f} s) of {len(mae)}"]]
+        used.append(f"{letter}: {_rel(run)}, {len(mae)} trials of {period:.0f} s")
+    fig.tight_layout()
+    caption = ("Thesis Fig. 3.3: MAE per trial of the snn controller learning from scratch (thesis: stabilization "
+               f"after about 500 trials). Runs: {'; '.join(used)}. Stabilization trial: the first trial where the "
+               f"trailing running mean (max(5, n/50) trials) is within {CONVERGENCE_TOL:.0%} of the final level "
+               "(mean of the last 10 % of trials).")
+    return Figure([save(fig, stem)], caption, table, notes)
+
+
+# ---- Fig. 3.5: end-effector density under a 50 ms delay ------------------------------------------
+def _sample_ee(run: Run, trials: int = FIG3_5_TRIALS) -> tuple[np.ndarray, np.ndarray, int]:
+    """ee and ee_des of up to ``trials`` evenly spaced trials (time-windowed reads), and how many."""
+    n, period, w = run.trials, run.period_s, min(run.warmup, max(run.trials - 1, 0))
+    picks = np.unique(np.linspace(w, n - 1, min(n - w, trials)).round().astype(int))
+    ee, des = [], []
+    for k in picks:
+        c = run.control(["ee", "ee_des"], k * period, (k + 1) * period, every=2)
+        if c["ee"].size:
+            ee.append(c["ee"])
+            des.append(c["ee_des"])
+    if not ee:
+        return np.zeros((0, 3)), np.zeros((0, 3)), 0
+    return np.concatenate(ee), np.concatenate(des), len(picks)
+
+
+def plane(des: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Origin, 2x3 projection and axis labels: x-y for a flat path, else its two principal axes."""
+    if not des.size:
+        return np.zeros(3), np.eye(3)[:2], ["x (m)", "y (m)"]
+    spread = np.ptp(des, axis=0)
+    if spread[2] <= 0.05 * max(spread[0], spread[1]):
+        return np.zeros(3), np.eye(3)[:2], ["x (m)", "y (m)"]
+    centre = des.mean(0)
+    axes = np.linalg.svd(des - centre, full_matrices=False)[2][:2]
+    for i in range(2):  # orient: first axis along +x, second along +y
+        if axes[i, i] < 0:
+            axes[i] *= -1
+    labels = [f"{u} (m) along ({a[0]:.2f}, {a[1]:.2f}, {a[2]:.2f})" for u, a in zip("uv", axes, strict=True)]
+    return centre, axes, labels
+
+
+def _limits(des2: np.ndarray, clouds: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Panel limits: the desired path with a 6 cm margin, widened to the 1-99 % range of the densities but at
+    most 35 cm from the path's centre."""
+    if not des2.size:
+        return np.full(2, -0.3), np.full(2, 0.3)
+    lo, hi = des2.min(0) - 0.06, des2.max(0) + 0.06
+    if clouds:
+        pts = np.concatenate(clouds)
+        lo, hi = np.minimum(lo, np.percentile(pts, 1, axis=0)), np.maximum(hi, np.percentile(pts, 99, axis=0))
+    mid = (des2.min(0) + des2.max(0)) / 2
+    return np.maximum(lo, mid - 0.35), np.minimum(hi, mid + 0.35)
+
+
+def _density_rgba(h: np.ndarray, color: str) -> np.ndarray:
+    img = np.zeros((*h.shape, 4))
+    img[..., :3] = to_rgb(color)
+    img[..., 3] = 0.85 * np.sqrt(h / h.max()) if h.max() > 0 else 0.0
+    return img
+
+
+@figure("fig3_5", "End-effector density under a 50 ms delay: PD vs SNN and ANN vs SNN (Fig. 3.5)",
+        studies=("fig3_5_snn_circle", "fig3_5_snn_inclined_circle", "fig3_5_snn_circle_eight", "fig3_5_ann_circle",
+                 "fig3_5_ann_inclined_circle", "fig3_5_ann_circle_eight", "fig3_5_pd_circle",
+                 "fig3_5_pd_inclined_circle", "fig3_5_pd_circle_eight", "fig3_5_position", "baselines_circle"))
+def fig3_5(runs: RunSet, stem: Path) -> Figure:
+    delayed = runs.where(lambda r: r.delay == "constant" and r.delay_total_ms == FIG3_5_DELAY_MS and r.trials > 0
+                         and (r.controller != "snn" or r.kernel_peaks_ms == [THESIS_KERNEL_MS]))
+    slots = {(task, c): delayed.where(task=task, controller=c).best()
+             for task in CH3_TASKS for c in ("pd", "ann", "snn")}
+    if not any(slots.values()):
+        raise MissingRuns(f"no pd / ann / snn runs under a constant {FIG3_5_DELAY_MS:.0f} ms delay "
+                          "(studies fig3_5_*)")
+    refs = {task: runs.where(lambda r: r.is_factory_position and r.trials > 0, task=task, delay="none").best()
+            for task in CH3_TASKS}
+    data = {key: _sample_ee(r) for key, r in slots.items() if r is not None}
+    colors = {"pd": "C3", "ann": "C1", "snn": "C0"}
+    fig, axes = plt.subplots(2, 3, figsize=(15, 9.6))
+    notes: list[str] = []
+    table = [["quantity", "paper", "cerebx"]]
+    claims = {"snn": "figure only (SNN stays accurate)", "ann": "figure only (ANN degrades)",
+              "pd": "figure only (PD degrades)"}
+    for col, task in enumerate(CH3_TASKS):
+        des = next((data[(task, c)][1] for c in ("snn", "ann", "pd") if (task, c) in data), np.zeros((0, 3)))
+        ref = refs[task]
+        ref_ee = (ref.control(["ee"], (ref.trials - 1) * ref.period_s, ref.trials * ref.period_s)["ee"]
+                  if ref is not None else np.zeros((0, 3)))
+        if not des.size and ref_ee.size:
+            des = ref_ee
+        centre, proj, labels = plane(des)
+        pd_ = {key: (v[0] - centre) @ proj.T for key, v in data.items() if key[0] == task}
+        des2 = (des - centre) @ proj.T if des.size else np.zeros((0, 2))
+        lo, hi = _limits(des2, list(pd_.values()))
+        for row, other in enumerate(("pd", "ann")):
+            ax = axes[row, col]
+            handles = []
+            for c in (other, "snn"):
+                pts = pd_.get((task, c))
+                r = slots[(task, c)]
+                if pts is None or r is None:
+                    continue
+                h, xe, ye = np.histogram2d(pts[:, 0], pts[:, 1], bins=120, range=[[lo[0], hi[0]], [lo[1], hi[1]]])
+                ax.imshow(_density_rgba(h.T, colors[c]), origin="lower", extent=(xe[0], xe[-1], ye[0], ye[-1]),
+                          interpolation="nearest", aspect="equal")
+                handles.append(Patch(color=colors[c], label=f"{c.upper()} ({data[(task, c)][2]} trials)"))
+            if des2.size:
+                handles += ax.plot(des2[:, 0], des2[:, 1], "k--", lw=1, label="desired")
+            if ref_ee.size:
+                r2 = (ref_ee - centre) @ proj.T
+                handles += ax.plot(r2[:, 0], r2[:, 1], color="C2", lw=1.2, label="factory position, no delay")
+            ax.set_xlim(lo[0], hi[0])
+            ax.set_ylim(lo[1], hi[1])
+            ax.set_xlabel(labels[0], fontsize=8)
+            ax.set_ylabel(labels[1], fontsize=8)
+            ax.set_title(f"{'ABCDEF'[3 * row + col]}  {other.upper()} vs SNN, {TASK_NAMES[task]}", loc="left",
+                         fontweight="bold", fontsize=10)
+            if handles:
+                ax.legend(handles=handles, fontsize=7, loc="upper right")
+            else:
+                ax.text(0.5, 0.5, "no runs", transform=ax.transAxes, ha="center")
+        for c in ("pd", "ann", "snn"):
+            r = slots[(task, c)]
+            table.append([f"{TASK_NAMES[task]}, {c.upper()} at {FIG3_5_DELAY_MS:.0f} ms: MAE (rad)", claims[c],
+                          f"{mean_std(r.mae)} ({r.n_measured} trials)" if r is not None else "not run"])
+        missing = [c for c in ("pd", "ann", "snn") if slots[(task, c)] is None]
+        if missing:
+            notes.append(f"no {' / '.join(missing)} run on {task} at {FIG3_5_DELAY_MS:.0f} ms")
+        table.append([f"{TASK_NAMES[task]}, factory position, no delay: MAE (rad)", PAPER_FACTORY_CH3[task],
+                      f"{mean_std(ref.mae)} ({ref.n_measured} trials)" if ref is not None else "not run"])
+        if ref is None:
+            notes.append(f"no factory position run on {task} without delay: no reference path")
+    fig.suptitle(f"End-effector density under a constant {FIG3_5_DELAY_MS:.0f} ms round-trip delay", fontsize=11)
+    fig.tight_layout()
+    counts = sorted({f"{data[k][2]} of {slots[k].trials}" for k in data})
+    caption = (f"Thesis Fig. 3.5: end-effector density of PD vs SNN (A–C) and ANN vs SNN (D–F) under a constant "
+               f"{FIG3_5_DELAY_MS:.0f} ms round-trip delay (thesis: 100 trials per controller; here the density of "
+               f"{', '.join(counts)} trials, evenly spaced, every 2nd control step); dashed: desired path; green: "
+               "last trial of the factory position controller without delay. Circle and circle-Lissajous in the xy "
+               "plane, the inclined circle in the principal plane of its desired path.")
+    return Figure([save(fig, stem)], caption, table, notes)

@@ -33,3 +33,20 @@ PhysicsStepMs = Annotated[float, Field(gt=0, description="MuJoCo timestep; must 
 NonNegFloat = Annotated[float, Field(ge=0)]
 PerJoint = tuple[float, ...]
 """One value per controlled joint, in joint order; length is checked against the plant."""
+
+
+class PlantSchema(Strict):
+    """Base of plant schemas: the signals a plant of this config senses and is commanded with.
+    The defaults are a joint-torque plant; a plant with other signals overrides both."""
+
+    def sensor_signals(self) -> dict:
+        from cerebx.signals import joint_signals
+
+        s = joint_signals(self.n_joints)  # type: ignore[attr-defined]
+        return {"joint.q": s["joint.q"], "joint.qd": s["joint.qd"]}
+
+    def command_signals(self) -> dict:
+        from cerebx.signals import joint_signals
+
+        limit = getattr(self, "torque_limit_Nm", None)
+        return {"joint.torque": joint_signals(self.n_joints, limit)["joint.torque"]}  # type: ignore[attr-defined]

@@ -10,6 +10,7 @@ from pydantic import Field, model_validator
 
 from cerebx.registry import Plugin
 from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
+from cerebx.signals import StageIO, torque_controller_io
 
 
 class ControllerConfig(Strict):
@@ -18,6 +19,10 @@ class ControllerConfig(Strict):
     def cross_check(self, exp: Any) -> list[str]:
         """Problems that involve other parts of the experiment (one ``path: message`` line each)."""
         return []
+
+    def io(self, n_joints: int) -> StageIO:
+        """The signals this controller reads and writes (default: a joint-torque controller)."""
+        return torque_controller_io(n_joints)
 
 
 class PDController(ControllerConfig):
@@ -202,3 +207,13 @@ class CompositeController(ControllerConfig):
 
     def cross_check(self, exp: Any) -> list[str]:
         return [f"controller.parts.{i}.{line}" for i, p in enumerate(self.parts) for line in p.cross_check(exp)]
+
+    def io(self, n_joints: int) -> StageIO:
+        """Reads what a part reads before an earlier part wrote it; writes every part's outputs."""
+        written: dict[str, Any] = {}
+        reads: list[str] = []
+        for part in self.parts:
+            pio = part.io(n_joints)
+            reads += [r for r in pio.reads if r not in written and r not in reads]
+            written.update({s.name: s for s in pio.writes})
+        return StageIO(tuple(reads), tuple(written.values()))

@@ -8,8 +8,8 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, Field, ValidationError, create_model, model_validator
 
 from cerebx import registry
-from cerebx.registry import Plugin
 from cerebx.errors import ConfigError
+from cerebx.registry import Plugin
 from cerebx.schema.base import CONTROL_DT_MS, NonNegFloat, Strict
 from cerebx.schema.network import NetworkConfig
 
@@ -95,6 +95,14 @@ class _ExperimentBase(Strict):
                     problems.append(f"{side}.{i}: stage {st.kind!r} runs on the {' or '.join(st.sides)} side")
                 elif st.receiver and not (side == "robot" and i == 0):
                     problems.append(f"{side}.{i}: {st.kind!r} is a receiver; it can only be the first robot stage")
+        if not problems:
+            from cerebx.errors import ConfigError
+            from cerebx.stages.base import wire
+
+            try:
+                wire(self)
+            except ConfigError as err:
+                problems += err.problems
         if self.warmup_trials >= self.trials:
             problems.append(f"warmup_trials: {self.warmup_trials} leaves no measured trial of {self.trials}")
         if self.init_from is not None:

@@ -6,10 +6,10 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
-from cerebx.schema.base import NonNegFloat, PhysicsStepMs, PositiveFloat, Strict
+from cerebx.schema.base import NonNegFloat, PhysicsStepMs, PlantSchema, PositiveFloat, Strict
 
 
-class Planar2Config(Strict):
+class Planar2Config(PlantSchema):
     """Planar two-link arm in a vertical plane (shoulder, elbow), torque-driven; for fast tests."""
 
     kind: Literal["planar2"] = "planar2"
@@ -66,7 +66,7 @@ class S1SpringConfig(Strict):
     rest_rad: float = Field(-2.147, description="s1 angle where the spring is slack (the upper stop)")
 
 
-class BaxterConfig(Strict):
+class BaxterConfig(PlantSchema):
     """Compliant Baxter left arm (six controlled joints, w2 held at 0)."""
 
     kind: Literal["baxter"] = "baxter"

@@ -11,13 +11,18 @@ from typing import ClassVar, Literal
 from pydantic import Field
 
 from cerebx.schema.base import NonNegFloat, Strict
+from cerebx.signals import Signal, StageIO
 
 
 class StageConfig(Strict):
-    """Base of every stage schema."""
+    """Base of every stage schema: where it may stand and the signals it reads and writes."""
 
     sides: ClassVar[tuple[str, ...]] = ("brain", "robot")
     receiver: ClassVar[bool] = False
+
+    def io(self, n_joints: int) -> StageIO:
+        """Signals read, written and added to (receivers pass on what the link delivers)."""
+        return StageIO()
 
 
 class HoldConfig(StageConfig):
@@ -62,3 +67,7 @@ class SupervisorConfig(StageConfig):
         "encoder", description="'encoder': the controller's MF position ranges (as the original); 'plant': joint limits"
     )
     margin_rad: NonNegFloat = 0.0
+
+    def io(self, n_joints: int) -> StageIO:
+        torque = Signal("joint.torque", len(self.kp), "N·m")
+        return StageIO(("joint.q", "joint.qd", "joint.torque"), (torque,), frozenset({"joint.torque"}))

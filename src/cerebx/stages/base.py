@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from cerebx.errors import ConfigError
-from cerebx.loop.signals import Frame, Message, Signal
+from cerebx.signals import Frame, Message, Signal, StageIO
 
 if TYPE_CHECKING:
     from cerebx.recording.recorder import Recorder
@@ -89,31 +90,67 @@ def _fmt(signals: dict[str, Signal]) -> str:
     return ", ".join(str(s) for s in signals.values()) or "nothing"
 
 
-def check_chain(side: Side, source: str, available: dict[str, Signal], stages: list[Stage]) -> dict[str, Signal]:
-    """Walk ``stages`` in order from the signals ``source`` provides; return what the chain ends
-    with. A stage that reads a signal nobody before it wrote, or of another size, is refused with
-    one line naming both neighbours."""
+def check_chain(side: Side, source: str, available: dict[str, Signal],
+                stages: list[tuple[str, StageIO]]) -> dict[str, Signal]:
+    """Walk the (label, io) of ``stages`` in order from the signals ``source`` provides; return what
+    the chain ends with. A stage that reads a signal nobody before it wrote, or writes one of another
+    size, is refused with one line naming both neighbours."""
     have = dict(available)
     prev = source
-    for i, st in enumerate(stages):
-        here = f"{side} stage {i} ({st.name})"
-        for name in st.reads:
+    for label, io in stages:
+        for name in io.reads:
             if name not in have:
-                raise ConfigError(f"{here}: reads {name}, but {prev} provides only {_fmt(have)}")
-        for sig in st.writes:
+                raise ConfigError(f"{label}: reads {name}, but {prev} provides only {_fmt(have)}")
+        for sig in io.writes:
             old = have.get(sig.name)
             if old is not None and old.size != sig.size:
-                raise ConfigError(f"{here}: writes {sig}, but {prev} provides {old}")
-            if sig.name in st.adds and old is None:
-                raise ConfigError(f"{here}: adds to {sig.name}, but {prev} provides no {sig.name}")
+                raise ConfigError(f"{label}: writes {sig}, but {prev} provides {old}")
+            if sig.name in io.adds and old is None:
+                raise ConfigError(f"{label}: adds to {sig.name}, but {prev} provides no {sig.name}")
             have[sig.name] = sig
-        prev = here
+        prev = label
     return have
 
 
-def check_feeds_plant(last: str, have: dict[str, Signal], plant_name: str, commands: dict[str, Signal]) -> None:
-    """The robot side must end with every command signal the plant declares, of the declared size."""
+@dataclass(frozen=True)
+class Wiring:
+    """The signal graph of an experiment: what crosses the link and which robot stages follow the receiver."""
+
+    sent: tuple[Signal, ...]
+    receiver: Any  # the receiver's config (hold when none is listed)
+    robot: tuple[Any, ...]  # the other robot-stage configs, in order
+
+
+def wire(exp: Any) -> Wiring:
+    """Check the experiment's signals from the declarations alone (no part is built): each stage finds
+    what it reads, and the robot side ends with the plant's command signals. One ConfigError line on
+    the first mismatch."""
+    from cerebx import registry
+
+    plant = exp.plant
+    n = plant.n_joints
+    sensors, commands = plant.sensor_signals(), plant.command_signals()
+    ref = {"ref.q": Signal("ref.q", n, "rad"), "ref.qd": Signal("ref.qd", n, "rad/s")}
+    brain = [(f"controller ({exp.controller.kind})", exp.controller.io(n))]
+    brain += [(f"brain stage {i} ({s.kind})", s.io(n)) for i, s in enumerate(exp.brain)]
+    have = check_chain("brain", "the task and the link", {**ref, **sensors}, brain)
+    written = [s.name for _, io in brain for s in io.writes]
+
+    robot_cfg = list(exp.robot)
+    receiver = robot_cfg.pop(0) if robot_cfg and robot_cfg[0].receiver else registry.stages.parse({"kind": "hold"})
+    robot = [(f"robot stage {i + 1 if exp.robot and exp.robot[0].receiver else i} ({s.kind})", s.io(n))
+             for i, s in enumerate(robot_cfg)]
+    needed = set(commands) | {r for _, io in robot for r in io.reads}
+    sent = tuple(dict.fromkeys(have[w] for w in written if w in needed and w not in sensors))
+    if not sent:
+        raise ConfigError(f"controller ({exp.controller.kind}): the brain side writes "
+                          f"{', '.join(sorted(set(written))) or 'nothing'}, but neither the robot stages nor "
+                          f"plant {plant.kind} ({_fmt(commands)}) use it")
+    source = f"the link ({receiver.kind}: {', '.join(str(s) for s in sent)}) and plant {plant.kind}"
+    have = check_chain("robot", source, {**{s.name: s for s in sent}, **sensors}, robot)
+    last = robot[-1][0] if robot else source
     for name, sig in commands.items():
         got = have.get(name)
         if got is None or got.size != sig.size:
-            raise ConfigError(f"plant {plant_name}: is commanded with {sig}, but {last} provides {_fmt(have)}")
+            raise ConfigError(f"plant {plant.kind}: is commanded with {sig}, but {last} provides {_fmt(have)}")
+    return Wiring(sent, receiver, tuple(robot_cfg))

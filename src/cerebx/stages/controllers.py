@@ -15,19 +15,18 @@ from typing import Any
 import numpy as np
 
 from cerebx.controllers.base import ControlInput, Controller, SensorMsg
-from cerebx.loop.signals import Frame, Signal
+from cerebx.signals import Frame, Signal, torque_controller_io
 from cerebx.stages.base import Stage
 
 
 class TorqueControllerStage(Stage):
     """Runs a :class:`Controller` on the brain side."""
 
-    reads = ("ref.q", "ref.qd")
-
     def __init__(self, controller: Controller, kind: str, n_joints: int):
         self.controller = controller
         self.name = kind
-        self.writes = (Signal("joint.torque", n_joints, "N·m"),)
+        io = torque_controller_io(n_joints)
+        self.reads, self.writes = io.reads, io.writes
         self._sensed: Any = None
         self._sensor: SensorMsg | None = None
 

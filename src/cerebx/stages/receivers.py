@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.loop.signals import Message, Signal
 from cerebx.schema import stages as schema
+from cerebx.signals import Message, Signal
 from cerebx.stages.base import Receiver
 
 

@@ -6,8 +6,8 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.loop.signals import Frame, Signal
 from cerebx.schema.stages import SupervisorConfig
+from cerebx.signals import Frame
 from cerebx.stages.base import Stage
 
 
@@ -15,15 +15,14 @@ class Supervisor(Stage):
     """Adds kp (bound - q) - s kd qd to ``joint.torque`` for joints outside [lo, hi]; s ramps to 1."""
 
     name = "supervisor"
-    reads = ("joint.q", "joint.qd", "joint.torque")
 
     def __init__(self, cfg: SupervisorConfig, lo: np.ndarray, hi: np.ndarray):
         self.kp, self.kd = np.asarray(cfg.kp), np.asarray(cfg.kd)
         self.ramp = cfg.ramp_per_step
         self.lo, self.hi = lo - cfg.margin_rad, hi + cfg.margin_rad
         self.s = np.zeros_like(self.kp)
-        self.writes = (Signal("joint.torque", len(self.kp), "N·m"),)
-        self.adds = frozenset({"joint.torque"})
+        io = cfg.io(len(self.kp))
+        self.reads, self.writes, self.adds = io.reads, io.writes, io.adds
         self.tau = np.zeros_like(self.kp)
 
     def correction(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:

@@ -44,6 +44,21 @@ def joint_signals(n: int, tau_max: np.ndarray | None = None) -> dict[str, Signal
             "joint.torque": Signal("joint.torque", n, "N·m", lo, hi)}
 
 
+@dataclass(frozen=True)
+class StageIO:
+    """What a stage reads, writes, and adds to (a written signal that is summed with the present value)."""
+
+    reads: tuple[str, ...] = ()
+    writes: tuple[Signal, ...] = ()
+    adds: frozenset[str] = frozenset()
+
+
+def torque_controller_io(n_joints: int) -> StageIO:
+    """A joint-torque controller: desired joint state in, ``joint.torque`` out (the measured joint state
+    it also uses arrives through the link and may be absent in the first ticks)."""
+    return StageIO(("ref.q", "ref.qd"), (Signal("joint.torque", n_joints, "N·m"),))
+
+
 class Message:
     """Named arrays stamped with the time they are meant for (sensor: measured at; command: apply at)."""
 

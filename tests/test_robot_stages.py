@@ -1,0 +1,63 @@
+"""Robot-side stages: the receivers (torque filters) and the watchdog supervisor, against hand-computed values."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cerebx.schema.stages import FuturePastFilterConfig, SupervisorConfig
+from cerebx.signals import Frame, Message, Signal
+from cerebx.stages.receivers import FuturePastFilter, MeanFilter
+from cerebx.stages.supervisor import Supervisor
+
+TAU = (Signal("joint.torque", 1, "N·m"),)
+
+
+def _msg(stamp: float, v: float) -> Message:
+    return Message(stamp, {"joint.torque": np.array([v])})
+
+
+def test_mean_filter_is_15_tap_average():
+    f = MeanFilter(TAU, 15)
+    outs = [f.receive([_msg(0.0, float(v))], 0.0)["joint.torque"][0] for v in range(1, 31)]
+    assert outs[0] == 1.0
+    assert outs[14] == pytest.approx(np.mean(range(1, 16)))
+    assert outs[29] == pytest.approx(np.mean(range(16, 31)))
+
+
+def test_future_past_filter_hand_computed():
+    f = FuturePastFilter(TAU, FuturePastFilterConfig(past_samples=2, min_future_samples=2))
+    dt = 0.002
+    # samples stamped for ticks 0..5 with values 10, 20, ..., 60 all arrive at tick 0
+    f.receive([_msg(i * dt, 10.0 * (i + 1)) for i in range(6)], 0.0)
+    # at t = 2 dt: future = ticks 2..5 (30,40,50,60) -> F = min(4, 3) = 3 -> 30,40,50; past = 10,20 -> 2 newest
+    out = f.receive([], 2 * dt)["joint.torque"]
+    assert out[0] == pytest.approx(np.mean([30, 40, 50, 10, 20]))
+
+
+def test_future_past_filter_decays_when_starved():
+    f = FuturePastFilter(TAU, FuturePastFilterConfig(past_samples=10, min_future_samples=2, decay_per_step=0.998))
+    f.receive([_msg(i * 0.002, 5.0) for i in range(4)], 0.0)
+    first = f.receive([], 0.002)["joint.torque"][0]
+    assert first == pytest.approx(5.0)
+    outs = [f.receive([], (k + 2) * 0.002)["joint.torque"][0] for k in range(10)]
+    # from tick 2 on, fewer than 3 future samples remain: each step multiplies by 0.998
+    assert outs[-1] == pytest.approx(outs[-2] * 0.998)
+    assert outs[0] == pytest.approx(5.0 * 0.998, rel=1e-12)
+    assert outs[-1] == pytest.approx(5.0 * 0.998 ** 10, rel=1e-12)
+
+
+def test_supervisor_acts_only_outside_and_ramps():
+    sup = Supervisor(SupervisorConfig(kp=(20.0,), kd=(5.0,)), np.array([-1.0]), np.array([1.0]))
+
+    def run(q: float, qd: float) -> float:
+        frame = Frame(0, 0.0, {"joint.q": np.array([q]), "joint.qd": np.array([qd]), "joint.torque": np.array([1.0])})
+        sup.step(frame)
+        return frame.signals["joint.torque"][0] - 1.0  # the supervisor adds to the command
+
+    assert run(0.5, 1.0) == 0.0
+    assert run(1.1, 2.0) == pytest.approx(20 * (1.0 - 1.1) - 0.02 * 5 * 2.0)
+    assert run(1.1, 2.0) == pytest.approx(20 * (1.0 - 1.1) - 0.04 * 5 * 2.0)
+    assert sup.record()["tau_supervisor"][0] == pytest.approx(20 * (1.0 - 1.1) - 0.04 * 5 * 2.0)
+    assert run(0.0, 2.0) == 0.0
+    assert sup.s[0] == 0.0
