@@ -36,8 +36,9 @@ def test_zn_on_planar2(load, tmp_path):
     text = out.read_text()
     assert "K_u" in text and "T_u" in text
     data = yaml.safe_load(text)
-    assert data["kind"] == "pd" and data["tau_max_Nm"] == [30.0, 20.0]
-    assert data["kp"] == pytest.approx([r.kp for r in results], rel=1e-4)
+    ctrl = data["controller"]
+    assert ctrl["kind"] == "pd" and ctrl["tau_max_Nm"] == [30.0, 20.0] and data["robot"] == [{"kind": "hold"}]
+    assert ctrl["kp"] == pytest.approx([r.kp for r in results], rel=1e-4)
 
     base = load([*DEMO, "trials=2"])
     zn = base.model_copy(update={"controller": tuned})
