@@ -24,23 +24,23 @@ def _method(plant: Any, name: str) -> Callable[..., None]:
 
 
 def attach_payload(cfg: Any, plant: Any) -> Callable[[], None]:
-    fn = _method(plant, "attach_payload")
+    fn = _method(plant, cfg.plant_method)
     return lambda: fn(cfg.mass_kg, cfg.rod_length_m)
 
 
 def detach_payload(cfg: Any, plant: Any) -> Callable[[], None]:
-    return _method(plant, "detach_payload")
+    return _method(plant, cfg.plant_method)
 
 
 def elastic_band(cfg: Any, plant: Any) -> Callable[[], None]:
-    fn = _method(plant, "elastic_band")
+    fn = _method(plant, cfg.plant_method)
     return lambda: fn(cfg.stiffness_N_per_m, np.asarray(cfg.anchor_offset_m, float), cfg.rest_length_m)
 
 
 def remove_band(cfg: Any, plant: Any) -> Callable[[], None]:
-    return _method(plant, "remove_band")
+    return _method(plant, cfg.plant_method)
 
 
 def force_pulse(cfg: Any, plant: Any) -> Callable[[], None]:
-    fn = _method(plant, "force_pulse")
+    fn = _method(plant, cfg.plant_method)
     return lambda: fn(np.asarray(cfg.force_N, float), cfg.duration_ms, cfg.body)

@@ -9,9 +9,11 @@ topic                      schema                 content
 =========================  =====================  ===============================================
 /joint_states/desired      foxglove.JointStates   desired position (rad) and velocity (rad/s)
 /joint_states/actual       foxglove.JointStates   actual position, velocity, applied torque (N·m)
-/control                   cerebx.Control         controller torque, supervisor torque, error,
-                                                  end-effector and desired end-effector (m), delays
-                                                  sampled for this step's messages (r2c_ms, c2r_ms)
+/control                   cerebx.Control         what the brain side sent (joint.torque as
+                                                  tau_controller, other signals by name), what robot
+                                                  stages report (tau_supervisor), error, end-effector
+                                                  and desired end-effector (m), delays sampled for
+                                                  this step's messages (r2c_ms, c2r_ms)
 /trial_metrics             cerebx.TrialMetrics    per-trial MAE per joint, velocity MAE, dtau, task variant
 /events                    cerebx.PlantEvent      plant events as they happen
 /spikes/<population>       cerebx.Spikes          neuron indices that fired in the step

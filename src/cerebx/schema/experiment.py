@@ -95,6 +95,11 @@ class _ExperimentBase(Strict):
                     problems.append(f"{side}.{i}: stage {st.kind!r} runs on the {' or '.join(st.sides)} side")
                 elif st.receiver and not (side == "robot" and i == 0):
                     problems.append(f"{side}.{i}: {st.kind!r} is a receiver; it can only be the first robot stage")
+        plant_cls = registry.plants[plant.kind].resolve()
+        for i, ev in enumerate(self.events):
+            method = getattr(ev.action, "plant_method", None)
+            if method and not callable(getattr(plant_cls, method, None)):
+                problems.append(f"events.{i}.action: plant {plant.kind} does not support event {ev.action.kind!r}")
         if not problems:
             from cerebx.errors import ConfigError
             from cerebx.stages.base import wire
