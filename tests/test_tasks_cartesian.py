@@ -8,11 +8,14 @@ import mujoco
 import numpy as np
 import pytest
 
+from cerebx import registry
 from cerebx.plants.baxter import JOINT_RANGE, kinematic_mjcf
+from cerebx.registry import load_plugins
 from cerebx.schema import task as T
 from cerebx.tasks import cartesian
 from cerebx.tasks.ik import SiteIK, rotation_angle
 
+load_plugins()
 LO = np.array([r[0] for r in JOINT_RANGE])
 HI = np.array([r[1] for r in JOINT_RANGE])
 CONFIGS = {
@@ -33,7 +36,7 @@ def cache(tmp_path_factory):
 @pytest.fixture(scope="module")
 def tasks(cache):
     ctx = SimpleNamespace(cache_dir=cache, plant=None)
-    return {k: cartesian.build_cartesian_task(cfg, ctx) for k, cfg in CONFIGS.items()}
+    return {k: registry.tasks.build(cfg, ctx) for k, cfg in CONFIGS.items()}
 
 
 @pytest.fixture(scope="module")
@@ -124,7 +127,7 @@ def test_envelope_covers_every_reaching_target(tasks):
 def test_ik_is_cached_on_disk(cache, tasks, monkeypatch):
     files = [f for f in cache.glob("ik_circle_*.npz") if not f.name.startswith("ik_circle_eight")]
     assert len(files) == 1
-    monkeypatch.setattr(cartesian, "solve_paths", lambda cfg: pytest.fail("IK was re-run despite the cache"))
-    again = cartesian.build_cartesian_task(CONFIGS["circle"], SimpleNamespace(cache_dir=cache))
+    monkeypatch.setattr(cartesian, "solve_paths", lambda *a: pytest.fail("IK was re-run despite the cache"))
+    again = registry.tasks.build(CONFIGS["circle"], SimpleNamespace(cache_dir=cache))
     np.testing.assert_array_equal(again._q, tasks["circle"]._q)
     assert cartesian.cache_key(T.CircleTask(radius_m=0.1)) != cartesian.cache_key(CONFIGS["circle"])

@@ -11,11 +11,11 @@ from cerebx.schema import task as t
 from cerebx.schema.ann import ANNController
 
 registry.tasks.register(t.JointSineTask, "cerebx.tasks.joint_sine:JointSine")
-registry.tasks.register(t.CircleTask, "cerebx.tasks.cartesian:build_cartesian_task")
-registry.tasks.register(t.EightTask, "cerebx.tasks.cartesian:build_cartesian_task")
-registry.tasks.register(t.InclinedCircleTask, "cerebx.tasks.cartesian:build_cartesian_task")
-registry.tasks.register(t.CircleEightTask, "cerebx.tasks.cartesian:build_cartesian_task")
-registry.tasks.register(t.ReachingTask, "cerebx.tasks.cartesian:build_cartesian_task")
+registry.tasks.register(t.CircleTask, "cerebx.tasks.cartesian:build_circle")
+registry.tasks.register(t.EightTask, "cerebx.tasks.cartesian:build_eight")
+registry.tasks.register(t.InclinedCircleTask, "cerebx.tasks.cartesian:build_inclined_circle")
+registry.tasks.register(t.CircleEightTask, "cerebx.tasks.cartesian:build_circle_eight")
+registry.tasks.register(t.ReachingTask, "cerebx.tasks.cartesian:build_reaching")
 
 registry.plants.register(p.Planar2Config, "cerebx.plants.planar2:Planar2Arm")
 registry.plants.register(p.BaxterConfig, "cerebx.plants.baxter:BaxterArm")

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, ClassVar, Literal
 
+import numpy as np
 from pydantic import Field, model_validator
 
 from cerebx.registry import Plugin
@@ -83,6 +84,16 @@ class GivenRanges(Strict):
                 raise ValueError(f"{lo_name} must be below {hi_name} (empty range at joint {bad[0]})")
         return self
 
+    def bounds(self, n_joints: int, task: Any = None) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi), each (n_joints, 4) for q_d, q, qd_d, qd: as configured (q_d and q share the
+        position range, as in the original)."""
+        if min(len(self.q_min), len(self.qd_min), len(self.qd_des_min)) < n_joints:
+            raise ValueError(f"controller ranges: given ranges cover fewer than the {n_joints} controlled joints")
+        qlo, qhi = np.asarray(self.q_min, float), np.asarray(self.q_max, float)
+        lo = np.stack([qlo, qlo, np.asarray(self.qd_des_min, float), np.asarray(self.qd_min, float)], axis=1)
+        hi = np.stack([qhi, qhi, np.asarray(self.qd_des_max, float), np.asarray(self.qd_max, float)], axis=1)
+        return lo[:n_joints], hi[:n_joints]
+
 
 class TaskRanges(Strict):
     """Encoder ranges from the task's desired trajectory, widened by ``margin`` of the span."""
@@ -90,6 +101,22 @@ class TaskRanges(Strict):
     kind: Literal["from_task"] = "from_task"
     margin: NonNegFloat = 0.1
     velocity_margin: NonNegFloat = 0.1
+
+    def bounds(self, n_joints: int, task: Any = None) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi), each (n_joints, 4) for q_d, q, qd_d, qd: the task's desired envelope widened by
+        ``margin`` (positions) and ``velocity_margin`` (velocities) of its span; actual and desired
+        share the range."""
+        if task is None:
+            raise ValueError("controller ranges: 'from_task' needs a task to derive the encoder ranges")
+        q_min, q_max, qd_min, qd_max = (np.asarray(a, dtype=float)[:n_joints] for a in task.envelope())
+        qlo, qhi = _widen(q_min, q_max, self.margin)
+        vlo, vhi = _widen(qd_min, qd_max, self.velocity_margin)
+        return np.stack([qlo, qlo, vlo, vlo], axis=1), np.stack([qhi, qhi, vhi, vhi], axis=1)
+
+
+def _widen(a: np.ndarray, b: np.ndarray, margin: float) -> tuple[np.ndarray, np.ndarray]:
+    span = np.maximum(b - a, 1e-3)
+    return a - margin * span, b + margin * span
 
 
 class BoxEncoder(Strict):

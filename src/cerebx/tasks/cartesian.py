@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -40,37 +41,50 @@ def min_jerk(s: np.ndarray) -> np.ndarray:
     return s**3 * (10 - 15 * s + 6 * s**2)
 
 
-def cartesian_offsets(cfg: Any) -> list[np.ndarray]:
-    """Desired end-effector offsets from the centre, (steps, 3) per trial variant."""
-    steps = int(round(cfg.period_s / CONTROL_DT_S))
-    t = np.arange(steps) * CONTROL_DT_S
-    r, period = cfg.radius_m, cfg.period_s
-    if cfg.kind == "circle":
-        return [_circle(t, period, r)]
-    if cfg.kind == "eight":
-        return [_eight(t, period, r)]
-    if cfg.kind == "inclined_circle":
-        c = _circle(t, period, r)
-        tilt = np.deg2rad(cfg.tilt_deg)
-        c[:, 2] = c[:, 0] * np.sin(tilt)
-        c[:, 0] *= np.cos(tilt)
-        return [c]
-    if cfg.kind == "circle_eight":
-        # The circle starts at its top point (centre + (0, R)) where the eight starts; the eight runs
-        # in the reverse direction so position, velocity and acceleration join continuously.
-        half = steps // 2
-        th = t[:half]
-        return [np.concatenate([_circle(th, period / 2, r, np.pi / 2), _eight(th, period / 2, r, -1.0)])]
-    if cfg.kind == "reaching":
-        n_out = int(round(cfg.out_s / CONTROL_DT_S))
-        n_back = steps - n_out
-        s = np.concatenate([min_jerk(np.arange(n_out) / n_out), 1.0 - min_jerk(np.arange(n_back) / n_back)])
-        out = []
-        for k in range(cfg.targets):
-            a = np.pi + 2 * np.pi * k / cfg.targets
-            out.append(s[:, None] * np.array([r * np.cos(a), r * np.sin(a), 0.0]))
-        return out
-    raise ValueError(f"unknown Cartesian task kind {cfg.kind!r}")
+def _steps(cfg: Any) -> np.ndarray:
+    return np.arange(int(round(cfg.period_s / CONTROL_DT_S))) * CONTROL_DT_S
+
+
+def circle_offsets(cfg: Any) -> list[np.ndarray]:
+    return [_circle(_steps(cfg), cfg.period_s, cfg.radius_m)]
+
+
+def eight_offsets(cfg: Any) -> list[np.ndarray]:
+    return [_eight(_steps(cfg), cfg.period_s, cfg.radius_m)]
+
+
+def inclined_circle_offsets(cfg: Any) -> list[np.ndarray]:
+    c = _circle(_steps(cfg), cfg.period_s, cfg.radius_m)
+    tilt = np.deg2rad(cfg.tilt_deg)
+    c[:, 2] = c[:, 0] * np.sin(tilt)
+    c[:, 0] *= np.cos(tilt)
+    return [c]
+
+
+def circle_eight_offsets(cfg: Any) -> list[np.ndarray]:
+    """The circle starts at its top point (centre + (0, R)) where the eight starts; the eight runs
+    in the reverse direction so position, velocity and acceleration join continuously."""
+    t = _steps(cfg)
+    th = t[: len(t) // 2]
+    r, half = cfg.radius_m, cfg.period_s / 2
+    return [np.concatenate([_circle(th, half, r, np.pi / 2), _eight(th, half, r, -1.0)])]
+
+
+def reaching_offsets(cfg: Any) -> list[np.ndarray]:
+    """One out-and-back path per target, evenly spaced on a circle of ``radius_m``."""
+    steps = len(_steps(cfg))
+    n_out = int(round(cfg.out_s / CONTROL_DT_S))
+    n_back = steps - n_out
+    s = np.concatenate([min_jerk(np.arange(n_out) / n_out), 1.0 - min_jerk(np.arange(n_back) / n_back)])
+    r = cfg.radius_m
+    out = []
+    for k in range(cfg.targets):
+        a = np.pi + 2 * np.pi * k / cfg.targets
+        out.append(s[:, None] * np.array([r * np.cos(a), r * np.sin(a), 0.0]))
+    return out
+
+
+Offsets = Callable[[Any], list[np.ndarray]]
 
 
 def periodic_derivative(q: np.ndarray, dt: float) -> np.ndarray:
@@ -78,7 +92,7 @@ def periodic_derivative(q: np.ndarray, dt: float) -> np.ndarray:
     return (np.roll(q, -1, 0) - np.roll(q, 1, 0)) / (2 * dt)
 
 
-def solve_paths(cfg: Any) -> dict[str, np.ndarray]:
+def solve_paths(cfg: Any, offsets_of: Offsets) -> dict[str, np.ndarray]:
     """Run IK for every variant of ``cfg``: arrays q (V, steps, 6), xyz (V, steps, 3), errors."""
     model = mujoco.MjModel.from_xml_string(kinematic_mjcf())
     lo = np.array([r[0] for r in JOINT_RANGE])
@@ -87,7 +101,7 @@ def solve_paths(cfg: Any) -> dict[str, np.ndarray]:
     home = np.asarray(cfg.home_q_rad, dtype=float)
     centre, rot = ik.fk(home)
     qs, xyzs = [], []
-    for offsets in cartesian_offsets(cfg):
+    for offsets in offsets_of(cfg):
         xyz = centre + offsets
         q = np.empty((len(xyz), 6))
         prev = home
@@ -104,10 +118,10 @@ def cache_key(cfg: Any) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 
-def load_or_solve(cfg: Any, cache_dir: Path | None) -> dict[str, np.ndarray]:
+def load_or_solve(cfg: Any, cache_dir: Path | None, offsets_of: Offsets) -> dict[str, np.ndarray]:
     """Joint paths from the cache, or solved and written there (atomically)."""
     if cache_dir is None:
-        return solve_paths(cfg)
+        return solve_paths(cfg, offsets_of)
     path = Path(cache_dir) / f"ik_{cfg.kind}_{cache_key(cfg)}.npz"
     if path.exists():
         try:
@@ -115,7 +129,7 @@ def load_or_solve(cfg: Any, cache_dir: Path | None) -> dict[str, np.ndarray]:
                 return {k: f[k] for k in f.files}
         except (OSError, ValueError):
             pass
-    data = solve_paths(cfg)
+    data = solve_paths(cfg, offsets_of)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(f".{np.random.default_rng().integers(1 << 30)}.tmp.npz")
     np.savez(tmp, **data)
@@ -163,7 +177,17 @@ class CartesianTask(Task):
         return q.min(0), q.max(0), qd.min(0), qd.max(0)
 
 
-def build_cartesian_task(cfg: Any, ctx: Any = None) -> CartesianTask:
-    """Registry builder for circle, eight, inclined_circle, circle_eight and reaching."""
-    cache = getattr(ctx, "cache_dir", None) if ctx is not None else None
-    return CartesianTask(cfg, load_or_solve(cfg, cache))
+def _builder(offsets_of: Offsets) -> Callable[[Any, Any], CartesianTask]:
+    def build(cfg: Any, ctx: Any = None) -> CartesianTask:
+        cache = getattr(ctx, "cache_dir", None) if ctx is not None else None
+        return CartesianTask(cfg, load_or_solve(cfg, cache, offsets_of))
+
+    build.__doc__ = f"Registry builder: the Cartesian task whose path is ``{offsets_of.__name__}``."
+    return build
+
+
+build_circle = _builder(circle_offsets)
+build_eight = _builder(eight_offsets)
+build_inclined_circle = _builder(inclined_circle_offsets)
+build_circle_eight = _builder(circle_eight_offsets)
+build_reaching = _builder(reaching_offsets)
