@@ -154,3 +154,18 @@ def test_mismatched_stages_refused_with_one_line(muscle_plugin, load, capsys, tm
         "provides only joint.torque[2], joint.q[2], joint.qd[2]"]
     code = main(["run", *DEMO, "robot=[{kind: hold}, {kind: reflex_test}]", "hydra.run.dir=" + str(tmp_path / "r")])
     assert code == 2 and not (tmp_path / "r").exists()
+
+
+def test_body_slots_run_after_the_receiver_before_the_robot_list(muscle_plugin, load, tmp_path):
+    from cerebx.stages.base import wire
+
+    cfg = load([*DEMO, "trials=1", "plant.kind=muscle_arm_test", "+muscle={kind: split_test}",
+                "robot=[{kind: mean}]"])
+    wiring = wire(cfg)
+    assert wiring.receiver.kind == "mean" and [s.kind for s in wiring.robot] == ["split_test"]
+    s = run_experiment(cfg, tmp_path)
+    assert s["status"] == "completed", s
+    # a stage in the muscle slot reads what the link gives; the slot cannot hold a receiver
+    with pytest.raises(ConfigError) as err:
+        load([*DEMO, "+muscle={kind: hold}"])
+    assert err.value.problems == ["muscle: stage 'hold' cannot stand between the receiver and the plant"]

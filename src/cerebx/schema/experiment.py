@@ -53,6 +53,10 @@ def tuple_union(types: tuple[type, ...]) -> Any:
     return out
 
 
+BODY_SLOTS = ("spinal", "muscle")
+"""Named robot-side stage slots, in the order they run between the receiver and the ``robot`` list."""
+
+
 class _ExperimentBase(Strict):
     """Top-level keys shared by every experiment."""
 
@@ -68,6 +72,12 @@ class _ExperimentBase(Strict):
     robot: list[Plugin("stage")] = Field(
         default_factory=list, description="robot-side stages after the link, in order; the first may be a receiver "
         "(hold, mean, future_past: what to apply from the samples that arrived), else the newest sample is held")
+    spinal: Plugin("stage") | None = Field(
+        None, description="robot-side stage right after the receiver standing for the spinal cord (e.g. reflexes "
+        "between the cerebellum's commands and the muscles); null: none")
+    muscle: Plugin("stage") | None = Field(
+        None, description="robot-side stage after the spinal cord standing for the muscles (e.g. an antagonist "
+        "muscle law turning agonist/antagonist commands into joint torques); null: the commands drive the plant")
     init_from: str | None = Field(None, description="run folder whose learned state starts this run")
     warmup_trials: int = Field(
         0, ge=0, description="the first trials let a learned controller settle onto the path; they are run and "
@@ -95,6 +105,13 @@ class _ExperimentBase(Strict):
                     problems.append(f"{side}.{i}: stage {st.kind!r} runs on the {' or '.join(st.sides)} side")
                 elif st.receiver and not (side == "robot" and i == 0):
                     problems.append(f"{side}.{i}: {st.kind!r} is a receiver; it can only be the first robot stage")
+        for slot in BODY_SLOTS:
+            st = getattr(self, slot)
+            if st is None:
+                continue
+            problems += _per_joint_lengths(st, slot, n)
+            if "robot" not in st.sides or st.receiver:
+                problems.append(f"{slot}: stage {st.kind!r} cannot stand between the receiver and the plant")
         plant_cls = registry.plants[plant.kind].resolve()
         for i, ev in enumerate(self.events):
             method = getattr(ev.action, "plant_method", None)

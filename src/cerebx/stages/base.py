@@ -114,7 +114,8 @@ def check_chain(side: Side, source: str, available: dict[str, Signal],
 
 @dataclass(frozen=True)
 class Wiring:
-    """The signal graph of an experiment: what crosses the link and which robot stages follow the receiver."""
+    """The signal graph of an experiment: what crosses the link and which robot stages follow the receiver
+    (the ``spinal`` and ``muscle`` slots first, then the ``robot`` list)."""
 
     sent: tuple[Signal, ...]
     receiver: Any  # the receiver's config (hold when none is listed)
@@ -126,6 +127,7 @@ def wire(exp: Any) -> Wiring:
     what it reads, and the robot side ends with the plant's command signals. One ConfigError line on
     the first mismatch."""
     from cerebx import registry
+    from cerebx.schema.experiment import BODY_SLOTS
 
     plant = exp.plant
     n = plant.n_joints
@@ -138,8 +140,12 @@ def wire(exp: Any) -> Wiring:
 
     robot_cfg = list(exp.robot)
     receiver = robot_cfg.pop(0) if robot_cfg and robot_cfg[0].receiver else registry.stages.parse({"kind": "hold"})
-    robot = [(f"robot stage {i + 1 if exp.robot and exp.robot[0].receiver else i} ({s.kind})", s.io(n))
-             for i, s in enumerate(robot_cfg)]
+    first = 1 if exp.robot and exp.robot[0].receiver else 0
+    body = [(slot, getattr(exp, slot, None)) for slot in BODY_SLOTS]
+    body = [(slot, s) for slot, s in body if s is not None]
+    robot = [(f"{slot} ({s.kind})", s.io(n)) for slot, s in body]
+    robot += [(f"robot stage {i + first} ({s.kind})", s.io(n)) for i, s in enumerate(robot_cfg)]
+    robot_cfg = [s for _, s in body] + robot_cfg
     needed = set(commands) | {r for _, io in robot for r in io.reads}
     sent = tuple(dict.fromkeys(have[w] for w in written if w in needed and w not in sensors))
     if not sent:
