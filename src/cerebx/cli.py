@@ -75,7 +75,8 @@ def _validate(args: list[str]) -> int:
 
 
 def _inspect(args: list[str]) -> int:
-    from cerebx.recording.reader import channel_counts, mcap_path, read_summary
+    """The run's summary and its channels; a bad summary or log is one line each, the other still shown."""
+    from cerebx.recording.reader import channel_counts, has_summary, mcap_path, read_summary
     from cerebx.report.console import format_summary
 
     if len(args) != 1:
@@ -84,17 +85,24 @@ def _inspect(args: list[str]) -> int:
     if not p.exists():
         return _fail([f"{p}: no such file or folder"])
     run_dir = p if p.is_dir() else p.parent
-    try:
-        if (run_dir / "summary.json").exists():
+    problems: list[str] = []
+    if (run_dir / "summary.json").exists() or p.is_dir():
+        try:
             print(format_summary(read_summary(run_dir), run_dir))
-        counts = channel_counts(mcap_path(p))
-    except CerebxError as err:
-        return _fail([str(err)])
-    width = max(map(len, counts), default=10)
-    print(f"\n{mcap_path(p)}")
-    for topic, n in counts.items():
-        print(f"  {topic:<{width}}  {n:>9,}")
-    return 0
+        except CerebxError as err:
+            problems.append(str(err))
+    log = mcap_path(p)
+    try:
+        counts = channel_counts(log)
+        width = max(map(len, counts), default=10)
+        closed = has_summary(log)
+        print(f"\n{log}" + ("" if closed else "  (no summary section: counted by scanning up to the last "
+                                                "complete record; the run was killed or is still going)"))
+        for topic, n in counts.items():
+            print(f"  {topic:<{width}}  {n:>9,}")
+    except (CerebxError, OSError) as err:
+        problems.append(str(err) if isinstance(err, CerebxError) else f"{log}: {err.strerror}")
+    return _fail(problems) if problems else 0
 
 
 def _bench(args: list[str]) -> int:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import logging
-import os
 import signal
 import sys
 import time
@@ -18,8 +17,9 @@ from cerebx import __version__
 from cerebx.build import build_components
 from cerebx.errors import CerebxError, Diverged
 from cerebx.loop.loop import ClosedLoop
-from cerebx.metrics import final_mae
 from cerebx.recording.recorder import Recorder
+from cerebx.recording.sentinel import Sentinel
+from cerebx.recording.summary import new_summary, trial_fields, write_summary
 
 log = logging.getLogger("cerebx")
 
@@ -53,12 +53,6 @@ def _progress(cfg, total: int):
                 dynamic_ncols=True)
 
 
-def _write_json_atomic(path: Path, data: dict) -> None:
-    tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(data, indent=2))
-    os.replace(tmp, path)
-
-
 def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
                    overrides: list[str] | None = None, choices: dict[str, str] | None = None) -> dict:
     """Run ``cfg`` into ``run_dir``: writes run.mcap, summary.json and the controller state."""
@@ -66,15 +60,10 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
     run_dir.mkdir(parents=True, exist_ok=True)
     started = time.time()
     wall0 = time.perf_counter()
-    summary: dict[str, Any] = {
-        "status": "failed", "task": cfg.task.kind, "controller": cfg.controller.kind,
-        "plant": cfg.plant.kind, "delay": cfg.delay.kind, "network": cfg.network.name,
-        "seed": cfg.seed, "trials": cfg.trials, "warmup_trials": cfg.warmup_trials, "trials_completed": 0,
-        "mae_per_trial": [],
-        "final_mae": None, "sim_seconds": 0.0, "wall_seconds": 0.0, "rt_factor": None,
-        "version": __version__, "overrides": list(overrides or []), "started_at": started, "error": None,
-        "presets": dict(choices or {}),
-    }
+    summary = new_summary(cfg, version=__version__, overrides=list(overrides or []), started_at=started,
+                          presets=dict(choices or {}))
+    write_summary(run_dir, summary)
+    sentinel = Sentinel(run_dir)  # finishes run.mcap and summary.json if this process is hard-killed
     rec = Recorder(run_dir / "run.mcap", chunk_size_kb=cfg.recording.chunk_size_kb,
                    compression=cfg.recording.compression)
     rec.metadata("cerebx", {"version": __version__, "overrides": json.dumps(list(overrides or []))})
@@ -99,6 +88,8 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
                 if bar is not None:
                     bar.set_postfix_str(f"trial {trial + 1}/{cfg.trials}  MAE {m.mae:.4f} rad")
                     bar.update(1)
+                summary.update(trial_fields(loop.metrics, loop.sim_seconds), wall_seconds=time.perf_counter() - wall0)
+                write_summary(run_dir, summary)
             summary["status"] = "completed"
     except KeyboardInterrupt:
         summary["status"] = "interrupted"
@@ -107,27 +98,18 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
         summary["status"] = "diverged"
         summary["error"] = str(err)
     except CerebxError as err:
-        summary["error"] = str(err)
+        summary["status"], summary["error"] = "failed", str(err)
     except Exception as err:  # record any crash, then re-raise for the caller's exit code
-        summary["error"] = f"{type(err).__name__}: {err}"
+        summary["status"], summary["error"] = "failed", f"{type(err).__name__}: {err}"
         summary["traceback"] = traceback.format_exc()
     finally:
         if bar is not None:
             bar.close()
+        if summary["status"] == "running":  # left by an exception that is not an Exception (SystemExit)
+            summary["status"] = "failed"
         wall = time.perf_counter() - wall0
         if loop is not None:
-            ms = loop.metrics
-            mae = [m.mae for m in ms]
-            summary.update({
-                "trials_completed": loop.trials_done,
-                "mae_per_trial": mae,
-                "mae_per_joint_per_trial": [list(m.mae_per_joint) for m in ms],
-                "vel_mae_per_trial": [m.vel_mae for m in ms],
-                "torque_variability_per_trial": [m.torque_variability_Nm_per_ms for m in ms],
-                "ee_error_per_trial": [m.ee_error_m for m in ms],
-                "final_mae": final_mae(mae),
-                "sim_seconds": loop.sim_seconds,
-            })
+            summary.update(trial_fields(loop.metrics, loop.sim_seconds))
             if cfg.recording.save_state and loop.trials_done > 0:
                 try:
                     loop.controller.save_state(run_dir / STATE_FILE)
@@ -139,5 +121,6 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             rec.metadata("summary", {"json": json.dumps(summary)})
         finally:
             rec.close()
-            _write_json_atomic(run_dir / "summary.json", summary)
+            write_summary(run_dir, summary)
+            sentinel.done()
     return summary

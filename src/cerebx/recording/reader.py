@@ -11,6 +11,9 @@ from mcap.decoder import DecoderFactory
 from mcap.reader import make_reader
 
 from cerebx.errors import CerebxError
+from cerebx.recording.summary import read_summary
+
+__all__ = ["channel_counts", "mcap_path", "read_messages", "read_metadata", "read_summary"]
 
 
 def _short(err: Exception) -> str:
@@ -38,6 +41,7 @@ def _reader(fh):
 
 
 def _has_summary(fh) -> bool:
+    """Whether the file ends in a footer that points to a summary section (a cleanly closed file)."""
     try:
         return make_reader(fh).get_summary() is not None
     except Exception:
@@ -46,22 +50,41 @@ def _has_summary(fh) -> bool:
         fh.seek(0)
 
 
-def _stream_messages(fh, topics: list[str] | None) -> Iterator[tuple[str, int, Any]]:
-    """Every complete message of a file without a summary (a run in progress or hard-killed)."""
-    from mcap.records import Channel, Message
+def _scan(fh) -> Iterator[Any]:
+    """Every complete record of a file read front to back, for a file without a summary (a run in
+    progress, or one hard-killed): stops quietly at an incomplete tail, raises for a file that is not MCAP."""
     from mcap.stream_reader import StreamReader
 
-    channels: dict[int, Channel] = {}
+    records = StreamReader(fh, skip_magic=False).records
     try:
-        for rec in StreamReader(fh, skip_magic=False).records:
-            if isinstance(rec, Channel):
-                channels[rec.id] = rec
-            elif isinstance(rec, Message):
-                ch = channels.get(rec.channel_id)
-                if ch is not None and (topics is None or ch.topic in topics) and ch.message_encoding == "json":
+        first = next(records)
+    except Exception as err:
+        raise CerebxError(f"{fh.name}: not an MCAP file ({_short(err)})") from None
+    yield first
+    while True:
+        try:
+            rec = next(records)
+        except StopIteration:
+            return
+        except Exception:  # the incomplete tail: stop at the last complete record
+            return
+        yield rec
+
+
+def _stream_messages(fh, topics: list[str] | None) -> Iterator[tuple[str, int, Any]]:
+    from mcap.records import Channel, Message
+
+    channels: dict[int, Channel] = {}
+    for rec in _scan(fh):
+        if isinstance(rec, Channel):
+            channels[rec.id] = rec
+        elif isinstance(rec, Message):
+            ch = channels.get(rec.channel_id)
+            if ch is not None and (topics is None or ch.topic in topics) and ch.message_encoding == "json":
+                try:
                     yield ch.topic, rec.log_time, json.loads(rec.data)
-    except Exception:  # the incomplete tail: stop at the last complete record
-        return
+                except ValueError:  # a message that is not JSON: skipped like the incomplete tail
+                    continue
 
 
 def read_messages(path: Path | str, topics: list[str] | None = None, start_ns: int | None = None,
@@ -92,11 +115,22 @@ def read_messages(path: Path | str, topics: list[str] | None = None, start_ns: i
 
 
 def channel_counts(path: Path | str) -> dict[str, int]:
-    """Message count per topic, from the file's summary section."""
+    """Message count per topic: from the file's summary section, or by scanning a file without one."""
+    from mcap.records import Channel, Message
+
     p = mcap_path(path)
     if not p.exists():
         raise CerebxError(f"{p}: no such file")
     with open(p, "rb") as fh:
+        if not _has_summary(fh):
+            topics: dict[int, str] = {}
+            counts: dict[int, int] = {}
+            for rec in _scan(fh):
+                if isinstance(rec, Channel):
+                    topics[rec.id] = rec.topic
+                elif isinstance(rec, Message):
+                    counts[rec.channel_id] = counts.get(rec.channel_id, 0) + 1
+            return {topics[c]: n for c, n in sorted(counts.items()) if c in topics}
         try:
             summary = _reader(fh).get_summary()
         except CerebxError:
@@ -104,26 +138,28 @@ def channel_counts(path: Path | str) -> dict[str, int]:
         except Exception as err:
             raise CerebxError(f"{p}: damaged MCAP file ({_short(err)})") from None
         if summary is None or summary.statistics is None:
-            raise CerebxError(f"{p}: MCAP file has no summary (was the run killed?)")
+            raise CerebxError(f"{p}: MCAP summary has no statistics")
         return {summary.channels[cid].topic: n for cid, n in sorted(summary.statistics.channel_message_counts.items())}
 
 
+def has_summary(path: Path | str) -> bool:
+    """Whether the file was closed cleanly (its summary section is there)."""
+    with open(mcap_path(path), "rb") as fh:
+        return _has_summary(fh)
+
+
 def read_metadata(path: Path | str) -> dict[str, dict[str, str]]:
+    from mcap.records import Metadata
+
     p = mcap_path(path)
+    if not p.exists():
+        raise CerebxError(f"{p}: no such file")
     with open(p, "rb") as fh:
+        if not _has_summary(fh):
+            return {r.name: dict(r.metadata) for r in _scan(fh) if isinstance(r, Metadata)}
         try:
             return {m.name: dict(m.metadata) for m in _reader(fh).iter_metadata()}
         except CerebxError:
             raise
         except Exception as err:
             raise CerebxError(f"{p}: damaged MCAP file ({_short(err)})") from None
-
-
-def read_summary(run_dir: Path | str) -> dict[str, Any]:
-    p = Path(run_dir) / "summary.json"
-    try:
-        return json.loads(p.read_text())
-    except FileNotFoundError:
-        raise CerebxError(f"{p}: no such file (not a cerebx run folder?)") from None
-    except json.JSONDecodeError as err:
-        raise CerebxError(f"{p}: not valid JSON ({err})") from None

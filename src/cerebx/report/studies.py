@@ -9,7 +9,6 @@ trials is reused, anything else (missing, failed, interrupted) is run again. Job
 from __future__ import annotations
 
 import itertools
-import json
 import shutil
 import signal
 import subprocess
@@ -23,7 +22,7 @@ from pathlib import Path
 import yaml
 from pydantic import Field, ValidationError
 
-from cerebx.errors import ConfigError
+from cerebx.errors import CerebxError, ConfigError
 from cerebx.schema.base import Strict
 from cerebx.schema.experiment import format_errors
 
@@ -98,9 +97,11 @@ class Job:
         return out
 
     def done(self) -> bool:
+        from cerebx.recording.summary import read_summary
+
         try:
-            s = json.loads((self.run_dir / "summary.json").read_text())
-        except (OSError, json.JSONDecodeError):
+            s = read_summary(self.run_dir)
+        except CerebxError:
             return False
         return s.get("status") == "completed" and (s.get("trials_completed") or 0) >= self.trials
 
@@ -240,7 +241,9 @@ class _Scheduler:
             rc, why = 1, f"{type(err).__name__}: {err}"
         if rc == 0 and j.done():
             self.finished.add(j.name)
-            s = json.loads((j.run_dir / "summary.json").read_text())
+            from cerebx.recording.summary import read_summary
+
+            s = read_summary(j.run_dir)
             mae = s.get("final_mae")
             self.log(f"[{self._clock()}] done  {j.name}: final MAE {mae if mae is None else round(mae, 4)} rad, "
                      f"{s.get('wall_seconds', 0):.0f} s ({len(self.finished) - self.reused}/{len(self.todo)})")
