@@ -153,11 +153,11 @@ def test_inspect_prints_summary_and_channels(load, tmp_path, capsys):
     assert "status    completed" in out and "/joint_states/actual" in out and "1,000" in out
 
 
-def test_inspect_truncated_file_one_line(tmp_path, capsys, load):
+def test_inspect_file_that_is_not_mcap_one_line(tmp_path, capsys, load):
     run_experiment(load([*DEMO, "trials=1"]), tmp_path / "r")
     data = (tmp_path / "r" / "run.mcap").read_bytes()
     bad = tmp_path / "bad.mcap"
-    bad.write_bytes(data[: len(data) // 2])
+    bad.write_bytes(b"garbage!" + data[8: len(data) // 2])
     assert main(["inspect", str(bad)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "bad.mcap" in err[0]

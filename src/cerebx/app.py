@@ -7,11 +7,13 @@ from pathlib import Path
 
 import hydra
 from hydra.core.hydra_config import HydraConfig
+from hydra.types import RunMode
 from omegaconf import DictConfig
 
 from cerebx.config import to_plain, user_choices
 from cerebx.errors import ConfigError
 from cerebx.schema.experiment import validate
+from cerebx.sweep import ERROR_FILE
 
 
 @hydra.main(config_path="conf", config_name="config", version_base="1.3")
@@ -21,18 +23,22 @@ def run_app(cfg: DictConfig) -> float | None:
 
     hc = HydraConfig.get()
     run_dir = Path(hc.runtime.output_dir)
+    in_sweep = hc.mode == RunMode.MULTIRUN  # a sweep's job fails alone: the next job still runs
     try:
         plain = to_plain(cfg)
         exp = validate(plain)
     except ConfigError as err:
         for line in err.problems:
             print(line, file=sys.stderr)
+        if in_sweep:
+            (run_dir / ERROR_FILE).write_text("; ".join(err.problems) + "\n")
+            return None
         raise SystemExit(2) from None
     choices = user_choices(hc.runtime.choices)
     summary = run_experiment(exp, run_dir, plain, overrides=list(hc.overrides.task), choices=choices)
     print_summary(summary, run_dir)
-    if summary["status"] == "failed":
-        raise SystemExit(1)
     if summary["status"] == "interrupted":
         raise SystemExit(130)
+    if summary["status"] == "failed" and not in_sweep:
+        raise SystemExit(1)
     return summary["final_mae"]

@@ -51,9 +51,20 @@ def _run(args: list[str]) -> int:
             return _fail(problems)
     from cerebx.app import run_app
 
+    root = None
+    if multirun and not any(a in ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i") for a in args):
+        from cerebx.sweep import sweep_dir
+
+        root, args = sweep_dir(args)
     sys.argv = [sys.argv[0]] + args
     run_app()
-    return 0
+    if root is None:
+        return 0
+    from cerebx.sweep import MAX_EXIT_CODE, table
+
+    lines, failed = table(root)
+    print("\n".join(lines), file=sys.stderr if failed else sys.stdout)
+    return min(failed, MAX_EXIT_CODE)
 
 
 def _validate(args: list[str]) -> int:

@@ -1,0 +1,154 @@
+"""Every failure honest (issue #17): sweeps that survive a bad job, hard-killed runs that stay first-class,
+no code from configuration, one-line errors at the edges, limits and estimates."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from cerebx.cli import main
+from cerebx.controllers.pd import PD
+from cerebx.loop.runner import run_experiment
+from cerebx.recording.reader import channel_counts, read_messages, read_summary
+
+DEMO = ["+experiment=demo"]
+
+
+def _one_line(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    return err[0]
+
+
+# ---- a sweep survives a bad job ---------------------------------------------------------------------
+
+def test_sweep_runs_every_job_and_counts_the_failures(in_tmp, monkeypatch, capsys):
+    from cerebx.loop import runner
+
+    build = runner.build_components
+
+    def fail_for_seed_1(cfg, run_dir):
+        if cfg.seed == 1:
+            raise RuntimeError("state of another network")
+        return build(cfg, run_dir)
+
+    monkeypatch.setattr(runner, "build_components", fail_for_seed_1)
+    code = main(["run", "-m", *DEMO, "trials=1", "seed=1,2", "hydra.sweep.dir=sw"])
+    assert code == 1  # one job failed
+    bad, good = read_summary(in_tmp / "sw" / "0"), read_summary(in_tmp / "sw" / "1")
+    assert bad["status"] == "failed" and "state of another network" in bad["error"]
+    assert good["status"] == "completed" and good["trials_completed"] == 1
+    err = capsys.readouterr().err
+    assert "1 of 2 jobs completed, 1 failed (exit code 1)" in err
+    table = [ln for ln in err.splitlines() if ln.startswith(("0 ", "1 "))]
+    assert table[0].split()[:2] == ["0", "failed"] and table[1].split()[:2] == ["1", "completed"]
+
+
+def test_sweep_exit_code_is_the_number_of_failed_jobs(in_tmp, monkeypatch, capsys):
+    def boom(cfg, run_dir):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr("cerebx.loop.runner.build_components", boom)
+    assert main(["run", "-m", *DEMO, "trials=1", "seed=1,2,3", "hydra.sweep.dir=sw"]) == 3
+    assert [read_summary(in_tmp / "sw" / str(i))["status"] for i in range(3)] == ["failed"] * 3
+    assert "0 of 3 jobs completed, 3 failed" in capsys.readouterr().err
+
+
+# ---- a hard-killed run stays first-class ------------------------------------------------------------
+
+def _start(tmp_path: Path, *args: str) -> subprocess.Popen:
+    env = {**os.environ, "PYTHONUNBUFFERED": "1", "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+    return subprocess.Popen([sys.executable, "-m", "cerebx.cli", "run", *args], cwd=tmp_path, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def _wait_for(pred, seconds: float, what: str) -> None:
+    deadline = time.time() + seconds
+    while not pred():
+        assert time.time() < deadline, what
+        time.sleep(0.1)
+
+
+def _trials_done(run: Path) -> int:
+    try:
+        return json.loads((run / "summary.json").read_text()).get("trials_completed", 0)
+    except (OSError, ValueError):
+        return 0
+
+
+def test_sigkill_leaves_a_killed_run_the_standard_reader_reads(tmp_path, capsys):
+    from mcap.reader import make_reader
+
+    run = tmp_path / "run"
+    proc = _start(tmp_path, *DEMO, "trials=5000", "hydra.run.dir=run")
+    _wait_for(lambda: _trials_done(run) >= 3, 120, "the run did not finish 3 trials within 120 s")
+    assert json.loads((run / "summary.json").read_text())["status"] == "running"
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(timeout=30)
+    _wait_for(lambda: json.loads((run / "summary.json").read_text())["status"] != "running", 30,
+              "the sentinel did not mark the run")
+    s = read_summary(run)
+    assert s["status"] == "killed" and 3 <= s["trials_completed"] < 5000
+    assert len(s["mae_per_trial"]) == s["trials_completed"]
+    with open(run / "run.mcap", "rb") as fh:  # the standard seeking reader, as any MCAP tool uses it
+        topics = [ch.topic for _, ch, _ in make_reader(fh).iter_messages()]
+    # every trial the summary lists reached the log (chunks hold at most a few trials of this run)
+    assert topics.count("/trial_metrics") >= s["trials_completed"] - 2
+    assert topics.count("/control") >= 1000 * (s["trials_completed"] - 2)
+    assert channel_counts(run)["/control"] == topics.count("/control")
+    assert main(["inspect", str(run)]) == 0
+    out = capsys.readouterr().out
+    assert "status    killed" in out and f"trials    {s['trials_completed']}/5000" in out
+    assert main(["report", str(run), "--out", str(tmp_path / "rep"), "--figures", "fig3_4"]) == 0
+    rows = (tmp_path / "rep" / "runs.csv").read_text().splitlines()
+    assert rows[1].split(",")[1:2] == ["killed"] and f",{s['trials_completed']}," in rows[1]
+
+
+def test_a_running_summary_whose_process_is_gone_reads_as_killed(load, tmp_path):
+    run_experiment(load([*DEMO, "trials=1"]), tmp_path)
+    s = json.loads((tmp_path / "summary.json").read_text())
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    s.update(status="running", pid=dead.pid)
+    (tmp_path / "summary.json").write_text(json.dumps(s))
+    assert read_summary(tmp_path)["status"] == "killed"
+    s["pid"] = os.getpid()  # alive: still running
+    (tmp_path / "summary.json").write_text(json.dumps(s))
+    assert read_summary(tmp_path)["status"] == "running"
+
+
+def test_summary_says_running_while_the_run_goes(load, tmp_path, monkeypatch):
+    seen = []
+    original = PD.end_trial
+
+    def peek(self, trial):
+        seen.append(json.loads((tmp_path / "summary.json").read_text()))
+        return original(self, trial)
+
+    monkeypatch.setattr(PD, "end_trial", peek)
+    run_experiment(load([*DEMO, "trials=3"]), tmp_path)
+    assert [x["status"] for x in seen] == ["running"] * 3
+    assert [x["trials_completed"] for x in seen] == [0, 1, 2]
+    assert read_summary(tmp_path)["status"] == "completed"
+
+
+def test_an_unsealed_log_is_read_by_scanning_everywhere(load, tmp_path, capsys):
+    from cerebx.recording.reader import read_metadata
+
+    run_experiment(load([*DEMO, "trials=2"]), tmp_path / "r")
+    whole = (tmp_path / "r" / "run.mcap").read_bytes()
+    full = channel_counts(tmp_path / "r")
+    cut = tmp_path / "cut"
+    cut.mkdir()
+    (cut / "run.mcap").write_bytes(whole[: int(len(whole) * 0.7)])
+    counts = channel_counts(cut)
+    assert 0 < counts["/control"] < full["/control"]
+    assert sum(1 for _ in read_messages(cut, ["/control"])) == counts["/control"]
+    assert "config" in read_metadata(cut)
+    assert main(["inspect", str(cut / "run.mcap")]) == 0
+    assert "counted by scanning" in capsys.readouterr().out
