@@ -11,6 +11,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from cerebx.cli import main
 from cerebx.controllers.pd import PD
 from cerebx.loop.runner import run_experiment
@@ -152,3 +154,79 @@ def test_an_unsealed_log_is_read_by_scanning_everywhere(load, tmp_path, capsys):
     assert "config" in read_metadata(cut)
     assert main(["inspect", str(cut / "run.mcap")]) == 0
     assert "counted by scanning" in capsys.readouterr().out
+
+
+# ---- configuration never carries code ---------------------------------------------------------------
+
+CODE_ROUTES = [
+    ["+hydra.callbacks.e._target_=os.makedirs", "+hydra.callbacks.e._args_=[{dir}]"],  # the example
+    ["+hydra={{callbacks:{{e:{{_target_:os.makedirs,_args_:[{dir}]}}}}}}"],
+    ["+hydra/callbacks=anything"],
+    ["hydra/launcher=my_launcher"],
+    ["hydra/launcher=basic,my_launcher"],
+    ["+hydra.launcher._target_=os.makedirs"],
+    ["+controller.gains={{_target_:os.makedirs,_args_:[{dir}]}}"],
+    ["+extra=[1,{{_target_:os.makedirs}}]"],
+    ["+hydra.job.env_set.LD_PRELOAD=/tmp/x.so"],
+    ["hydra.searchpath=[file://{dir}]"],
+    ['+hydra.job_logging.handlers.h={{"()":os.makedirs}}'],
+    ["--experimental-rerun", "{dir}/config.pickle"],
+]
+
+
+@pytest.mark.parametrize("route", CODE_ROUTES, ids=lambda r: r[0][:40])
+def test_code_bearing_overrides_are_refused_before_hydra_acts(route, in_tmp, capsys):
+    made = in_tmp / "made_by_config"
+    args = [a.format(dir=made) for a in route]
+    assert main(["run", *DEMO, "trials=1", *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err and all(": " in ln for ln in err) and len(err) <= len(args)
+    assert not made.exists() and not (in_tmp / "runs").exists()
+    assert main(["validate", *DEMO, *args]) == 2
+
+
+def test_a_config_dir_preset_with_code_is_refused(in_tmp, capsys):
+    made = in_tmp / "made_by_config"
+    (in_tmp / "cd" / "experiment").mkdir(parents=True)
+    (in_tmp / "cd" / "experiment" / "evil.yaml").write_text(
+        f"# @package _global_\nhydra:\n  callbacks:\n    e:\n      _target_: os.makedirs\n      _args_: [{made}]\n")
+    assert main(["run", "--config-dir", str(in_tmp / "cd"), *DEMO, "+experiment=evil", "trials=1"]) == 2
+    line = _one_line(capsys)
+    assert "evil.yaml: hydra.callbacks" in line
+    assert not made.exists() and not (in_tmp / "runs").exists()
+    (in_tmp / "cd" / "hydra" / "launcher").mkdir(parents=True)
+    (in_tmp / "cd" / "experiment" / "evil.yaml").write_text("# @package _global_\ntrials: 1\n")
+    (in_tmp / "cd" / "hydra" / "launcher" / "mine.yaml").write_text("_target_: os.makedirs\n")
+    assert main(["run", "-cd", str(in_tmp / "cd"), *DEMO, "hydra/launcher=mine"]) == 2
+    err = capsys.readouterr().err
+    assert "mine.yaml: _target_" in err and "unknown launcher 'mine'" in err
+
+
+def test_a_package_preset_with_code_fails_validation(tmp_path, monkeypatch, capsys):
+    import shutil
+
+    from cerebx import guard
+
+    tree = tmp_path / "conf"
+    shutil.copytree(guard.CONF_ROOT, tree)
+    (tree / "experiment" / "evil.yaml").write_text(
+        "# @package _global_\ndefaults:\n  - override /hydra/launcher: mine\nhydra:\n  callbacks:\n"
+        "    e: {_target_: os.makedirs, _args_: [x]}\n")
+    monkeypatch.setattr(guard, "CONF_ROOT", tree)
+    guard._package_tree_problems.cache_clear()
+    try:
+        assert main(["validate", *DEMO]) == 2
+    finally:
+        guard._package_tree_problems.cache_clear()
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["conf/experiment/evil.yaml: defaults: unknown launcher 'mine' (installed: basic, joblib)",
+                   "conf/experiment/evil.yaml: hydra.callbacks: hydra.callbacks is not accepted (it runs code, adds "
+                   "config sources or sets the environment of every process)"]
+
+
+def test_the_shipped_presets_carry_no_code():
+    from cerebx import guard
+
+    assert guard.check_tree(guard.CONF_ROOT) == []
+    assert guard.check_overrides(["hydra/launcher=joblib", "hydra.launcher.n_jobs=2", "seed=1,2",
+                                  "hydra.run.dir=x", "+task=circle"]) == []

@@ -43,7 +43,11 @@ def _fail(lines: list[str]) -> int:
 
 def _run(args: list[str]) -> int:
     from cerebx.config import check
+    from cerebx.guard import check_args
 
+    problems = check_args(args)  # before Hydra reads any of it, whatever the flags
+    if problems:
+        return _fail(problems)
     multirun = any(a in ("-m", "--multirun") for a in args)
     if not any(a.split("=")[0] in _PASS_THROUGH for a in args):
         problems = check([a for a in args if not a.startswith("-")], multirun=multirun)

@@ -67,6 +67,11 @@ def compose_with_choices(overrides: list[str]) -> tuple[DictConfig, dict[str, st
     from omegaconf import open_dict
     from omegaconf.errors import OmegaConfBaseException
 
+    from cerebx.guard import check_args
+
+    problems = check_args(overrides)
+    if problems:
+        raise ConfigError(problems)
     GlobalHydra.instance().clear()
     try:
         with initialize_config_module(config_module="cerebx.conf", version_base="1.3"):
