@@ -113,8 +113,8 @@ def test_sweep_is_checked_before_any_job(in_tmp, capsys):
 
 
 def test_config_cannot_import_code(load):
-    """A '_target_' or import path in config is just an unknown key, never executed."""
-    with pytest.raises(Exception, match="Extra inputs are not permitted"):
+    """A '_target_' in config is refused before Hydra composes anything (tests/test_honesty.py: every route)."""
+    with pytest.raises(Exception, match="controller._target_: names a Python callable"):
         load(["+task=circle", "+controller._target_=os.system"])
 
 

@@ -230,3 +230,53 @@ def test_the_shipped_presets_carry_no_code():
     assert guard.check_tree(guard.CONF_ROOT) == []
     assert guard.check_overrides(["hydra/launcher=joblib", "hydra.launcher.n_jobs=2", "seed=1,2",
                                   "hydra.run.dir=x", "+task=circle"]) == []
+
+
+# ---- init_from states are opened and fingerprinted at validation ------------------------------------
+
+SMALL = ["+task=circle", "+experiment=small_snn"]
+
+
+@pytest.fixture(scope="module")
+def small_state(tmp_path_factory):
+    """A run folder holding the learned state of one trial of the small SNN."""
+    from cerebx.config import load
+
+    d = tmp_path_factory.mktemp("small")
+    s = run_experiment(load([*SMALL, "trials=1"])[0], d)
+    assert s["status"] == "completed" and (d / "controller_state.npz").stat().st_size > 1000
+    return d
+
+
+def _damaged(tmp_path: Path, small_state: Path, how: str) -> Path:
+    data = (small_state / "controller_state.npz").read_bytes()
+    if how == "truncated":
+        data = data[: len(data) // 2]
+    elif how == "corrupt":
+        mid = len(data) // 2
+        data = data[:mid] + bytes(b ^ 0xFF for b in data[mid: mid + 64]) + data[mid + 64:]
+    elif how == "garbage":
+        data = b"not a state at all"
+    d = tmp_path / how
+    d.mkdir()
+    (d / "controller_state.npz").write_bytes(data)
+    return d
+
+
+@pytest.mark.parametrize("how", ["truncated", "corrupt", "garbage"])
+def test_a_damaged_state_is_refused_at_validation(how, small_state, in_tmp, capsys):
+    bad = _damaged(in_tmp, small_state, how)
+    assert main(["run", *SMALL, "trials=1", f"init_from={bad}"]) == 2
+    line = _one_line(capsys)
+    assert line.startswith("init_from: ") and "not a readable cerebx state" in line, line
+    assert not (in_tmp / "runs").exists()
+
+
+def test_a_state_of_another_network_is_refused_at_validation(small_state, in_tmp, capsys):
+    assert main(["run", "+task=circle", "trials=1", f"init_from={small_state}"]) == 2
+    line = _one_line(capsys)
+    assert "fingerprint" in line and "'thesis_ch3'" in line and not (in_tmp / "runs").exists()
+    assert main(["validate", *SMALL, f"init_from={small_state}"]) == 0  # the same network is fine
+    capsys.readouterr()
+    assert main(["validate", "+task=circle", "controller=ann", f"init_from={small_state}"]) == 2
+    assert "is not an ANN state" in _one_line(capsys)

@@ -47,7 +47,7 @@ def test_pipelined_network_gives_identical_results(load):
 
 
 def test_init_from_other_network_is_one_clear_error(load, tmp_path, capsys):
-    """A learned state from a different network is refused with one line, and the run says so."""
+    """A learned state from a different network is refused at validation with one line."""
     from cerebx.loop.runner import run_experiment
 
     first = run_experiment(load(["+task=circle", "+experiment=small_snn", "trials=1"]), tmp_path / "small")
@@ -56,10 +56,12 @@ def test_init_from_other_network_is_one_clear_error(load, tmp_path, capsys):
                 f"init_from={tmp_path / 'small'}"])
     same = run_experiment(cfg, tmp_path / "same")  # same structure, other weights: allowed
     assert same["status"] == "completed"
-    cfg = load(["+task=circle", "trials=1", f"init_from={tmp_path / 'small'}"])
-    other = run_experiment(cfg, tmp_path / "other")
-    assert other["status"] == "failed"
-    assert "different structure" in other["error"] and "\n" not in other["error"]
+    from cerebx.errors import ConfigError
+
+    with pytest.raises(ConfigError) as err:  # refused at validation: no run folder is made
+        load(["+task=circle", "trials=1", f"init_from={tmp_path / 'small'}"])
+    assert len(err.value.problems) == 1 and "fingerprint" in err.value.problems[0]
+    assert err.value.problems[0].startswith("init_from: ") and not (tmp_path / "other").exists()
 
 
 @pytest.mark.slow

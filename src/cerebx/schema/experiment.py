@@ -128,11 +128,9 @@ class _ExperimentBase(Strict):
         if self.warmup_trials >= self.trials:
             problems.append(f"warmup_trials: {self.warmup_trials} leaves no measured trial of {self.trials}")
         if self.init_from is not None:
-            from pathlib import Path
+            from cerebx.schema.init_state import init_from_problems
 
-            state = Path(self.init_from) / "controller_state.npz"
-            if not state.is_file():
-                problems.append(f"init_from: {state} does not exist (give a run folder that saved its state)")
+            problems += init_from_problems(self)
         if problems:
             raise ValueError("; ".join(problems))
         return self
