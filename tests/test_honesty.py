@@ -280,3 +280,42 @@ def test_a_state_of_another_network_is_refused_at_validation(small_state, in_tmp
     capsys.readouterr()
     assert main(["validate", "+task=circle", "controller=ann", f"init_from={small_state}"]) == 2
     assert "is not an ANN state" in _one_line(capsys)
+
+
+# ---- run-folder problems and bad summaries: one line -------------------------------------------------
+
+@pytest.mark.parametrize("folder", ["/proc/cerebx_x", "a_file", "a_file/sub"])
+def test_a_run_folder_that_cannot_be_made_is_one_line(folder, in_tmp, capsys):
+    (in_tmp / "a_file").write_text("x")
+    assert main(["run", *DEMO, "trials=1", f"hydra.run.dir={folder}"]) == 2
+    line = _one_line(capsys)
+    assert line.startswith(f"hydra.run.dir: {folder}") and not Path("/proc/cerebx_x").exists()
+    assert main(["run", "-m", *DEMO, "trials=1", "seed=1,2", f"hydra.sweep.dir={folder}"]) == 2
+    assert _one_line(capsys).startswith(f"hydra.sweep.dir: {folder}")
+    assert sorted(p.name for p in in_tmp.iterdir()) == ["a_file"]
+
+
+@pytest.mark.parametrize("change", [{"final_mae": "banana"}, {"task": None}, {"trials": -3}, {"status": "odd"}])
+def test_a_wrong_shaped_summary_is_one_line_and_the_report_is_built(change, load, tmp_path, capsys):
+    good, bad = tmp_path / "runs" / "good", tmp_path / "runs" / "bad"
+    for d in (good, bad):
+        run_experiment(load([*DEMO, "trials=1"]), d)
+    s = json.loads((bad / "summary.json").read_text())
+    s.update(change)
+    s = {k: v for k, v in s.items() if v is not None}
+    (bad / "summary.json").write_text(json.dumps(s))
+    key = next(iter(change))
+    assert main(["inspect", str(bad)]) == 2
+    captured = capsys.readouterr()
+    assert f"summary.json: {key}: " in _one_line_of(captured.err) and "/control" in captured.out
+    code = main(["report", str(tmp_path / "runs"), "--out", str(tmp_path / "rep"), "--figures", "fig3_4"])
+    err = capsys.readouterr().err
+    assert code == 0 and f"bad/summary.json: {key}: " in err
+    rows = (tmp_path / "rep" / "runs.csv").read_text().splitlines()
+    assert len(rows) == 2 and "good" in rows[1]
+
+
+def _one_line_of(err: str) -> str:
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, lines
+    return lines[0]

@@ -33,6 +33,7 @@ COMMANDS = ("run", "validate", "inspect", "bench", "report", "tune")
 _PASS_THROUGH = ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i", "--resolve",
                  "--package", "-p", "-sc", "--shell-completion", "--config-dir", "-cd",
                  "--config-name", "-cn", "--config-path", "-cp", "--experimental-rerun")
+_INFO = ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i", "-sc", "--shell-completion")
 
 
 def _fail(lines: list[str]) -> int:
@@ -42,13 +43,18 @@ def _fail(lines: list[str]) -> int:
 
 
 def _run(args: list[str]) -> int:
-    from cerebx.config import check
+    from cerebx.config import check, check_output_dir
     from cerebx.guard import check_args
 
     problems = check_args(args)  # before Hydra reads any of it, whatever the flags
     if problems:
         return _fail(problems)
     multirun = any(a in ("-m", "--multirun") for a in args)
+    runs = not any(a.split("=")[0] in _INFO for a in args)  # --help, --cfg ... make no folder
+    if runs:
+        problems = check_output_dir(args, multirun)
+        if problems:
+            return _fail(problems)
     if not any(a.split("=")[0] in _PASS_THROUGH for a in args):
         problems = check([a for a in args if not a.startswith("-")], multirun=multirun)
         if problems:
@@ -56,7 +62,7 @@ def _run(args: list[str]) -> int:
     from cerebx.app import run_app
 
     root = None
-    if multirun and not any(a in ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i") for a in args):
+    if multirun and runs:
         from cerebx.sweep import sweep_dir
 
         root, args = sweep_dir(args)

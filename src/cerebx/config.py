@@ -4,7 +4,9 @@ expand sweeps, and turn Hydra's composition errors into one ``path: message`` li
 from __future__ import annotations
 
 import itertools
+import os
 import re
+from pathlib import Path
 from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
@@ -134,3 +136,51 @@ def check(overrides: list[str], multirun: bool = False) -> list[str]:
                 if prefix + line not in seen:
                     seen.append(prefix + line)
     return seen
+
+
+RUN_DIR_DEFAULTS = {"run": "runs", "sweep": "runs/multirun"}
+"""The literal part of conf/config.yaml's hydra.run.dir / hydra.sweep.dir (before the first ${...})."""
+
+
+def _literal_prefix(path: str) -> Path:
+    parts = Path(path).parts
+    keep = list(itertools.takewhile(lambda p: "${" not in p, parts))
+    return Path(*keep) if keep else Path(".")
+
+
+def _can_make(folder: Path) -> str | None:
+    """Why ``folder`` cannot be a run folder (None if it can); whatever is created to find out is removed."""
+    if folder.exists():
+        if not folder.is_dir():
+            return "it exists and is not a folder"
+        probe = folder / f".cerebx-probe-{os.getpid()}"
+        try:
+            probe.mkdir()
+            probe.rmdir()
+        except OSError as err:
+            return f"cannot create a folder in it ({err.strerror})"
+        return None
+    missing = [folder]
+    while not missing[-1].parent.exists() and missing[-1].parent != missing[-1]:
+        missing.append(missing[-1].parent)
+    if missing[-1].parent.exists() and not missing[-1].parent.is_dir():
+        return f"{missing[-1].parent} exists and is not a folder"  # an ancestor
+    try:
+        folder.mkdir(parents=True)
+    except OSError as err:
+        return f"cannot be created ({err.strerror})"
+    for d in missing:
+        d.rmdir()
+    return None
+
+
+def check_output_dir(overrides: list[str], multirun: bool) -> list[str]:
+    """The run (or sweep) folder of a ``cerebx run`` command can be made; one line if not."""
+    key = "hydra.sweep.dir" if multirun else "hydra.run.dir"
+    value = RUN_DIR_DEFAULTS["sweep" if multirun else "run"]
+    for o in overrides:
+        k, _, v = o.lstrip("+").partition("=")
+        if k == key:
+            value = v.strip("'\"")
+    why = _can_make(_literal_prefix(value))
+    return [f"{key}: {value}: {why}"] if why else []
