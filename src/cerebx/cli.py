@@ -56,7 +56,9 @@ def _run(args: list[str]) -> int:
         if problems:
             return _fail(problems)
     if not any(a.split("=")[0] in _PASS_THROUGH for a in args):
-        problems = check([a for a in args if not a.startswith("-")], multirun=multirun)
+        estimates: list = []
+        problems = check([a for a in args if not a.startswith("-")], multirun=multirun, estimates=estimates)
+        problems += _size_problems(estimates, args, multirun)
         if problems:
             return _fail(problems)
     from cerebx.app import run_app
@@ -75,6 +77,20 @@ def _run(args: list[str]) -> int:
     lines, failed = table(root)
     print("\n".join(lines), file=sys.stderr if failed else sys.stdout)
     return min(failed, MAX_EXIT_CODE)
+
+
+def _size_problems(estimates: list, args: list[str], multirun: bool) -> list[str]:
+    """Print the disk and time estimate of the command; one line if it does not fit on the disk."""
+    from cerebx.config import output_root
+    from cerebx.estimate import disk_problem, total
+
+    if not estimates:
+        return []
+    total = total(estimates)
+    what = f"sweep of {len(estimates)} jobs" if multirun else "run"
+    print(f"{what}: {total.line()}", file=sys.stderr)
+    why = disk_problem(total.mcap_bytes + total.state_bytes, output_root(args, multirun), what)
+    return [why] if why else []
 
 
 def _validate(args: list[str]) -> int:

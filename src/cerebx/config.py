@@ -4,6 +4,7 @@ expand sweeps, and turn Hydra's composition errors into one ``path: message`` li
 from __future__ import annotations
 
 import itertools
+import math
 import os
 import re
 from pathlib import Path
@@ -14,7 +15,8 @@ from omegaconf import DictConfig, OmegaConf
 from cerebx.errors import ConfigError
 from cerebx.schema.experiment import validate
 
-MAX_SWEEP_CHECK = 2000
+MAX_SWEEP_JOBS = 1000
+"""The largest command-line sweep cerebx accepts (every job is validated before the first starts)."""
 
 
 def to_plain(cfg: DictConfig) -> dict[str, Any]:
@@ -112,24 +114,34 @@ def expand_sweep(overrides: list[str]) -> list[list[str]]:
         parsed = OverridesParser.create().parse_overrides([o for o in overrides if not _is_hydra(o)])
     except HydraException as err:
         raise ConfigError(_hydra_lines(err)) from None
-    choices = []
+    choices: list[list[str]] = []
     for o in parsed:
         if o.is_sweep_override():
             key = o.get_key_element()
             choices.append([f"{key}={v}" for v in o.sweep_string_iterator()])
         else:
             choices.append([o.input_line])
-    combos = itertools.islice(itertools.product(*choices), MAX_SWEEP_CHECK)
-    return [list(c) for c in combos]
+    n = math.prod(len(c) for c in choices)
+    if n > MAX_SWEEP_JOBS:
+        raise ConfigError(f"sweep: {n:,} jobs; at most {MAX_SWEEP_JOBS:,} are run by one command (split the sweep)")
+    return [list(c) for c in itertools.product(*choices)]
 
 
-def check(overrides: list[str], multirun: bool = False) -> list[str]:
-    """Every problem of every job the command would run, one line each (empty when all is well)."""
-    jobs = expand_sweep(overrides) if multirun else [overrides]
+def check(overrides: list[str], multirun: bool = False, estimates: list | None = None) -> list[str]:
+    """Every problem of every job the command would run, one line each (empty when all is well);
+    the disk and time estimate of each valid job is appended to ``estimates``."""
+    from cerebx.estimate import estimate
+
+    try:
+        jobs = expand_sweep(overrides) if multirun else [overrides]
+    except ConfigError as err:
+        return err.problems
     seen: list[str] = []
     for job in jobs:
         try:
-            load(job)
+            exp, _ = load(job)
+            if estimates is not None:
+                estimates.append(estimate(exp))
         except ConfigError as err:
             prefix = f"[{' '.join(job)}] " if multirun and len(jobs) > 1 else ""
             for line in err.problems:
@@ -174,13 +186,24 @@ def _can_make(folder: Path) -> str | None:
     return None
 
 
-def check_output_dir(overrides: list[str], multirun: bool) -> list[str]:
-    """The run (or sweep) folder of a ``cerebx run`` command can be made; one line if not."""
+def _output_dir(overrides: list[str], multirun: bool) -> tuple[str, str]:
+    """(key, value) of the run or sweep folder a ``cerebx run`` command would use."""
     key = "hydra.sweep.dir" if multirun else "hydra.run.dir"
     value = RUN_DIR_DEFAULTS["sweep" if multirun else "run"]
     for o in overrides:
         k, _, v = o.lstrip("+").partition("=")
         if k == key:
             value = v.strip("'\"")
+    return key, value
+
+
+def output_root(overrides: list[str], multirun: bool) -> Path:
+    """The literal part of the run or sweep folder (where the disk space is needed)."""
+    return _literal_prefix(_output_dir(overrides, multirun)[1])
+
+
+def check_output_dir(overrides: list[str], multirun: bool) -> list[str]:
+    """The run (or sweep) folder of a ``cerebx run`` command can be made; one line if not."""
+    key, value = _output_dir(overrides, multirun)
     why = _can_make(_literal_prefix(value))
     return [f"{key}: {value}: {why}"] if why else []

@@ -16,7 +16,7 @@ def save_state_npz(path: Path, meta: dict[str, Any], **arrays: np.ndarray) -> No
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
     with open(tmp, "wb") as f:
-        np.savez(f, meta=np.array(json.dumps(meta)), **arrays)
+        np.savez_compressed(f, meta=np.array(json.dumps(meta)), **arrays)  # lossless; most weights repeat
     tmp.replace(path)
 
 

@@ -189,8 +189,13 @@ def main(argv: list[str]) -> int:
             root = Path("runs") / "report"
             jobs = plan(a.profile, root, needed_studies(names))
             if a.dry_run:
+                from cerebx.estimate import estimate_jobs
+
                 for j in jobs:
                     print(f"{'reuse' if j.done() else 'run  '} {j.run_dir}  cerebx run {' '.join(j.overrides())}")
+                todo = [j.overrides() for j in jobs if not j.done()]
+                est, bad = estimate_jobs(todo)
+                print(f"{len(todo)} runs to do: {est.line()}", *bad, sep="\n")
                 return 0
             try:
                 failed = execute(jobs, parallel=a.jobs)

@@ -28,6 +28,10 @@ class ScheduledEvent(Strict):
         return self
 
 
+MAX_TRIALS = 100_000
+"""The largest run cerebx accepts (the thesis's longest study has 1,000 trials); a larger one is a typo."""
+
+
 class RecordingConfig(Strict):
     """What goes into run.mcap and how the run reports progress."""
 
@@ -62,7 +66,7 @@ class _ExperimentBase(Strict):
 
     name: str = "run"
     seed: int = Field(0, ge=0)
-    trials: int = Field(10, ge=1)
+    trials: int = Field(10, ge=1, le=MAX_TRIALS, description="trials to run (at most 100,000: 55 h of a 2 s task)")
     control_dt_ms: Literal[2.0] = CONTROL_DT_MS
     network: NetworkConfig
     recording: RecordingConfig = RecordingConfig()

@@ -1,0 +1,129 @@
+"""Disk and time a run will take, printed before it starts, and the limit that refuses absurd sizes.
+
+The rates are measured, not derived (``cerebx run`` of 2-4 trials on the 2-core development machine,
+zstd chunks of 256 kB, every step recorded):
+
+===========================================  ======================  ==========================
+run                                          run.mcap per sim. s     wall
+===========================================  ======================  ==========================
+planar2 + PD (``+experiment=demo``)          113 kB                  README bench
+Baxter + PD                                  288 kB                  README bench
+Baxter + SNN ``small`` / ``thesis_ch3``      285 kB / 320 kB         README bench
+===========================================  ======================  ==========================
+
+hence about 25 kB/s plus 44 kB/s per joint for the joint and control channels, and 32 kB/s for the
+default spike channels of an SNN; without joint states (``recording.joint_states=false``) a third of the
+per-joint rate is kept for ``/control`` (*constructed*: one of three per-step channels). The learned SNN
+state holds 4 bytes per plastic synapse and ~44 bytes per neuron before compression (``thesis_ch3``:
+147.9 MB raw, 0.7 MB of weights once zlib-compressed after 2 trials, because most PF-PC weights stay at
+their initial value); it is written compressed. Wall
+time uses the bench's real-time factors of a quiet machine (Baxter + PD 30x; ``thesis_ch3`` closed
+loop with recording 7x, i.e. 0.033 s + 3.1 ns per plastic synapse per simulated second); a shared
+machine is slower.
+"""
+
+from __future__ import annotations
+
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+BYTES_PER_S_BASE = 25e3
+BYTES_PER_S_PER_JOINT = 44e3
+BYTES_PER_S_SPIKES = 32e3
+STATE_BYTES_PER_PLASTIC = 4.0
+STATE_BYTES_PER_NEURON = 44.0
+WALL_PER_SIM_S = 0.033
+WALL_PER_SIM_S_PER_PLASTIC = 3.1e-9
+DISK_MARGIN = 1.2
+"""A run is refused when its estimate times this margin exceeds the free space of its folder's disk."""
+
+
+@dataclass(frozen=True)
+class Estimate:
+    sim_s: float
+    mcap_bytes: float
+    state_bytes: float
+    wall_s: float
+
+    def line(self) -> str:
+        state = f", learned state <= {_size(self.state_bytes)} before compression" if self.state_bytes else ""
+        return (f"estimate: {self.sim_s:,.0f} s simulated, run.mcap ~{_size(self.mcap_bytes)}{state}, "
+                f"~{_duration(self.wall_s)} on a quiet 2-core machine")
+
+
+def _size(b: float) -> str:
+    for unit, f in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if b >= f:
+            return f"{b / f:,.1f} {unit}"
+    return f"{b:.0f} B"
+
+
+def _duration(s: float) -> str:
+    if s >= 86400:
+        return f"{s / 86400:,.1f} days"
+    if s >= 3600:
+        return f"{s / 3600:.1f} h"
+    if s >= 60:
+        return f"{s / 60:.0f} min"
+    return f"{s:.0f} s"
+
+
+def _snn_parts(exp: Any) -> list[Any]:
+    c = exp.controller
+    parts = c.parts if c.kind == "composite" else [c]
+    return [p for p in parts if p.kind == "snn"]
+
+
+def estimate(exp: Any) -> Estimate:
+    """The estimate of one validated experiment."""
+    sim_s = exp.trials * exp.task.period_s
+    n = exp.plant.n_joints
+    per_joint = BYTES_PER_S_PER_JOINT if exp.recording.joint_states else BYTES_PER_S_PER_JOINT / 3
+    per_s = BYTES_PER_S_BASE + per_joint * n
+    per_s /= exp.recording.decimation
+    snn = _snn_parts(exp)
+    plastic = exp.network.n_plastic if snn else 0
+    if snn and any(p.record_spikes for p in snn):
+        per_s += BYTES_PER_S_SPIKES
+    state = (STATE_BYTES_PER_PLASTIC * plastic + STATE_BYTES_PER_NEURON * exp.network.n_neurons
+             if snn and exp.recording.save_state else 0.0)
+    wall = sim_s * (WALL_PER_SIM_S + WALL_PER_SIM_S_PER_PLASTIC * plastic)
+    return Estimate(sim_s, per_s * sim_s, state, wall)
+
+
+def free_bytes(folder: Path) -> int:
+    """Free space of the disk ``folder`` would be on (its nearest existing ancestor)."""
+    p = Path(folder).absolute()
+    while not p.exists():
+        p = p.parent
+    return shutil.disk_usage(p).free
+
+
+def disk_problem(total_bytes: float, folder: Path, what: str) -> str | None:
+    """One line when ``total_bytes`` (with a margin) does not fit on ``folder``'s disk."""
+    free = free_bytes(folder)
+    if total_bytes * DISK_MARGIN > free:
+        return (f"{what}: needs ~{_size(total_bytes)} but {folder} has {_size(free)} free; lower trials or "
+                "record less (recording.decimation=N, recording.joint_states=false)")
+    return None
+
+
+def estimate_jobs(jobs: list[list[str]]) -> tuple[Estimate, list[str]]:
+    """The summed estimate of runs given by their overrides (``init_from`` left out: the run it names may
+    not exist yet, and it changes no size); one line per job that does not validate."""
+    from cerebx.config import load
+    from cerebx.errors import ConfigError
+
+    parts, problems = [], []
+    for overrides in jobs:
+        try:
+            parts.append(estimate(load([o for o in overrides if not o.lstrip("+").startswith("init_from=")])[0]))
+        except ConfigError as err:
+            problems.append(f"[{' '.join(overrides)}] {err.problems[0]}")
+    return total(parts), problems
+
+
+def total(parts: list[Estimate]) -> Estimate:
+    return Estimate(*(sum(getattr(e, f) for e in parts) for f in ("sim_s", "mcap_bytes", "state_bytes", "wall_s")))
