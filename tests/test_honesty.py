@@ -11,6 +11,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from cerebx.cli import main
@@ -319,3 +320,56 @@ def _one_line_of(err: str) -> str:
     lines = err.strip().splitlines()
     assert len(lines) == 1, lines
     return lines[0]
+
+
+# ---- limits and estimates ---------------------------------------------------------------------------
+
+def test_absurd_trials_are_refused(in_tmp, capsys):
+    assert main(["run", *DEMO, "trials=1e12"]) == 2
+    assert _one_line(capsys) == "trials: Input should be less than or equal to 100000"
+    assert not (in_tmp / "runs").exists()
+
+
+def test_a_sweep_larger_than_the_limit_is_refused(in_tmp, capsys):
+    seeds = ",".join(str(i) for i in range(1001))
+    assert main(["run", "-m", *DEMO, "trials=1", f"seed={seeds}"]) == 2
+    assert _one_line(capsys) == "sweep: 1,001 jobs; at most 1,000 are run by one command (split the sweep)"
+
+
+def test_a_run_that_does_not_fit_on_the_disk_is_refused(in_tmp, capsys, monkeypatch):
+    from cerebx import estimate
+
+    monkeypatch.setattr(estimate, "free_bytes", lambda folder: 10_000_000)
+    assert main(["run", *DEMO, "trials=100"]) == 2  # 200 s of planar2 at 113 kB/s: ~22.6 MB
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[0].startswith("run: estimate: 200 s simulated, run.mcap ~22.6 MB")
+    assert err[1] == ("run: needs ~22.6 MB but runs has 10.0 MB free; lower trials or record less "
+                      "(recording.decimation=N, recording.joint_states=false)")
+    assert not (in_tmp / "runs").exists()
+
+
+def test_the_estimate_matches_a_measured_run(load, tmp_path):
+    """The disk estimate of the demo is within 30 % of what a run writes."""
+    from cerebx.estimate import estimate
+
+    cfg = load([*DEMO, "trials=4"])
+    run_experiment(cfg, tmp_path)
+    written = (tmp_path / "run.mcap").stat().st_size
+    assert abs(estimate(cfg).mcap_bytes / written - 1) < 0.3, (estimate(cfg), written)
+
+
+def test_the_full_network_estimate_and_its_compressed_state(load, small_state):
+    from cerebx.estimate import estimate
+
+    e = estimate(load(["+task=circle", "trials=100"]))
+    assert 140e6 < e.state_bytes < 150e6  # 36 M plastic synapses x 4 bytes + neurons (147.9 MB measured raw)
+    assert 60e6 < e.mcap_bytes < 70e6  # 200 s at 320 kB/s: the issue's 68 MB
+    with np.load(small_state / "controller_state.npz") as data:
+        raw = sum(data[k].nbytes for k in data.files)
+    assert (small_state / "controller_state.npz").stat().st_size < raw / 2  # written compressed
+
+
+def test_report_dry_run_prints_an_estimate(in_tmp, capsys):
+    assert main(["report", "--profile", "quick", "--dry-run", "--figures", "fig3_4"]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert " runs to do: estimate: " in last and "run.mcap ~" in last and "quiet 2-core machine" in last
