@@ -373,3 +373,45 @@ def test_report_dry_run_prints_an_estimate(in_tmp, capsys):
     assert main(["report", "--profile", "quick", "--dry-run", "--figures", "fig3_4"]) == 0
     last = capsys.readouterr().out.strip().splitlines()[-1]
     assert " runs to do: estimate: " in last and "run.mcap ~" in last and "quiet 2-core machine" in last
+
+
+# ---- small things -----------------------------------------------------------------------------------
+
+def test_completion_install_prints_the_script():
+    exe = Path(sys.executable).parent / "cerebx"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+    done = subprocess.run([str(exe), "-sc", "install=bash"], capture_output=True, text=True, env=env, timeout=120)
+    assert done.returncode == 0, done.stderr
+    out = done.stdout
+    assert "hydra_bash_completion()" in out and "complete -o nospace -o default -F hydra_bash_completion cerebx" in out
+
+
+def test_run_help_leaves_out_internal_groups(capsys):
+    with pytest.raises(SystemExit) as ex:
+        main(["run", "--help"])
+    assert ex.value.code in (0, None)
+    out = capsys.readouterr().out
+    assert "\ntask: " in out and "\nnetwork: " in out and "\nreport: " not in out
+
+
+def test_numba_cache_defaults_to_the_checkout(monkeypatch):
+    from cerebx.cli import _default_numba_cache
+
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    _default_numba_cache()
+    root = Path(__file__).resolve().parents[1]
+    assert os.environ["NUMBA_CACHE_DIR"] == str(root / ".cache" / "numba")
+
+
+def test_a_small_network_without_its_preset_points_to_it(capsys):
+    assert main(["validate", "+task=circle", "network=small"]) == 2
+    assert _one_line(capsys).endswith("(network 'small' comes with matching encoders in +experiment=small_snn)")
+
+
+def test_the_setup_line_names_the_chosen_presets(load, tmp_path, capsys):
+    run_experiment(load([*DEMO, "trials=1"]), tmp_path)
+    s = json.loads((tmp_path / "summary.json").read_text())
+    s["presets"] = {**s.get("presets", {}), "delay": "gamma45", "controller": "pd_planar2"}
+    (tmp_path / "summary.json").write_text(json.dumps(s))
+    assert main(["inspect", str(tmp_path)]) == 0
+    assert "controller=pd_planar2 plant=planar2 delay=gamma45 " in capsys.readouterr().out

@@ -69,6 +69,8 @@ def _run(args: list[str]) -> int:
 
         root, args = sweep_dir(args)
     sys.argv = [sys.argv[0]] + args
+    if any(a in ("--help", "-h") for a in args):
+        _hide_internal_groups()
     run_app()
     if root is None:
         return 0
@@ -77,6 +79,22 @@ def _run(args: list[str]) -> int:
     lines, failed = table(root)
     print("\n".join(lines), file=sys.stderr if failed else sys.stdout)
     return min(failed, MAX_EXIT_CODE)
+
+
+INTERNAL_GROUPS = ("report",)
+"""Config groups read by cerebx itself (the report's study list), not options of a run."""
+
+
+def _hide_internal_groups() -> None:
+    """Leave cerebx's internal config groups out of ``cerebx run --help``."""
+    from hydra._internal.hydra import Hydra
+
+    listed = Hydra.list_all_config_groups
+
+    def public(self, parent: str = "") -> list[str]:
+        return [g for g in listed(self, parent) if g.split("/")[0] not in INTERNAL_GROUPS]
+
+    Hydra.list_all_config_groups = public
 
 
 def _size_problems(estimates: list, args: list[str], multirun: bool) -> list[str]:
@@ -162,7 +180,14 @@ def _tune(args: list[str]) -> int:
 
 
 def _completion(argv: list[str]) -> int:
-    """Hydra's completion, with the subcommand word removed from the line it completes."""
+    """Hydra's completion, with the subcommand word removed from the line it completes; ``install=bash``
+    (and uninstall) print Hydra's script, which calls ``cerebx -sc query=bash`` back."""
+    if not any(a.startswith("query=") for a in argv):
+        from cerebx.app import run_app
+
+        sys.argv = [sys.argv[0]] + argv
+        run_app()
+        return 0
     line = os.environ.get("COMP_LINE", "")
     words = line.split()
     if len(words) <= 1 or (len(words) == 2 and not line.endswith(" ")):
@@ -177,7 +202,18 @@ def _completion(argv: list[str]) -> int:
     return 0
 
 
+def _default_numba_cache() -> None:
+    """Compiled numba kernels go where ``make`` puts them (``.cache/numba`` of a source checkout, else
+    ``~/.cache/cerebx/numba``), never into ``src/.../__pycache__``, also when ``cerebx`` is run directly."""
+    if "NUMBA_CACHE_DIR" in os.environ:
+        return
+    checkout = Path(__file__).resolve().parents[2]
+    root = checkout / ".cache" if (checkout / "pyproject.toml").is_file() else Path.home() / ".cache" / "cerebx"
+    os.environ["NUMBA_CACHE_DIR"] = str(root / "numba")
+
+
 def main(argv: list[str] | None = None) -> int:
+    _default_numba_cache()
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv and argv[0] in ("-sc", "--shell-completion"):
         return _completion(argv)

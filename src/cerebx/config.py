@@ -3,6 +3,7 @@ expand sweeps, and turn Hydra's composition errors into one ``path: message`` li
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import os
@@ -102,7 +103,42 @@ def _is_hydra(override: str) -> bool:
 def load(overrides: list[str]) -> tuple[Any, dict[str, Any]]:
     """Compose and validate; returns (validated experiment, plain resolved dict)."""
     plain = to_plain(compose(overrides))
-    return validate(plain), plain
+    try:
+        return validate(plain), plain
+    except ConfigError as err:
+        raise ConfigError(_with_hints(err.problems, plain)) from None
+
+
+def _with_hints(problems: list[str], plain: dict[str, Any]) -> list[str]:
+    """Point a network/encoder size mismatch to the experiment presets made for that network."""
+    net = (plain.get("network") or {}).get("name") if isinstance(plain.get("network"), dict) else None
+    presets = _presets_for_network(str(net)) if net else ()
+    if not presets:
+        return problems
+    hint = f" (network {net!r} comes with matching encoders in +experiment={' or +experiment='.join(presets)})"
+    return [p + hint if p.startswith("controller.mf.fibers_per_signal:") else p for p in problems]
+
+
+@functools.cache
+def _presets_for_network(name: str) -> tuple[str, ...]:
+    """Experiment presets that choose network ``name`` for the SNN controller (``override /network: NAME``)."""
+    import yaml
+
+    from cerebx.guard import CONF_ROOT
+
+    out = []
+    for f in sorted((CONF_ROOT / "experiment").glob("*.yaml")):
+        try:
+            doc = yaml.safe_load(f.read_text()) or {}
+        except (OSError, yaml.YAMLError):
+            continue
+        chosen: dict[str, Any] = {}
+        for entry in doc.get("defaults") or [] if isinstance(doc, dict) else []:
+            if isinstance(entry, dict):
+                chosen.update(entry)
+        if chosen.get("override /network") == name and str(chosen.get("override /controller", "snn")).startswith("snn"):
+            out.append(f.stem)
+    return tuple(out)
 
 
 def expand_sweep(overrides: list[str]) -> list[list[str]]:

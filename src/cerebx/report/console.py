@@ -14,8 +14,9 @@ def format_summary(s: dict[str, Any], run_dir: Path | None = None) -> str:
     if run_dir is not None:
         lines.append(f"run       {run_dir}")
     lines.append(f"status    {s['status']}" + (f"  ({s['error']})" if s.get("error") else ""))
-    lines.append(f"setup     task={s['task']} controller={s['controller']} plant={s['plant']} "
-                 f"delay={s['delay']} network={s.get('network')} seed={s['seed']}")
+    chosen = {**{k: s[k] for k in ("controller", "plant", "delay")}, **(s.get("presets") or {})}  # delay=gamma45
+    lines.append(f"setup     task={s['task']} controller={chosen['controller']} plant={chosen['plant']} "
+                 f"delay={chosen['delay']} network={s.get('network')} seed={s['seed']}")
     mae = s.get("mae_per_trial") or []
     lines.append(f"trials    {s.get('trials_completed', len(mae))}/{s['trials']}")
     if mae:
