@@ -80,7 +80,7 @@ class Registry:
             raise ValueError(f"expected a mapping with a 'kind' ({self.group} kinds: {', '.join(self.kinds())})")
         kind = value.get("kind")
         if kind not in self._entries:
-            raise ValueError(f"unknown {self.group} kind {kind!r}; known: {', '.join(self.kinds())}")
+            raise ValueError(f"unknown {self.group} kind {kind!r} (known: {', '.join(self.kinds())})")
         return self._entries[kind].schema.model_validate(value)
 
 
