@@ -23,11 +23,13 @@ MAX_EXIT_CODE = 100
 OK_STATUSES = ("completed", "diverged")  # diverging is a result of the experiment, not a failure of the job
 
 
-def sweep_dir(args: list[str]) -> tuple[Path, list[str]]:
-    """The sweep folder of a ``-m`` command, and the arguments with ``hydra.sweep.dir`` set to it."""
+def sweep_dir(args: list[str]) -> tuple[Path | None, list[str]]:
+    """The sweep folder of a ``-m`` command, and the arguments with ``hydra.sweep.dir`` set to it (None when
+    the user's own folder is only known after Hydra resolves it: then no table is printed)."""
     for a in args:
         if a.lstrip("+").startswith("hydra.sweep.dir="):
-            return Path(a.split("=", 1)[1].strip("'\"")), args
+            value = a.split("=", 1)[1].strip("'\"")
+            return (None if "${" in value else Path(value)), args
     now = _dt.datetime.now()
     d = Path("runs") / "multirun" / now.strftime("%Y-%m-%d") / now.strftime("%H-%M-%S-%f")
     return d, [*args, f"hydra.sweep.dir={d}"]

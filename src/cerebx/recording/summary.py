@@ -44,7 +44,16 @@ class RunSummary(BaseModel):
     wall_seconds: float = Field(0.0, ge=0, description="wall-clock time, s")
     rt_factor: float | None = Field(None, description="simulated seconds per wall second")
     error: str | None = None
-    pid: int | None = Field(None, description="process that writes the run (to tell running from killed)")
+    mae_per_joint_per_trial: list[list[float]] = Field(default_factory=list, description="rad, per trial and joint")
+    vel_mae_per_trial: list[float] = Field(default_factory=list, description="rad/s")
+    torque_variability_per_trial: list[float] = Field(default_factory=list, description="N·m/ms")
+    ee_error_per_trial: list[float | None] = Field(default_factory=list, description="end-effector error, m")
+    presets: dict[str, str] = Field(default_factory=dict, description="option chosen in each config group")
+    overrides: list[str] = Field(default_factory=list, description="command-line overrides")
+    controller_info: dict[str, Any] = Field(default_factory=dict, description="static facts of the controller")
+    version: str | None = None
+    started_at: float | None = Field(None, description="Unix time the run started, s")
+    pid: int | None = Field(None, ge=1, description="process that writes the run (to tell running from killed)")
     host: str | None = Field(None, description="host of that process")
 
 
@@ -68,10 +77,10 @@ def write_summary(run_dir: Path, summary: dict[str, Any]) -> None:
 def _alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
     except PermissionError:  # someone else's process
         return True
+    except (OSError, OverflowError):  # no such process (or no possible one)
+        return False
     return True
 
 
