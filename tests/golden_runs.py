@@ -27,8 +27,8 @@ RUNS: dict[str, list[str]] = {
                                       "delay=gamma45", "trials=2", "seed=11"],
 }
 
-# summary fields that depend on the machine's clock, not on the simulation
-WALL_CLOCK = {"wall_seconds", "rt_factor", "started_at", "controller_info"}
+# summary fields that depend on the machine (clock, process), not on the simulation
+WALL_CLOCK = {"wall_seconds", "rt_factor", "started_at", "controller_info", "pid", "host"}
 
 
 def digest(run_dir: Path) -> dict:

@@ -43,7 +43,8 @@ values = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True).map(repr),
     st.sampled_from(["null", "true", "false", "[]", "{}", "[1,2]", "{a:1}", "''", "'a b'", "${seed}", "${nope}",
                      "1e12", "-0", "nan", "inf", "[1,[2,[3]]]", "{kind:pd}", "/nonexistent", "runs", "x,y",
-                     "range(1,3)", "choice(1,2)", "[{kind:x}]", "[{kind:hold}]", "{kind:x}", "\\", "'", "\"", "=", "???", "${oc.env:HOME}"]),
+                     "range(1,3)", "choice(1,2)", "[{kind:x}]", "[{kind:hold}]", "{kind:x}", "\\", "'", "\"", "=",
+                     "???", "${oc.env:HOME}"]),
     st.text(alphabet=st.characters(blacklist_categories=("Cs",)), max_size=12),
 )
 group_override = st.sampled_from(sorted(GROUPS)).flatmap(

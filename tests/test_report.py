@@ -96,7 +96,8 @@ def test_every_study_job_is_a_valid_experiment(fixture_runs):
             key = tuple(o for o in ov if not o.startswith("trials="))  # the profiles mostly differ in trials
             if key not in seen:
                 seen.add(key)
-                assert check(ov) == [], (profile, job.name)
+                # the fixture state comes from a reduced network: only its fingerprint may not fit
+                assert [p for p in check(ov) if "fingerprint" not in p] == [], (profile, job.name)
 
 
 def test_study_runner_reuses_finished_runs_and_skips_dependents_of_failures(tmp_path):
@@ -107,8 +108,9 @@ def test_study_runner_reuses_finished_runs_and_skips_dependents_of_failures(tmp_
         if job.study == "learn_circle":
             return 1
         job.run_dir.mkdir(parents=True, exist_ok=True)
-        (job.run_dir / "summary.json").write_text(json.dumps({"status": "completed", "trials_completed": job.trials,
-                                                              "final_mae": 0.1, "wall_seconds": 1}))
+        (job.run_dir / "summary.json").write_text(json.dumps({
+            "status": "completed", "task": "circle", "controller": "pd", "plant": "baxter", "delay": "none",
+            "seed": 0, "trials": job.trials, "trials_completed": job.trials, "final_mae": 0.1, "wall_seconds": 1}))
         return 0
 
     jobs = plan("quick", tmp_path, ["fig3_4_pd", "fig3_4_snn"])
