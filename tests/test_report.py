@@ -96,8 +96,8 @@ def test_every_study_job_is_a_valid_experiment(fixture_runs):
             key = tuple(o for o in ov if not o.startswith("trials="))  # the profiles mostly differ in trials
             if key not in seen:
                 seen.add(key)
-                # the fixture state comes from a reduced network: only its fingerprint may not fit
-                assert [p for p in check(ov) if "fingerprint" not in p] == [], (profile, job.name)
+                # the fixture state stands in for every study's start (small SNN): it need not fit the job
+                assert [p for p in check(ov) if not p.startswith(f"init_from: {state}/")] == [], (profile, job.name)
 
 
 def test_study_runner_reuses_finished_runs_and_skips_dependents_of_failures(tmp_path):
