@@ -16,6 +16,9 @@ from cerebx.schema.experiment import validate
 
 @hydra.main(config_path="conf", config_name="config", version_base="1.3")
 def run_app(cfg: DictConfig) -> float | None:
+    from cerebx import jobenv
+
+    jobenv.configure()  # before numba is imported: launchers' jobs do not inherit the Makefile's env
     from cerebx.loop.runner import run_experiment
     from cerebx.report.console import print_summary
 
