@@ -19,6 +19,7 @@ def run_app(cfg: DictConfig) -> float | None:
     from cerebx import jobenv
 
     jobenv.configure()  # before numba is imported: launchers' jobs do not inherit the Makefile's env
+    from cerebx.loop import resume
     from cerebx.loop.runner import run_experiment
     from cerebx.report.console import print_summary
 
@@ -27,6 +28,7 @@ def run_app(cfg: DictConfig) -> float | None:
     try:
         plain = to_plain(cfg)
         exp = validate(plain)
+        exp, run_dir = resume.continued(exp, plain, run_dir)
     except ConfigError as err:
         for line in err.problems:
             print(line, file=sys.stderr)

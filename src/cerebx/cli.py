@@ -43,7 +43,9 @@ def _fail(lines: list[str]) -> int:
 
 def _run(args: list[str]) -> int:
     from cerebx.config import check
+    from cerebx.loop.resume import expand_args
 
+    args = expand_args(args)
     multirun = any(a in ("-m", "--multirun") for a in args)
     if not any(a.split("=")[0] in _PASS_THROUGH for a in args):
         problems = check([a for a in args if not a.startswith("-")], multirun=multirun)

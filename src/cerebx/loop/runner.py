@@ -17,6 +17,7 @@ from typing import Any
 from cerebx import __version__
 from cerebx.build import build_components
 from cerebx.errors import CerebxError, Diverged
+from cerebx.loop import resume
 from cerebx.loop.loop import ClosedLoop
 from cerebx.metrics import final_mae
 from cerebx.recording.recorder import Recorder
@@ -75,27 +76,35 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
         "version": __version__, "overrides": list(overrides or []), "started_at": started, "error": None,
         "presets": dict(choices or {}),
     }
-    rec = Recorder(run_dir / "run.mcap", chunk_size_kb=cfg.recording.chunk_size_kb,
+    rec = Recorder(resume.recorder_path(cfg, run_dir), chunk_size_kb=cfg.recording.chunk_size_kb,
                    compression=cfg.recording.compression)
     rec.metadata("cerebx", {"version": __version__, "overrides": json.dumps(list(overrides or []))})
     rec.metadata("config", {"json": json.dumps(resolved if resolved is not None else cfg.model_dump(mode="json"))})
     loop: ClosedLoop | None = None
     bar = None
+    wall_before = 0.0  # spent by the run this one continues
     try:
         with _sigterm_as_interrupt():
-            ctx = build_components(cfg, run_dir)
+            if cfg.resume is not None:
+                loop, wall_before = resume.load(cfg, run_dir, rec)
+            ctx = loop.ctx if loop is not None else build_components(cfg, run_dir)
             rec.joint_names = tuple(ctx.plant.joint_names)
-            if cfg.init_from:
+            if cfg.init_from and loop is None:
                 state = Path(cfg.init_from) / STATE_FILE
                 if not state.exists():
                     raise CerebxError(f"init_from: {state} does not exist")
                 ctx.brain[0].load_state(state)
-            loop = ClosedLoop(ctx, rec)
-            loop.start()
+            if loop is None:
+                loop = ClosedLoop(ctx, rec)
+                loop.start()
             summary["controller_info"] = ctx.brain[0].describe()
             bar = _progress(cfg, cfg.trials)
-            for trial in range(cfg.trials):
+            if bar is not None:
+                bar.update(loop.trials_done)
+            for trial in range(loop.trials_done, cfg.trials):
                 m = loop.run_trial(trial)
+                if resume.due(loop):
+                    resume.save(loop, run_dir, wall_before + time.perf_counter() - wall0)
                 if bar is not None:
                     bar.set_postfix_str(f"trial {trial + 1}/{cfg.trials}  MAE {m.mae:.4f} rad")
                     bar.update(1)
@@ -114,7 +123,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
     finally:
         if bar is not None:
             bar.close()
-        wall = time.perf_counter() - wall0
+        wall = wall_before + time.perf_counter() - wall0
         if loop is not None:
             ms = loop.metrics
             mae = [m.mae for m in ms]
@@ -140,4 +149,6 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
         finally:
             rec.close()
             _write_json_atomic(run_dir / "summary.json", summary)
+            if summary["status"] == "completed":
+                resume.finish(run_dir)
     return summary
