@@ -77,7 +77,8 @@ def _validate(args: list[str]) -> int:
 
 
 def _inspect(args: list[str]) -> int:
-    from cerebx.recording.reader import channel_counts, mcap_path, read_summary
+    from cerebx.recording.reader import channel_counts, read_summary
+    from cerebx.recording.segments import segments
     from cerebx.report.console import format_summary
 
     if len(args) != 1:
@@ -89,11 +90,12 @@ def _inspect(args: list[str]) -> int:
     try:
         if (run_dir / "summary.json").exists():
             print(format_summary(read_summary(run_dir), run_dir))
-        counts = channel_counts(mcap_path(p))
+        counts = channel_counts(p)
+        files = [s.path for s in segments(p)] if p.is_dir() else [p]
     except CerebxError as err:
         return _fail([str(err)])
     width = max(map(len, counts), default=10)
-    print(f"\n{mcap_path(p)}")
+    print("\n" + " + ".join(str(f) for f in files))
     for topic, n in counts.items():
         print(f"  {topic:<{width}}  {n:>9,}")
     return 0

@@ -11,6 +11,7 @@ from mcap.decoder import DecoderFactory
 from mcap.reader import make_reader
 
 from cerebx.errors import CerebxError
+from cerebx.recording.segments import segments
 
 
 def _short(err: Exception) -> str:
@@ -68,10 +69,27 @@ def read_messages(path: Path | str, topics: list[str] | None = None, start_ns: i
                   end_ns: int | None = None) -> Iterator[tuple[str, int, Any]]:
     """Yield (topic, log_time_ns, decoded message) in log-time order.
 
-    A file without a summary section (a run still going, or one killed with SIGKILL) is read as a
+    A run folder is read across its segments (a resumed run: ``run.mcap``, ``run.1.mcap`` …) as one
+    log. A file without a summary section (a run still going, or one killed with SIGKILL) is read as a
     stream up to its last complete record.
     """
-    p = mcap_path(path)
+    p = Path(path)
+    if not p.is_dir():
+        yield from _read_file(p, topics, start_ns, end_ns)
+        return
+    for seg in segments(p):
+        lo = seg.start_ns if start_ns is None else max(start_ns, seg.start_ns)
+        hi = seg.end_ns + 1 if seg.end_ns is not None else None  # the boundary itself: see owns()
+        if end_ns is not None:
+            hi = end_ns if hi is None else min(end_ns, hi)
+        if hi is None or lo < hi:
+            for topic, t, msg in _read_file(seg.path, topics, lo, hi):
+                if seg.owns(topic, t):
+                    yield topic, t, msg
+
+
+def _read_file(p: Path, topics: list[str] | None, start_ns: int | None,
+               end_ns: int | None) -> Iterator[tuple[str, int, Any]]:
     if not p.exists():
         raise CerebxError(f"{p}: no such file")
     with open(p, "rb") as fh:
@@ -92,7 +110,14 @@ def read_messages(path: Path | str, topics: list[str] | None = None, start_ns: i
 
 
 def channel_counts(path: Path | str) -> dict[str, int]:
-    """Message count per topic, from the file's summary section."""
+    """Message count per topic, from the file's summary section (a resumed run's folder: counted over
+    its segments as :func:`read_messages` reads them)."""
+    p = Path(path)
+    if p.is_dir() and len(segments(p)) > 1:
+        counts: dict[str, int] = {}
+        for topic, _t, _msg in read_messages(p):
+            counts[topic] = counts.get(topic, 0) + 1
+        return dict(sorted(counts.items()))
     p = mcap_path(path)
     if not p.exists():
         raise CerebxError(f"{p}: no such file")
@@ -109,7 +134,9 @@ def channel_counts(path: Path | str) -> dict[str, int]:
 
 
 def read_metadata(path: Path | str) -> dict[str, dict[str, str]]:
-    p = mcap_path(path)
+    """The metadata records of a file; of a run folder, its last segment's (each segment carries the
+    config, and the last one the summary of the whole run)."""
+    p = segments(path)[-1].path if Path(path).is_dir() else Path(path)
     with open(p, "rb") as fh:
         try:
             return {m.name: dict(m.metadata) for m in _reader(fh).iter_metadata()}

@@ -19,6 +19,9 @@ from cerebx.errors import CerebxError
 
 FIRST = "run.mcap"
 INDEX = "segments.json"
+# Written when a trial ends, stamped with the time of the next trial's first tick: at a segment boundary
+# (a checkpoint, taken between trials) they belong to the segment before it, every other topic to the one after.
+TRIAL_END_TOPICS = frozenset({"/trial_metrics", "/weights"})
 
 
 @dataclass(frozen=True)
@@ -26,6 +29,14 @@ class Segment:
     path: Path
     start_ns: int  # simulated time of its first message
     end_ns: int | None  # where the next segment takes over (None: the last one)
+
+    def owns(self, topic: str, t_ns: int) -> bool:
+        """Whether this segment's message on ``topic`` at ``t_ns`` is part of the run (not superseded)."""
+        if t_ns == self.start_ns and self.start_ns > 0:
+            return topic not in TRIAL_END_TOPICS
+        if self.end_ns is not None and t_ns >= self.end_ns:
+            return t_ns == self.end_ns and topic in TRIAL_END_TOPICS
+        return t_ns >= self.start_ns
 
 
 def segment_name(i: int) -> str:
