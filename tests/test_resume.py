@@ -111,7 +111,7 @@ def test_checkpoint_head_is_checked_before_anything_is_written(tmp_path, load):
         loop.run_trial(trial)
     resume.save(loop, tmp_path, wall_seconds=1.0)
     resume.check(cfg, tmp_path)
-    with pytest.raises(ConfigError, match=r"^delay\.r2c\.offset_ms: .* differs from the resumed run's"):
+    with pytest.raises(ConfigError, match=r"^delay\.c2r\.offset_ms: 6\.0 differs from the resumed run's 5\.0$"):
         resume.check(load([*RUN, "delay.r2c.offset_ms=6.0", "delay.c2r.offset_ms=6.0", "trials=6"]), tmp_path)
     with pytest.raises(ConfigError, match="trials: 2, but the checkpoint already has 2 trials done"):
         resume.check(load([*RUN, "trials=2"]), tmp_path)
