@@ -6,12 +6,18 @@ import sys
 from pathlib import Path
 
 import hydra
+from hydra.core.config_store import ConfigStore
 from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
 from cerebx.config import to_plain, user_choices
 from cerebx.errors import ConfigError
 from cerebx.schema.experiment import validate
+
+SWEEP_SUMMARY = "sweep_summary"  # hydra/callbacks option that prints a sweep's table when it ends
+# Registered here, in code: config files name no code. `cerebx run -m` selects it (cli.py).
+ConfigStore.instance().store(group="hydra/callbacks", name=SWEEP_SUMMARY, package="hydra.callbacks",
+                             node={SWEEP_SUMMARY: {"_target_": "cerebx.report.sweep.PrintSweepSummary"}})
 
 
 @hydra.main(config_path="conf", config_name="config", version_base="1.3")

@@ -23,13 +23,14 @@ commands:
   inspect RUN_DIR|FILE.mcap                            a run's summary and its MCAP channels
   bench [--seconds S] [--networks a,b]                 speed of plant, network and closed loop (JSON)
   report [RUN_DIR ...]                                 build reports/ from run logs
+  summarize MULTIRUN_DIR                               one table of a sweep's jobs (CSV, Markdown, plot)
   tune [--out PATH] OVERRIDES...                       Ziegler-Nichols PD gains on the simulated plant
 
 groups: task (required, +task=), controller (snn), plant (baxter), delay (none),
         network (thesis_ch3), experiment (presets: +experiment=NAME)
 """
 
-COMMANDS = ("run", "validate", "inspect", "bench", "report", "tune")
+COMMANDS = ("run", "validate", "inspect", "bench", "report", "tune", "summarize")
 _PASS_THROUGH = ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i", "--resolve",
                  "--package", "-p", "-sc", "--shell-completion", "--config-dir", "-cd",
                  "--config-name", "-cn", "--config-path", "-cp", "--experimental-rerun")
@@ -51,11 +52,19 @@ def _run(args: list[str]) -> int:
         problems = check([a for a in args if not a.startswith("-")], multirun=multirun)
         if problems:
             return _fail(problems)
-    from cerebx.app import run_app
+    from cerebx.app import SWEEP_SUMMARY, run_app
 
+    if multirun and not any(a.startswith("hydra/callbacks=") for a in args):
+        args = [*args, f"hydra/callbacks={SWEEP_SUMMARY}"]
     sys.argv = [sys.argv[0]] + args
     run_app()
     return 0
+
+
+def _summarize(args: list[str]) -> int:
+    from cerebx.report.sweep import main as summarize_main
+
+    return summarize_main(args)
 
 
 def _validate(args: list[str]) -> int:
@@ -150,7 +159,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     cmd, rest = argv[0], argv[1:]
     handlers = {"run": _run, "validate": _validate, "inspect": _inspect, "bench": _bench, "report": _report,
-                "tune": _tune}
+                "tune": _tune, "summarize": _summarize}
     if cmd not in handlers:
         return _fail([f"{cmd}: unknown command (choose from {', '.join(COMMANDS)})"])
     try:
