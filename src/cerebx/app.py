@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import sys
 from pathlib import Path
 
@@ -14,6 +15,8 @@ from cerebx.config import to_plain, user_choices
 from cerebx.errors import ConfigError
 from cerebx.schema.experiment import validate
 
+log = logging.getLogger("cerebx")
+
 SWEEP_SUMMARY = "sweep_summary"  # hydra/callbacks option that prints a sweep's table when it ends
 # Registered here, in code: config files name no code. `cerebx run -m` selects it (cli.py).
 ConfigStore.instance().store(group="hydra/callbacks", name=SWEEP_SUMMARY, package="hydra.callbacks",
@@ -25,6 +28,7 @@ def run_app(cfg: DictConfig) -> float | None:
     from cerebx import jobenv
 
     jobenv.configure()  # before numba is imported: launchers' jobs do not inherit the Makefile's env
+    log.info("job: %s", jobenv.describe())
     from cerebx.loop import resume
     from cerebx.loop.runner import run_experiment
     from cerebx.report.console import print_summary

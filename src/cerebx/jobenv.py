@@ -46,3 +46,11 @@ def configure(environ: dict[str, str] | None = None) -> dict[str, str]:
     if environ is None and "numba" in sys.modules and set_now:
         return {}  # too late for this process; nothing changed in effect
     return set_now
+
+
+def describe(environ: dict[str, str] | None = None) -> str:
+    """One line for the job's log: where it runs and with which numba settings."""
+    env = os.environ if environ is None else environ
+    keys = ("SLURM_JOB_ID", "SLURM_ARRAY_TASK_ID", "SLURM_RESTART_COUNT", "SLURM_CPUS_PER_TASK",
+            "NUMBA_NUM_THREADS", "NUMBA_CACHE_DIR")
+    return " ".join(f"{k}={env[k]}" for k in keys if env.get(k))
