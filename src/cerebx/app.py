@@ -38,11 +38,14 @@ def run_app(cfg: DictConfig) -> float | None:
     try:
         plain = to_plain(cfg)
         exp = validate(plain)
-        exp, run_dir = resume.continued(exp, plain, run_dir)
+        exp, run_dir, reused = resume.continued(exp, plain, run_dir)
     except ConfigError as err:
         for line in err.problems:
             print(line, file=sys.stderr)
         raise SystemExit(2) from None
+    if reused is not None:
+        print(f"reused: {run_dir} already completed {reused.get('trials_completed')} trials")
+        return reused.get("final_mae")
     choices = user_choices(hc.runtime.choices)
     summary = run_experiment(exp, run_dir, plain, overrides=list(hc.overrides.task), choices=choices)
     print_summary(summary, run_dir)

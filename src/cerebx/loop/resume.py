@@ -36,6 +36,7 @@ from cerebx.recording.segments import FIRST, add_segment
 log = logging.getLogger("cerebx")
 
 CHECKPOINT = "checkpoint.pkl"
+AUTO = "auto"  # resume=auto: reuse, continue or start the run in its own output folder
 _LOOP_FIELDS = ("tick", "trials_done", "metrics", "_sensed", "_task_rng", "_events")
 _RECORDER = "recorder"  # persistent id of the run's recorder inside the pickle
 
@@ -138,7 +139,7 @@ def expand_args(args: list[str]) -> list[str]:
     """``cerebx run resume=RUN_DIR [overrides]``: the overrides RUN_DIR was run with, then the given ones,
     with Hydra's output in RUN_DIR (its files of this attempt in ``.hydra.resumed``)."""
     given = [a for a in args if a.startswith("resume=")]
-    if not given:
+    if not given or given[-1] == f"resume={AUTO}":
         return args
     run_dir = Path(given[-1].split("=", 1)[1].strip("'\""))
     saved = run_dir / ".hydra" / "overrides.yaml"
@@ -175,14 +176,49 @@ def requeued_dir(run_dir: Path) -> Path | None:
     return None
 
 
-def continued(exp: Any, plain: dict, output_dir: Path) -> tuple[Any, Path]:
-    """The config and folder of a run: ``resume=RUN_DIR`` continues in RUN_DIR; a requeued SLURM job
-    continues in its own folder from its last checkpoint; any other run starts in ``output_dir``.
-    Raises ConfigError (before anything is written) when the continuation is not possible."""
-    if exp.resume is None and requeued_dir(output_dir) is not None:
+def continued(exp: Any, plain: dict, output_dir: Path) -> tuple[Any, Path, dict | None]:
+    """The config and folder of a run, and the summary of a finished run it reuses (then nothing is run).
+
+    ``resume=RUN_DIR`` continues in RUN_DIR; ``resume=auto`` (the report's jobs) reuses a completed run in
+    ``output_dir`` that has enough trials, continues one that left a checkpoint, else starts afresh there;
+    a requeued SLURM job continues in its own folder from its last checkpoint; any other run starts in
+    ``output_dir``. Raises ConfigError (before anything is written) when a continuation is not possible.
+    """
+    output_dir = Path(output_dir)
+    if exp.resume == AUTO:
+        done = _completed(output_dir)
+        if done is not None and (done.get("trials_completed") or 0) >= exp.trials:
+            return exp, output_dir, done
+        target = str(output_dir) if (output_dir / CHECKPOINT).exists() else None
+        if target is not None:
+            try:
+                check(exp, output_dir)
+            except ConfigError as err:
+                log.warning("not resuming %s: %s", output_dir, err)
+                target = None
+        if target is None:
+            _clear(output_dir)
+        exp = exp.model_copy(update={"resume": target})
+        plain["resume"] = target
+    elif exp.resume is None and requeued_dir(output_dir) is not None:
         plain["resume"] = str(output_dir)
         exp = exp.model_copy(update={"resume": str(output_dir)})
     if exp.resume is None:
-        return exp, Path(output_dir)
+        return exp, output_dir, None
     check(exp, Path(exp.resume))
-    return exp, Path(exp.resume)
+    return exp, Path(exp.resume), None
+
+
+def _completed(run_dir: Path) -> dict | None:
+    try:
+        s = json.loads((run_dir / "summary.json").read_text())
+    except (OSError, ValueError):
+        return None
+    return s if s.get("status") == "completed" else None
+
+
+def _clear(run_dir: Path) -> None:
+    """Drop what an unfinished attempt without a usable checkpoint left (a fresh run writes it anew)."""
+    for p in [*run_dir.glob("run.*.mcap"), run_dir / "segments.json", run_dir / CHECKPOINT,
+              run_dir / (CHECKPOINT + ".json"), run_dir / "summary.json"]:
+        p.unlink(missing_ok=True)

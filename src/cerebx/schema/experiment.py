@@ -84,7 +84,8 @@ class _ExperimentBase(Strict):
     init_from: str | None = Field(None, description="run folder whose learned state starts this run")
     resume: str | None = Field(
         None, description="run folder to continue from its last checkpoint (same config; trials may grow); the "
-        "continuation logs into a further MCAP segment")
+        "continuation logs into a further MCAP segment. 'auto': in the run's own output folder, reuse a completed "
+        "run, continue from a checkpoint, else start afresh (the report's jobs)")
     warmup_trials: int = Field(
         0, ge=0, description="the first trials let a learned controller settle onto the path; they are run and "
         "logged like the others, and the report leaves them out of its statistics")
@@ -139,7 +140,7 @@ class _ExperimentBase(Strict):
             state = Path(self.init_from) / "controller_state.npz"
             if not state.is_file():
                 problems.append(f"init_from: {state} does not exist (give a run folder that saved its state)")
-        if self.resume is not None:
+        if self.resume not in (None, "auto"):
             from pathlib import Path
 
             if not (Path(self.resume) / "checkpoint.pkl").is_file():
