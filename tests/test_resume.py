@@ -125,3 +125,27 @@ def test_resume_args_repeat_the_run_overrides(tmp_path):
     assert args == ["+experiment=demo", "seed=3", "trials=20", f"resume={tmp_path}", f"hydra.run.dir={tmp_path}",
                     "hydra.output_subdir=.hydra.resumed"]
     assert resume.expand_args(["+experiment=demo"]) == ["+experiment=demo"]
+
+
+def test_resume_auto_reuses_continues_or_restarts(tmp_path, load):
+    from cerebx.build import build_components
+    from cerebx.loop.loop import ClosedLoop
+
+    cfg = load([*RUN, "trials=6", "resume=auto"])
+    plain: dict = {}
+    # nothing there: a fresh run, and stale files of an attempt without checkpoint are dropped
+    (tmp_path / "segments.json").write_text("{}")
+    exp, run_dir, reused = resume.continued(cfg, plain, tmp_path)
+    assert (exp.resume, run_dir, reused) == (None, tmp_path, None) and not (tmp_path / "segments.json").exists()
+    # a checkpoint of the same config: continue from it
+    loop = ClosedLoop(build_components(load([*RUN, "trials=6"])), None)
+    loop.start()
+    loop.run_trial(0)
+    resume.save(loop, tmp_path, wall_seconds=0.5)
+    exp, run_dir, reused = resume.continued(cfg, plain, tmp_path)
+    assert exp.resume == str(tmp_path) and plain["resume"] == str(tmp_path) and reused is None
+    # completed with enough trials: reused, nothing runs
+    (tmp_path / "summary.json").write_text(json.dumps({"status": "completed", "trials_completed": 6}))
+    assert resume.continued(cfg, {}, tmp_path)[2]["trials_completed"] == 6
+    # completed with fewer trials than asked: continue from its checkpoint
+    assert resume.continued(load([*RUN, "trials=8", "resume=auto"]), {}, tmp_path)[0].resume == str(tmp_path)
