@@ -326,7 +326,8 @@ class _Scheduler:
         self.t0 = time.monotonic()
 
     def run(self) -> list[str]:
-        self.log(f"studies: {self.reused + len(self.todo)} jobs, {self.reused} reused, {len(self.todo)} to run")
+        what = "studies" if self.todo and isinstance(self.todo[0], Study) else "jobs"
+        self.log(f"studies: {self.reused + len(self.todo)} {what}, {self.reused} reused, {len(self.todo)} to run")
         with ThreadPoolExecutor(max_workers=self.parallel) as pool:
             try:
                 while self.pending or self.running:
