@@ -48,8 +48,9 @@ def test_sweep_runs_every_job_and_counts_the_failures(in_tmp, monkeypatch, capsy
     assert good["status"] == "completed" and good["trials_completed"] == 1
     err = capsys.readouterr().err
     assert "1 of 2 jobs completed, 1 failed (exit code 1)" in err
-    table = [ln for ln in err.splitlines() if ln.startswith(("0 ", "1 "))]
-    assert table[0].split()[:2] == ["0", "failed"] and table[1].split()[:2] == ["1", "completed"]
+    table = [ln.split("|")[1:-1] for ln in err.splitlines() if ln.startswith(("| 0 |", "| 1 |"))]
+    assert [c.strip() for c in table[0][:3]] == ["0", "1", "failed"] and "state of another network" in table[0][-1]
+    assert [c.strip() for c in table[1][:3]] == ["1", "2", "completed"]
 
 
 def test_sweep_exit_code_is_the_number_of_failed_jobs(in_tmp, monkeypatch, capsys):

@@ -153,3 +153,22 @@ def test_ctrl_c_stops_the_study_runner_and_says_how_to_resume(tmp_path):
     finally:
         signal.signal(signal.SIGINT, previous)
     assert any("interrupted" in line and "run again to resume" in line for line in lines)
+
+
+def test_studies_are_multiruns_of_their_presets(tmp_path):
+    from cerebx.report.studies import group, preset_sweep
+
+    assert preset_sweep(["+experiment=fig3_4_pd"]) == [[f"delay.total_ms={ms}"] for ms in (0, 20, 40, 60, 80)]
+    assert preset_sweep(["+experiment=baselines", "controller=pd"]) == [[]]  # an arg fixes the swept key
+    jobs = plan("quick", tmp_path, ["fig3_4_snn"])
+    studies = group(jobs)
+    assert [s.name for s in studies] == ["learn_circle", "fig3_4_snn"]
+    assert studies[1].deps == [studies[0]] and len(studies[1].jobs) == 5
+    assert jobs[1].run_dir == tmp_path / "quick" / "fig3_4_snn" / "delay.total_ms=0"
+    ov = studies[1].overrides(["hydra/launcher=slurm"])
+    assert ov[:2] == ["-m", "+experiment=fig3_4_snn"] and ov[-1] == "hydra/launcher=slurm"
+    assert "resume=auto" in ov and f"hydra.sweep.dir='{tmp_path / 'quick' / 'fig3_4_snn'}'" in ov
+    assert "hydra.sweep.subdir=${hydra.job.override_dirname}" in ov
+    excluded = next(o for o in ov if o.startswith("hydra.job.config.override_dirname.exclude_keys="))
+    assert "delay.total_ms" not in excluded and "init_from" in excluded and "trials" in excluded
+    assert "hydra.sweep.subdir=run" in studies[0].overrides()

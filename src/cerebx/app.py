@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import sys
 from pathlib import Path
 
@@ -15,9 +16,15 @@ from cerebx.errors import ConfigError
 from cerebx.schema.experiment import validate
 from cerebx.sweep import ERROR_FILE
 
+log = logging.getLogger("cerebx")
 
 @hydra.main(config_path="conf", config_name="config", version_base="1.3")
 def run_app(cfg: DictConfig) -> float | None:
+    from cerebx import jobenv
+
+    jobenv.configure()  # before numba is imported: launchers' jobs do not inherit the Makefile's env
+    log.info("job: %s", jobenv.describe())
+    from cerebx.loop import resume
     from cerebx.loop.runner import run_experiment
     from cerebx.report.console import print_summary
 
@@ -27,6 +34,7 @@ def run_app(cfg: DictConfig) -> float | None:
     try:
         plain = to_plain(cfg)
         exp = validate(plain)
+        exp, run_dir, reused = resume.continued(exp, plain, run_dir)
     except ConfigError as err:
         for line in err.problems:
             print(line, file=sys.stderr)
@@ -34,6 +42,9 @@ def run_app(cfg: DictConfig) -> float | None:
             (run_dir / ERROR_FILE).write_text("; ".join(err.problems) + "\n")
             return None
         raise SystemExit(2) from None
+    if reused is not None:
+        print(f"reused: {run_dir} already completed {reused.get('trials_completed')} trials")
+        return reused.get("final_mae")
     choices = user_choices(hc.runtime.choices)
     summary = run_experiment(exp, run_dir, plain, overrides=list(hc.overrides.task), choices=choices)
     print_summary(summary, run_dir)

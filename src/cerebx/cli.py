@@ -23,13 +23,14 @@ commands:
   inspect RUN_DIR|FILE.mcap                            a run's summary and its MCAP channels
   bench [--seconds S] [--networks a,b]                 speed of plant, network and closed loop (JSON)
   report [RUN_DIR ...]                                 build reports/ from run logs
+  summarize MULTIRUN_DIR                               one table of a sweep's jobs (CSV, Markdown, plot)
   tune [--out PATH] OVERRIDES...                       Ziegler-Nichols PD gains on the simulated plant
 
 groups: task (required, +task=), controller (snn), plant (baxter), delay (none),
         network (thesis_ch3), experiment (presets: +experiment=NAME)
 """
 
-COMMANDS = ("run", "validate", "inspect", "bench", "report", "tune")
+COMMANDS = ("run", "validate", "inspect", "bench", "report", "tune", "summarize")
 _PASS_THROUGH = ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i", "--resolve",
                  "--package", "-p", "-sc", "--shell-completion", "--config-dir", "-cd",
                  "--config-name", "-cn", "--config-path", "-cp", "--experimental-rerun")
@@ -45,8 +46,13 @@ def _fail(lines: list[str]) -> int:
 def _run(args: list[str]) -> int:
     from cerebx.config import check, check_output_dir
     from cerebx.guard import check_args
+    from cerebx.loop.resume import expand_args
 
     problems = check_args(args)  # before Hydra reads any of it, whatever the flags
+    if problems:
+        return _fail(problems)
+    args = expand_args(args)  # resume=RUN_DIR: that run's overrides (checked like the given ones)
+    problems = check_args(args)
     if problems:
         return _fail(problems)
     multirun = any(a in ("-m", "--multirun") for a in args)
@@ -74,11 +80,14 @@ def _run(args: list[str]) -> int:
     run_app()
     if root is None:
         return 0
-    from cerebx.sweep import MAX_EXIT_CODE, table
+    from cerebx.report.sweep import report
 
-    lines, failed = table(root)
-    print("\n".join(lines), file=sys.stderr if failed else sys.stdout)
-    return min(failed, MAX_EXIT_CODE)
+    try:
+        text, code = report(root)
+    except CerebxError as err:  # no job folder at all (every job refused before Hydra made one)
+        return _fail([str(err)])
+    print(text, file=sys.stderr if code else sys.stdout)
+    return code
 
 
 INTERNAL_GROUPS = ("report",)
@@ -111,6 +120,12 @@ def _size_problems(estimates: list, args: list[str], multirun: bool) -> list[str
     return [why] if why else []
 
 
+def _summarize(args: list[str]) -> int:
+    from cerebx.report.sweep import main as summarize_main
+
+    return summarize_main(args)
+
+
 def _validate(args: list[str]) -> int:
     from cerebx.config import load
     from cerebx.errors import ConfigError
@@ -131,7 +146,8 @@ def _validate(args: list[str]) -> int:
 
 def _inspect(args: list[str]) -> int:
     """The run's summary and its channels; a bad summary or log is one line each, the other still shown."""
-    from cerebx.recording.reader import channel_counts, has_summary, mcap_path, read_summary
+    from cerebx.recording.reader import channel_counts, has_summary, read_summary
+    from cerebx.recording.segments import segments
     from cerebx.report.console import format_summary
 
     if len(args) != 1:
@@ -146,13 +162,16 @@ def _inspect(args: list[str]) -> int:
             print(format_summary(read_summary(run_dir), run_dir))
         except CerebxError as err:
             problems.append(str(err))
-    log = mcap_path(p)
+    log = p
     try:
-        counts = channel_counts(log)
+        files = [s.path for s in segments(p)] if p.is_dir() else [p]
+        log = files[-1]
+        counts = channel_counts(p)
         width = max(map(len, counts), default=10)
-        closed = has_summary(log)
-        print(f"\n{log}" + ("" if closed else "  (no summary section: counted by scanning up to the last "
-                                                "complete record; the run was killed or is still going)"))
+        closed = all(has_summary(f) for f in files)
+        print("\n" + " + ".join(str(f) for f in files)
+              + ("" if closed else "  (no summary section: counted by scanning up to the last "
+                                   "complete record; the run was killed or is still going)"))
         for topic, n in counts.items():
             print(f"  {topic:<{width}}  {n:>9,}")
     except (CerebxError, OSError) as err:
@@ -227,7 +246,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     cmd, rest = argv[0], argv[1:]
     handlers = {"run": _run, "validate": _validate, "inspect": _inspect, "bench": _bench, "report": _report,
-                "tune": _tune}
+                "tune": _tune, "summarize": _summarize}
     if cmd not in handlers:
         return _fail([f"{cmd}: unknown command (choose from {', '.join(COMMANDS)})"])
     try:

@@ -16,6 +16,7 @@ from typing import Any
 from cerebx import __version__
 from cerebx.build import build_components
 from cerebx.errors import CerebxError, Diverged
+from cerebx.loop import resume
 from cerebx.loop.loop import ClosedLoop
 from cerebx.recording.recorder import Recorder
 from cerebx.recording.sentinel import Sentinel
@@ -63,32 +64,41 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
     summary = new_summary(cfg, version=__version__, overrides=list(overrides or []), started_at=started,
                           presets=dict(choices or {}))
     write_summary(run_dir, summary)
-    sentinel = Sentinel(run_dir)  # finishes run.mcap and summary.json if this process is hard-killed
-    rec = Recorder(run_dir / "run.mcap", chunk_size_kb=cfg.recording.chunk_size_kb,
+    sentinel = Sentinel(run_dir)  # finishes the log and summary.json if this process is hard-killed
+    rec = Recorder(resume.recorder_path(cfg, run_dir), chunk_size_kb=cfg.recording.chunk_size_kb,
                    compression=cfg.recording.compression)
     rec.metadata("cerebx", {"version": __version__, "overrides": json.dumps(list(overrides or []))})
     rec.metadata("config", {"json": json.dumps(resolved if resolved is not None else cfg.model_dump(mode="json"))})
     loop: ClosedLoop | None = None
     bar = None
+    wall_before = 0.0  # spent by the run this one continues
     try:
         with _sigterm_as_interrupt():
-            ctx = build_components(cfg, run_dir)
+            if cfg.resume is not None:
+                loop, wall_before = resume.load(cfg, run_dir, rec)
+            ctx = loop.ctx if loop is not None else build_components(cfg, run_dir)
             rec.joint_names = tuple(ctx.plant.joint_names)
-            if cfg.init_from:
+            if cfg.init_from and loop is None:
                 state = Path(cfg.init_from) / STATE_FILE
                 if not state.exists():
                     raise CerebxError(f"init_from: {state} does not exist")
                 ctx.brain[0].load_state(state)
-            loop = ClosedLoop(ctx, rec)
-            loop.start()
+            if loop is None:
+                loop = ClosedLoop(ctx, rec)
+                loop.start()
             summary["controller_info"] = ctx.brain[0].describe()
             bar = _progress(cfg, cfg.trials)
-            for trial in range(cfg.trials):
+            if bar is not None:
+                bar.update(loop.trials_done)
+            for trial in range(loop.trials_done, cfg.trials):
                 m = loop.run_trial(trial)
+                if resume.due(loop):
+                    resume.save(loop, run_dir, wall_before + time.perf_counter() - wall0)
                 if bar is not None:
                     bar.set_postfix_str(f"trial {trial + 1}/{cfg.trials}  MAE {m.mae:.4f} rad")
                     bar.update(1)
-                summary.update(trial_fields(loop.metrics, loop.sim_seconds), wall_seconds=time.perf_counter() - wall0)
+                summary.update(trial_fields(loop.metrics, loop.sim_seconds),
+                               wall_seconds=wall_before + time.perf_counter() - wall0)
                 write_summary(run_dir, summary)
             summary["status"] = "completed"
     except KeyboardInterrupt:
@@ -107,7 +117,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             bar.close()
         if summary["status"] == "running":  # left by an exception that is not an Exception (SystemExit)
             summary["status"] = "failed"
-        wall = time.perf_counter() - wall0
+        wall = wall_before + time.perf_counter() - wall0
         if loop is not None:
             summary.update(trial_fields(loop.metrics, loop.sim_seconds))
             if cfg.recording.save_state and loop.trials_done > 0:
@@ -123,4 +133,6 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             rec.close()
             write_summary(run_dir, summary)
             sentinel.done()
+            if summary["status"] == "completed":
+                resume.finish(run_dir)
     return summary

@@ -11,6 +11,7 @@ from mcap.decoder import DecoderFactory
 from mcap.reader import make_reader
 
 from cerebx.errors import CerebxError
+from cerebx.recording.segments import segments
 from cerebx.recording.summary import read_summary
 
 __all__ = ["channel_counts", "mcap_path", "read_messages", "read_metadata", "read_summary"]
@@ -91,10 +92,27 @@ def read_messages(path: Path | str, topics: list[str] | None = None, start_ns: i
                   end_ns: int | None = None) -> Iterator[tuple[str, int, Any]]:
     """Yield (topic, log_time_ns, decoded message) in log-time order.
 
-    A file without a summary section (a run still going, or one killed with SIGKILL) is read as a
+    A run folder is read across its segments (a resumed run: ``run.mcap``, ``run.1.mcap`` …) as one
+    log. A file without a summary section (a run still going, or one killed with SIGKILL) is read as a
     stream up to its last complete record.
     """
-    p = mcap_path(path)
+    p = Path(path)
+    if not p.is_dir():
+        yield from _read_file(p, topics, start_ns, end_ns)
+        return
+    for seg in segments(p):
+        lo = seg.start_ns if start_ns is None else max(start_ns, seg.start_ns)
+        hi = seg.end_ns + 1 if seg.end_ns is not None else None  # the boundary itself: see owns()
+        if end_ns is not None:
+            hi = end_ns if hi is None else min(end_ns, hi)
+        if hi is None or lo < hi:
+            for topic, t, msg in _read_file(seg.path, topics, lo, hi):
+                if seg.owns(topic, t):
+                    yield topic, t, msg
+
+
+def _read_file(p: Path, topics: list[str] | None, start_ns: int | None,
+               end_ns: int | None) -> Iterator[tuple[str, int, Any]]:
     if not p.exists():
         raise CerebxError(f"{p}: no such file")
     with open(p, "rb") as fh:
@@ -115,9 +133,15 @@ def read_messages(path: Path | str, topics: list[str] | None = None, start_ns: i
 
 
 def channel_counts(path: Path | str) -> dict[str, int]:
-    """Message count per topic: from the file's summary section, or by scanning a file without one."""
+    """Message count per topic: from the file's summary section, by scanning a file without one, or (a
+    resumed run's folder) counted over its segments as :func:`read_messages` reads them."""
     from mcap.records import Channel, Message
 
+    if Path(path).is_dir() and len(segments(path)) > 1:
+        per_topic: dict[str, int] = {}
+        for topic, _t, _msg in read_messages(path):
+            per_topic[topic] = per_topic.get(topic, 0) + 1
+        return dict(sorted(per_topic.items()))
     p = mcap_path(path)
     if not p.exists():
         raise CerebxError(f"{p}: no such file")
@@ -149,9 +173,11 @@ def has_summary(path: Path | str) -> bool:
 
 
 def read_metadata(path: Path | str) -> dict[str, dict[str, str]]:
+    """The metadata records of a file; of a run folder, its last segment's (each segment carries the
+    config, and the last one the summary of the whole run)."""
     from mcap.records import Metadata
 
-    p = mcap_path(path)
+    p = segments(path)[-1].path if Path(path).is_dir() else Path(path)
     if not p.exists():
         raise CerebxError(f"{p}: no such file")
     with open(p, "rb") as fh:

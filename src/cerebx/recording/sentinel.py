@@ -20,6 +20,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+from cerebx.errors import CerebxError
+from cerebx.recording.segments import segments
+
 MAGIC = b"\x89MCAP0\r\n"
 _DATA_END = 0x0F
 _FOOTER = 0x02
@@ -115,7 +118,12 @@ def _watch(run_dir: Path) -> int:
     word = sys.stdin.buffer.read()  # blocks until the run closes the pipe, by done() or by dying
     if word == _DONE:
         return 0
-    seal(run_dir / "run.mcap")
+    try:
+        files = [seg.path for seg in segments(run_dir)]  # a resumed run writes into its last segment
+    except CerebxError:
+        files = [run_dir / "run.mcap"]
+    for path in files:
+        seal(path)
     mark_killed(run_dir)
     return 0
 

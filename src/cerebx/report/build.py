@@ -170,7 +170,11 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--profile", choices=("quick", "full"),
                     help="run the missing studies of this profile into runs/report/PROFILE first")
     ap.add_argument("--figures", help="comma-separated figure names (default: all), e.g. fig3_4,fig3_6")
-    ap.add_argument("--jobs", type=int, default=2, help="experiments run at once (default 2)")
+    ap.add_argument("--jobs", type=int, default=2, help="studies run at once (default 2); each is one "
+                    "`cerebx run -m`, whose launcher runs its jobs")
+    ap.add_argument("-o", "--override", action="append", default=[], metavar="OVERRIDE",
+                    help="Hydra override for every study's multirun, e.g. -o hydra/launcher=slurm "
+                    "(repeatable; see README 'Sweeps on SLURM')")
     ap.add_argument("--dry-run", action="store_true", help="with --profile: list the jobs, run nothing")
     ap.add_argument("--out", type=Path, default=Path("reports"), help="output folder (default reports/)")
     ap.add_argument("--list", action="store_true", help="list the figures and the studies they need")
@@ -184,7 +188,7 @@ def main(argv: list[str]) -> int:
             return 0
         failed: list[str] = []
         if a.profile:
-            from cerebx.report.studies import execute, plan
+            from cerebx.report.studies import execute, group, plan, study_runner
 
             root = Path("runs") / "report"
             jobs = plan(a.profile, root, needed_studies(names))
@@ -198,7 +202,7 @@ def main(argv: list[str]) -> int:
                 print(f"{len(todo)} runs to do: {est.line()}", *bad, sep="\n")
                 return 0
             try:
-                failed = execute(jobs, parallel=a.jobs)
+                failed = execute(group(jobs), runner=study_runner(a.override), parallel=a.jobs)
             except KeyboardInterrupt:
                 print("report: interrupted; finished runs are kept (run the same command again to resume)",
                       file=sys.stderr)

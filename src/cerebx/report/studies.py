@@ -1,14 +1,17 @@
 """Run the experiment studies a report needs (conf/report/studies.yaml), reusing finished runs.
 
-A study is an experiment preset run once or as a sweep. Each job lands in
-``runs/report/<profile>/<study>/<job>``; a job whose folder holds a completed summary with enough
-trials is reused, anything else (missing, failed, interrupted) is run again. Jobs run as
-``cerebx run`` subprocesses, ``jobs`` at a time, each after the study it starts from.
+A study is an experiment preset run as a Hydra multirun (``cerebx run -m``): once, or over the sweep
+the preset declares (``hydra.sweeper.params``; the only place a sweep is defined), through whatever
+launcher the report is given (``-o hydra/launcher=slurm``, ``joblib`` …). Each job lands in
+``runs/report/<profile>/<study>/<job>`` (``run``, or the swept overrides, e.g. ``delay.total_ms=20``).
+Jobs run with ``resume=auto``: a job whose folder holds a completed summary with enough trials is
+reused, one that left a checkpoint continues from it, anything else runs again. Studies run ``jobs``
+at a time, each after the study whose learned state it starts from.
 """
 
 from __future__ import annotations
 
-import itertools
+import functools
 import shutil
 import signal
 import subprocess
@@ -18,6 +21,7 @@ from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import yaml
 from pydantic import Field, ValidationError
@@ -41,9 +45,8 @@ class ProfileSpec(Strict):
 class StudySpec(Strict):
     """One experiment preset run once or as a sweep."""
 
-    args: list[str] = Field(min_length=1, description="overrides of every job, the experiment preset first")
-    sweep: dict[str, list[str | int | float]] = Field(
-        default_factory=dict, description="override key -> values; one job per combination")
+    args: list[str] = Field(min_length=1, description="overrides of every job, the experiment preset first (its "
+                            "hydra.sweeper.params make the study a sweep; an arg setting a swept key fixes it)")
     init_from: str | None = Field(None, description="single-run study whose learned state starts each job")
     quick: ProfileSpec = Field(description="the quick profile (< 30 min on 2 cores in all)")
     full: ProfileSpec = Field(description="the full profile (the thesis's trial counts)")
@@ -66,9 +69,42 @@ def load_studies(path: Path = STUDIES_FILE) -> dict[str, StudySpec]:
     for name, s in studies.items():
         for prof in PROFILES:
             src = _init_from(s, prof)
-            if src is not None and (src not in studies or studies[src].sweep):
+            if src is not None and (src not in studies or preset_sweep(studies[src].args) != [[]]):
                 raise ConfigError(f"{path}: studies.{name}.init_from: {src!r} is not a single-run study")
     return studies
+
+
+def _key(override: str) -> str:
+    return override.split("=", 1)[0].lstrip("+~")
+
+
+def preset_sweep(args: list[str]) -> list[list[str]]:
+    """The job overrides of the sweep the preset in ``args`` declares (``hydra.sweeper.params``), less the
+    keys ``args`` sets; ``[[]]`` when there is none (one job)."""
+    return [list(c) for c in _preset_sweep(tuple(args))]
+
+
+@functools.lru_cache(maxsize=256)
+def _preset_sweep(args: tuple[str, ...]) -> tuple[tuple[str, ...], ...]:
+    args = list(args)
+    from hydra import compose, initialize_config_module
+    from hydra.core.global_hydra import GlobalHydra
+    from hydra.errors import HydraException
+    from omegaconf import OmegaConf
+
+    from cerebx.config import expand_sweep
+
+    GlobalHydra.instance().clear()
+    try:
+        with initialize_config_module(config_module="cerebx.conf", version_base="1.3"):
+            hydra_cfg = compose(config_name="config", overrides=args, return_hydra_config=True).hydra
+    except HydraException as err:
+        raise ConfigError(f"study {' '.join(args)}: {str(err).splitlines()[0]}") from None
+    node = hydra_cfg.sweeper.get("params")
+    params = OmegaConf.to_container(node, resolve=False) if node else {}
+    fixed = {_key(a) for a in args}
+    sweep = [f"{k}={v}" for k, v in params.items() if _key(k) not in fixed]
+    return tuple(tuple(sorted(c)) for c in expand_sweep(sweep)) if sweep else ((),)
 
 
 def _init_from(s: StudySpec, profile: str) -> str | None:
@@ -90,11 +126,28 @@ class Job:
     def name(self) -> str:
         return f"{self.study}/{self.label}"
 
+    sweep_args: list[str] = field(default_factory=list)  # this job's point of its preset's sweep
+
     def overrides(self) -> list[str]:
+        return [*self.common(), *self.sweep_args]
+
+    def common(self) -> list[str]:
+        """The overrides every job of the study shares."""
         out = [*self.args, f"trials={self.trials}"]
         if self.after is not None:
             out.append(f"init_from='{self.deps[0].run_dir}'")
         return out
+
+    def prepare(self) -> None:
+        if self.run_dir.exists():
+            shutil.rmtree(self.run_dir)  # an unfinished earlier attempt
+
+    def describe(self) -> str:
+        from cerebx.recording.summary import read_summary
+
+        s = read_summary(self.run_dir)
+        mae = s.get("final_mae")
+        return f"final MAE {mae if mae is None else round(mae, 4)} rad, {s.get('wall_seconds', 0):.0f} s"
 
     def done(self) -> bool:
         from cerebx.recording.summary import read_summary
@@ -130,22 +183,77 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
     for n in wanted:
         s = studies[n]
         p: ProfileSpec = getattr(s, profile)
-        keys = list(s.sweep)
-        combos = itertools.product(*(s.sweep[k] for k in keys)) if keys else [()]
+        args = [*s.args, *p.args]
         src = _init_from(s, profile)
-        for combo in combos:
-            sweep_args = [f"{k}={v}" for k, v in zip(keys, combo)]
-            label = ",".join(a.lstrip("+") for a in sweep_args) or "run"
-            job = Job(n, label, [*s.args, *p.args, *sweep_args], p.trials, root / profile / n / label, src)
+        for sweep_args in preset_sweep(args):
+            label = ",".join(sweep_args) or "run"  # as Hydra's override_dirname names the job's folder
+            job = Job(n, label, args, p.trials, root / profile / n / label, src, sweep_args=sweep_args)
             if src is not None:
                 job.deps = [single[src]]
-            if not keys:
+            if not sweep_args:
                 single[n] = job
             jobs.append(job)
     return jobs
 
 
-Runner = Callable[[Job], int]
+@dataclass
+class Study:
+    """The jobs of one study, run together as one ``cerebx run -m``."""
+
+    name: str
+    jobs: list[Job]
+    deps: list[Study] = field(default_factory=list, repr=False)
+
+    @property
+    def sweep_dir(self) -> Path:
+        return self.jobs[0].run_dir.parent
+
+    @property
+    def trials(self) -> int:
+        return self.jobs[0].trials * len(self.jobs)
+
+    @property
+    def run_dir(self) -> Path:  # where its log goes
+        return self.sweep_dir
+
+    def done(self) -> bool:
+        return all(j.done() for j in self.jobs)
+
+    def prepare(self) -> None:
+        """Nothing to clear: each job reuses, resumes or restarts itself (resume=auto)."""
+
+    def describe(self) -> str:
+        from cerebx.recording.summary import read_summary
+
+        maes = [read_summary(j.run_dir)["final_mae"] for j in self.jobs]
+        text = ", ".join("-" if m is None else f"{m:.4f}" for m in maes)
+        return f"{len(self.jobs)} job{'s' * (len(self.jobs) > 1)}, final MAE {text} rad"
+
+    def overrides(self, extra: list[str] = ()) -> list[str]:
+        """``cerebx run -m`` overrides: the shared ones, then where the jobs go, then ``extra`` (a launcher)."""
+        common = self.jobs[0].common()
+        swept = bool(self.jobs[0].sweep_args)
+        out = ["-m", *common, "resume=auto", "recording.progress=off", f"hydra.sweep.dir='{self.sweep_dir}'"]
+        if swept:
+            keys = sorted({_key(a) for a in [*common, "resume=", "recording.progress="]})
+            out += ["hydra.sweep.subdir=${hydra.job.override_dirname}",
+                    f"hydra.job.config.override_dirname.exclude_keys=[{','.join(keys)}]"]
+        else:
+            out.append("hydra.sweep.subdir=run")
+        return [*out, *extra]
+
+
+def group(jobs: list[Job]) -> list[Study]:
+    """The jobs as studies (in plan order), each depending on the studies its jobs start from."""
+    studies: dict[str, Study] = {}
+    for j in jobs:
+        studies.setdefault(j.study, Study(j.study, [])).jobs.append(j)
+    for st in studies.values():
+        st.deps = [studies[d.study] for d in st.jobs[0].deps if d.study in studies]
+    return list(studies.values())
+
+
+Runner = Callable[[Any], int]  # runs one Job, or one Study
 
 
 def subprocess_runner(job: Job) -> int:
@@ -167,6 +275,26 @@ def subprocess_runner(job: Job) -> int:
 _children: set[subprocess.Popen] = set()  # the `cerebx run` processes under way
 
 
+def study_runner(extra: list[str] = ()) -> Runner:
+    """Runs a :class:`Study` as one ``cerebx run -m`` child (``extra``: e.g. the launcher); its output goes
+    to ``<study>/study.log``."""
+
+    def run(study: Study) -> int:
+        study.sweep_dir.mkdir(parents=True, exist_ok=True)
+        cmd = [sys.executable, "-m", "cerebx", "run", *study.overrides(list(extra))]
+        with open(study.sweep_dir / "study.log", "a") as log:
+            log.write(" ".join(cmd) + "\n")
+            log.flush()
+            proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT)
+            _children.add(proc)
+            try:
+                return proc.wait()
+            finally:
+                _children.discard(proc)
+
+    return run
+
+
 def in_process_runner(job: Job) -> int:
     """Run in this process (for tests: no interpreter start-up per job)."""
     from cerebx.config import compose_with_choices, to_plain
@@ -179,9 +307,9 @@ def in_process_runner(job: Job) -> int:
     return 0 if s["status"] == "completed" else 1
 
 
-def execute(jobs: list[Job], runner: Runner = subprocess_runner, parallel: int = 2,
+def execute(jobs: list[Any], runner: Runner = subprocess_runner, parallel: int = 2,
             log: Callable[[str], None] | None = None) -> list[str]:
-    """Run every job that is not done, ``parallel`` at a time; returns one line per failed job.
+    """Run every job (or :class:`Study`) that is not done, ``parallel`` at a time; returns one line per failed one.
 
     Ctrl-C stops the jobs under way (their runs end as ``interrupted``) and re-raises; finished runs
     are kept, so running again resumes.
@@ -203,7 +331,8 @@ class _Scheduler:
         self.t0 = time.monotonic()
 
     def run(self) -> list[str]:
-        self.log(f"studies: {self.reused + len(self.todo)} jobs, {self.reused} reused, {len(self.todo)} to run")
+        what = "studies" if self.todo and isinstance(self.todo[0], Study) else "jobs"
+        self.log(f"studies: {self.reused + len(self.todo)} {what}, {self.reused} reused, {len(self.todo)} to run")
         with ThreadPoolExecutor(max_workers=self.parallel) as pool:
             try:
                 while self.pending or self.running:
@@ -229,24 +358,20 @@ class _Scheduler:
                 self.log(self.failed[j.name])
             elif all(d.name in self.finished for d in j.deps) and len(self.running) < self.parallel:
                 self.pending.remove(j)
-                if j.run_dir.exists():
-                    shutil.rmtree(j.run_dir)  # an unfinished earlier attempt
+                j.prepare()
                 self.log(f"[{self._clock()}] start {j.name} ({j.trials} trials)")
                 self.running[pool.submit(self.runner, j)] = j
 
-    def _record(self, j: Job, fut: Future) -> None:
+    def _record(self, j: Any, fut: Future) -> None:
+        logname = "study.log" if isinstance(j, Study) else "job.log"
         try:
-            rc, why = fut.result(), f"see {j.run_dir / 'job.log'}"
+            rc, why = fut.result(), f"see {j.run_dir / logname}"
         except Exception as err:  # a runner that raises is a failed job, not a failed report
             rc, why = 1, f"{type(err).__name__}: {err}"
         if rc == 0 and j.done():
             self.finished.add(j.name)
-            from cerebx.recording.summary import read_summary
-
-            s = read_summary(j.run_dir)
-            mae = s.get("final_mae")
-            self.log(f"[{self._clock()}] done  {j.name}: final MAE {mae if mae is None else round(mae, 4)} rad, "
-                     f"{s.get('wall_seconds', 0):.0f} s ({len(self.finished) - self.reused}/{len(self.todo)})")
+            self.log(f"[{self._clock()}] done  {j.name}: {j.describe()} ({len(self.finished) - self.reused}/"
+                     f"{len(self.todo)})")
         else:
             self.failed[j.name] = f"{j.name}: failed (exit code {rc}, {why})"
             self.log(self.failed[j.name])

@@ -41,6 +41,9 @@ class RecordingConfig(Strict):
     compression: Literal["zstd", "lz4", "none"] = "zstd"
     progress: Literal["auto", "on", "off"] = "auto"
     save_state: bool = True
+    checkpoint_every: int = Field(
+        10, ge=0, description="trials between checkpoints of the whole loop (resume=RUN_DIR continues from the "
+        "last one; a completed run deletes it); 0: none")
 
 
 def _union(reg: registry.Registry) -> Any:
@@ -83,6 +86,10 @@ class _ExperimentBase(Strict):
         None, description="robot-side stage after the spinal cord standing for the muscles (e.g. an antagonist "
         "muscle law turning agonist/antagonist commands into joint torques); null: the commands drive the plant")
     init_from: str | None = Field(None, description="run folder whose learned state starts this run")
+    resume: str | None = Field(
+        None, description="run folder to continue from its last checkpoint (same config; trials may grow); the "
+        "continuation logs into a further MCAP segment. 'auto': in the run's own output folder, reuse a completed "
+        "run, continue from a checkpoint, else start afresh (the report's jobs)")
     warmup_trials: int = Field(
         0, ge=0, description="the first trials let a learned controller settle onto the path; they are run and "
         "logged like the others, and the report leaves them out of its statistics")
@@ -135,6 +142,12 @@ class _ExperimentBase(Strict):
             from cerebx.schema.init_state import init_from_problems
 
             problems += init_from_problems(self)
+        if self.resume not in (None, "auto"):
+            from pathlib import Path
+
+            if not (Path(self.resume) / "checkpoint.pkl").is_file():
+                problems.append(f"resume: {Path(self.resume) / 'checkpoint.pkl'} does not exist (the run saved no "
+                                "checkpoint, or it completed)")
         if problems:
             raise ValueError("; ".join(problems))
         return self

@@ -1,0 +1,56 @@
+"""Per-job settings of a run's process: numba's cache folder and thread count.
+
+A job started by a launcher (joblib, submitit on SLURM) does not inherit the Makefile's environment, so
+``cerebx run`` sets them itself before numba is first imported. An environment variable that is already
+set wins; otherwise:
+
+- ``NUMBA_CACHE_DIR`` = ``$CEREBX_CACHE/numba`` (``~/.cache/cerebx/numba``): one writable cache per user,
+  shared by the jobs of a sweep on one machine (or one shared home on a cluster);
+- ``NUMBA_NUM_THREADS`` = the CPUs given to this job: ``SLURM_CPUS_PER_TASK`` inside a SLURM job, else
+  the CPUs this process may run on.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+
+def job_cpus(environ: dict[str, str] | None = None) -> int:
+    """CPUs this job may use: SLURM's allocation when inside a SLURM job, else the process's CPU set."""
+    env = os.environ if environ is None else environ
+    try:
+        available = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        available = os.cpu_count() or 1
+    slurm = env.get("SLURM_CPUS_PER_TASK", "")
+    if slurm.isdigit() and int(slurm) > 0:
+        return max(1, min(int(slurm), available))
+    return max(1, available)
+
+
+def numba_cache_dir(environ: dict[str, str] | None = None) -> Path:
+    env = os.environ if environ is None else environ
+    root = Path(env.get("CEREBX_CACHE", Path.home() / ".cache" / "cerebx"))
+    return root / "numba"
+
+
+def configure(environ: dict[str, str] | None = None) -> dict[str, str]:
+    """Set (if unset) the numba variables of this job in ``environ`` (default: the process's); return
+    what was set. Does nothing to numba itself once it is imported (its config is read at import)."""
+    env = os.environ if environ is None else environ
+    chosen = {"NUMBA_CACHE_DIR": str(numba_cache_dir(env)), "NUMBA_NUM_THREADS": str(job_cpus(env))}
+    set_now = {k: v for k, v in chosen.items() if not env.get(k)}
+    env.update(set_now)
+    if environ is None and "numba" in sys.modules and set_now:
+        return {}  # too late for this process; nothing changed in effect
+    return set_now
+
+
+def describe(environ: dict[str, str] | None = None) -> str:
+    """One line for the job's log: where it runs and with which numba settings."""
+    env = os.environ if environ is None else environ
+    keys = ("SLURM_JOB_ID", "SLURM_ARRAY_TASK_ID", "SLURM_RESTART_COUNT", "SLURM_CPUS_PER_TASK",
+            "NUMBA_NUM_THREADS", "NUMBA_CACHE_DIR")
+    return " ".join(f"{k}={env[k]}" for k in keys if env.get(k))

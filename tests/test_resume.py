@@ -1,0 +1,151 @@
+"""Resumable runs: a run killed with SIGKILL and resumed from its last checkpoint logs the same trials as
+one never interrupted, and its log reads as one run across its MCAP segments."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cerebx.errors import ConfigError
+from cerebx.loop import resume
+from cerebx.recording.reader import channel_counts, read_messages, read_metadata
+from cerebx.recording.segments import segments
+
+# PD on the planar arm over a random (gamma) link delay: every trial differs, so the continuation only
+# matches when the generators, the messages in flight and the plant's state are all restored.
+RUN = ["+experiment=demo", "delay=gamma25", "recording.progress=off"]
+
+
+def _cerebx(*args: str, cwd: Path) -> subprocess.Popen:
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src")}
+    return subprocess.Popen([sys.executable, "-m", "cerebx", "run", *args], cwd=cwd, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+def _summary(run_dir: Path) -> dict:
+    return json.loads((run_dir / "summary.json").read_text())
+
+
+def _wait_for_checkpoint(run_dir: Path, trials: int, proc: subprocess.Popen, timeout_s: float = 120) -> None:
+    head = run_dir / (resume.CHECKPOINT + ".json")
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout_s:
+        if proc.poll() is not None:
+            pytest.fail(f"run ended before its checkpoint: {proc.stdout.read()}")
+        try:
+            if json.loads(head.read_text())["trials_done"] >= trials:
+                return
+        except (OSError, ValueError):
+            pass
+        time.sleep(0.05)
+    pytest.fail(f"no checkpoint at trial {trials} within {timeout_s} s")
+
+
+def test_sigkilled_run_resumes_to_the_same_trials(tmp_path):
+    trials, every = 40, 5
+    whole, killed = tmp_path / "whole", tmp_path / "killed"
+    ref = _cerebx(*RUN, f"trials={trials}", f"recording.checkpoint_every={every}", f"hydra.run.dir={whole}",
+                  cwd=tmp_path)
+    run = _cerebx(*RUN, f"trials={trials}", f"recording.checkpoint_every={every}", f"hydra.run.dir={killed}",
+                  cwd=tmp_path)
+    _wait_for_checkpoint(killed, 15, run)
+    time.sleep(0.2)  # into the next trials, which the continuation runs again
+    run.send_signal(signal.SIGKILL)
+    run.wait()
+    assert ref.wait() == 0, ref.stdout.read()
+    assert not (killed / "summary.json").exists() or _summary(killed)["status"] != "completed"
+    done_at_kill = json.loads((killed / (resume.CHECKPOINT + ".json")).read_text())["trials_done"]
+    assert 15 <= done_at_kill < trials
+
+    cont = _cerebx(f"resume={killed}", cwd=tmp_path)
+    out, _ = cont.communicate(timeout=300)
+    assert cont.returncode == 0, out
+
+    a, b = _summary(whole), _summary(killed)
+    assert b["status"] == "completed" and b["trials_completed"] == trials
+    assert len(b["mae_per_trial"]) == trials
+    assert b["mae_per_trial"] == a["mae_per_trial"]  # exactly: same seed, same trials
+    assert b["mae_per_joint_per_trial"] == a["mae_per_joint_per_trial"]
+    assert np.std(a["mae_per_trial"]) > 0  # the trials differ from each other (random delays)
+    assert b["sim_seconds"] == a["sim_seconds"]
+
+    segs = segments(killed)
+    assert [s.path.name for s in segs] == ["run.mcap", "run.1.mcap"]
+    assert segs[1].start_ns == done_at_kill * 2_000_000_000  # demo trials last 2 s
+    assert not (killed / resume.CHECKPOINT).exists()  # a completed run drops its checkpoint
+    # the killed segment is still readable on its own, and the run reads as one log equal to the whole run's
+    first = [m["trial"] for _t, _ns, m in read_messages(segs[0].path, ["/trial_metrics"])]
+    assert first[:done_at_kill] == list(range(done_at_kill))
+    for topic in ("/trial_metrics", "/control", "/joint_states/actual"):
+        assert list(read_messages(killed, [topic])) == list(read_messages(whole, [topic])), topic
+    assert channel_counts(killed) == channel_counts(whole)
+    assert json.loads(read_metadata(killed)["summary"]["json"])["trials_completed"] == trials
+
+
+def test_resume_refuses_another_config(tmp_path):
+    run_dir = tmp_path / "run"
+    p = _cerebx(*RUN, "trials=4", "recording.checkpoint_every=2", f"hydra.run.dir={run_dir}", cwd=tmp_path)
+    assert p.wait() == 0
+    # a completed run has no checkpoint left
+    p = _cerebx(f"resume={run_dir}", "trials=8", cwd=tmp_path)
+    out, _ = p.communicate()
+    assert p.returncode == 2 and "resume:" in out and "checkpoint" in out, out
+
+
+def test_checkpoint_head_is_checked_before_anything_is_written(tmp_path, load):
+    from cerebx.build import build_components
+    from cerebx.loop.loop import ClosedLoop
+
+    cfg = load([*RUN, "trials=6", "recording.checkpoint_every=2"])
+    loop = ClosedLoop(build_components(cfg), None)
+    loop.start()
+    for trial in range(2):
+        loop.run_trial(trial)
+    resume.save(loop, tmp_path, wall_seconds=1.0)
+    resume.check(cfg, tmp_path)
+    with pytest.raises(ConfigError, match=r"^delay\.c2r\.offset_ms: 6\.0 differs from the resumed run's 5\.0$"):
+        resume.check(load([*RUN, "delay.r2c.offset_ms=6.0", "delay.c2r.offset_ms=6.0", "trials=6"]), tmp_path)
+    with pytest.raises(ConfigError, match="trials: 2, but the checkpoint already has 2 trials done"):
+        resume.check(load([*RUN, "trials=2"]), tmp_path)
+    assert not (tmp_path / "segments.json").exists()
+
+
+def test_resume_args_repeat_the_run_overrides(tmp_path):
+    (tmp_path / ".hydra").mkdir()
+    (tmp_path / ".hydra" / "overrides.yaml").write_text("- +experiment=demo\n- trials=10\n- seed=3\n")
+    args = resume.expand_args([f"resume={tmp_path}", "trials=20"])
+    assert args == ["+experiment=demo", "seed=3", "trials=20", f"resume={tmp_path}", f"hydra.run.dir={tmp_path}",
+                    "hydra.output_subdir=.hydra.resumed"]
+    assert resume.expand_args(["+experiment=demo"]) == ["+experiment=demo"]
+
+
+def test_resume_auto_reuses_continues_or_restarts(tmp_path, load):
+    from cerebx.build import build_components
+    from cerebx.loop.loop import ClosedLoop
+
+    cfg = load([*RUN, "trials=6", "resume=auto"])
+    plain: dict = {}
+    # nothing there: a fresh run, and stale files of an attempt without checkpoint are dropped
+    (tmp_path / "segments.json").write_text("{}")
+    exp, run_dir, reused = resume.continued(cfg, plain, tmp_path)
+    assert (exp.resume, run_dir, reused) == (None, tmp_path, None) and not (tmp_path / "segments.json").exists()
+    # a checkpoint of the same config: continue from it
+    loop = ClosedLoop(build_components(load([*RUN, "trials=6"])), None)
+    loop.start()
+    loop.run_trial(0)
+    resume.save(loop, tmp_path, wall_seconds=0.5)
+    exp, run_dir, reused = resume.continued(cfg, plain, tmp_path)
+    assert exp.resume == str(tmp_path) and plain["resume"] == str(tmp_path) and reused is None
+    # completed with enough trials: reused, nothing runs
+    (tmp_path / "summary.json").write_text(json.dumps({"status": "completed", "trials_completed": 6}))
+    assert resume.continued(cfg, {}, tmp_path)[2]["trials_completed"] == 6
+    # completed with fewer trials than asked: continue from its checkpoint
+    assert resume.continued(load([*RUN, "trials=8", "resume=auto"]), {}, tmp_path)[0].resume == str(tmp_path)
