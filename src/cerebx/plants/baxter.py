@@ -118,6 +118,7 @@ JOINT_RANGE = (
     (-3.059, 3.059),
     (-1.57079632679, 2.094),
 )
+W2_RANGE = (-3.059, 3.059)
 _PAYLOAD_IDLE_MASS_KG = 1e-6
 _PAYLOAD_IDLE_INERTIA = 1e-9
 
@@ -126,8 +127,9 @@ def _f(values: Any) -> str:
     return " ".join(f"{float(v):.10g}" for v in values)
 
 
-def _chain_xml(link_attrs: list[str], body_attrs: str, hand_children: str) -> str:
-    """The nested arm bodies; ``link_attrs[i]`` are extra joint attributes of joint i."""
+def _chain_xml(link_attrs: list[str], body_attrs: str, hand_children: str, w2: bool = False) -> str:
+    """The nested arm bodies; ``link_attrs[i]`` are extra joint attributes of joint i; ``w2`` adds
+    the wrist roll joint (kinematics only: the simulated arm holds w2 at 0 as a rigid wrist)."""
     open_tags = []
     for (body, joint, pos, quat, mass, com, inertia), extra in zip(_LINKS, link_attrs, strict=True):
         lo, hi = JOINT_RANGE[JOINTS.index(joint)]
@@ -137,9 +139,10 @@ def _chain_xml(link_attrs: list[str], body_attrs: str, hand_children: str) -> st
             f'<joint name="{joint}" axis="0 0 1" range="{lo} {hi}"{extra}/>'
         )
     wrist, hand = _WRIST, _HAND
+    w2_joint = f'<joint name="w2" axis="0 0 1" range="{W2_RANGE[0]} {W2_RANGE[1]}"/>' if w2 else ""
     tail = (
         f'<body name="{wrist[0]}" pos="{wrist[1]}" quat="{wrist[2]}"{body_attrs}>'
-        f'<inertial pos="{wrist[4]}" mass="{wrist[3]}" fullinertia="{wrist[5]}"/>'
+        f'<inertial pos="{wrist[4]}" mass="{wrist[3]}" fullinertia="{wrist[5]}"/>{w2_joint}'
         f'<body name="{hand[0]}" pos="{hand[1]}" quat="{hand[2]}"{body_attrs}>'
         f'<inertial pos="{hand[4]}" mass="{hand[3]}" fullinertia="{hand[5]}"/>'
         f'<site name="end_effector" pos="0 0 0"/>{hand_children}</body></body>'
@@ -153,12 +156,13 @@ def _chain_xml(link_attrs: list[str], body_attrs: str, hand_children: str) -> st
     )
 
 
-def kinematic_mjcf() -> str:
-    """The bare kinematic chain (no actuators or options): what inverse kinematics needs.
+def kinematic_mjcf(w2: bool = False) -> str:
+    """The bare kinematic chain (no actuators or options): what inverse kinematics needs; ``w2``
+    adds the wrist roll joint (7 joints, as the original's MoveIt planning chain).
 
     Its text is part of the IK cache key, so any change to the arm geometry invalidates caches.
     """
-    chain = _chain_xml([""] * 6, "", "")
+    chain = _chain_xml([""] * 6, "", "", w2)
     return (
         '<mujoco model="baxter_left_arm_kinematics"><compiler angle="radian"/>'
         f"<worldbody>{chain}</worldbody></mujoco>"
