@@ -176,6 +176,9 @@ class SNNController(ControllerConfig):
     error: ErrorGains = ErrorGains()
     decoder: DCNDecoderConfig = DCNDecoderConfig()
     pathway_delay_ms: NonNegFloat = Field(50.0, description="afferent = efferent sensorimotor delay D")
+    cf_pathway_delay_ms: NonNegFloat | None = Field(
+        None, description="afferent delay of the CF (error) spikes; null = pathway_delay_ms ([B]: 40 ms "
+        "with 50 ms for the MF)")
     efferent: Literal["hold", "stamp"] = Field(
         "hold",
         description="'hold': a torque is emitted D after the network computed it; 'stamp': it is sent at "
