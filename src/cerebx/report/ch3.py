@@ -570,12 +570,12 @@ def convergence_trial(mae: np.ndarray, tol: float = CONVERGENCE_TOL) -> tuple[in
 
 
 @figure("fig3_3", "Trajectory learning convergence curves (Fig. 3.3)",
-        studies=("learn_circle", "learn_inclined_circle", "learn_circle_eight"))
+        studies=("learn_circle_ch3", "learn_inclined_circle", "learn_circle_eight"))
 def fig3_3(runs: RunSet, stem: Path) -> Figure:
     found = {task: from_scratch(runs, task) for task in CH3_TASKS}
     if not any(found.values()):
         raise MissingRuns("no snn runs learning circle / inclined_circle / circle_eight from scratch "
-                          "(studies learn_circle, learn_inclined_circle, learn_circle_eight)")
+                          "(studies learn_circle_ch3, learn_inclined_circle, learn_circle_eight)")
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.3))
     table = [["quantity", "paper", "cerebx"]]
     notes, used = [], []
