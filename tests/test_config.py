@@ -178,3 +178,25 @@ def test_every_ranges_preset_validates(load, ranges):
     cfg = load(["+task=circle", f"+ranges={ranges}"])
     lo, hi = cfg.controller.mf.ranges.bounds(6)
     assert (lo < hi).all()
+
+
+@pytest.mark.parametrize(("overrides", "efferent", "receiver"), [
+    (["delay=none"], "hold", "mean"),
+    (["delay=constant", "delay.total_ms=80"], "stamp", "future_past"),
+    (["delay=gamma45", "controller=snn_ch2"], "stamp", "future_past"),
+    (["delay=gamma45", "controller.efferent=hold"], "hold", "mean"),  # an explicit choice is kept
+])
+def test_default_snn_is_delay_robust_under_any_delay(load, overrides, efferent, receiver):
+    cfg = load(["+task=circle", *overrides])
+    assert cfg.controller.efferent == efferent
+    assert cfg.robot[0].kind == receiver and cfg.robot[1].kind == "supervisor"
+
+
+def test_delayed_default_receiver_is_the_snn_delays_one(load):
+    from cerebx.schema.experiment import DELAYED_SNN_RECEIVER
+
+    explicit = load(["+task=circle", "controller=snn_delays", "delay=gamma45"])
+    auto = load(["+task=circle", "delay=gamma45"])
+    assert explicit.robot[0].model_dump() == auto.robot[0].model_dump()
+    assert explicit.robot[0].model_dump() == {**explicit.robot[0].model_dump(), **DELAYED_SNN_RECEIVER}
+    assert explicit.controller.model_dump() == {**auto.controller.model_dump(), "efferent": "stamp"}

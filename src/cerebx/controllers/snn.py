@@ -56,7 +56,7 @@ class SNNControllerImpl(Controller):
         self.k_cf = int(round(cf_ms / (STEP_S * 1000)))
         self.k_in = min(self.k_delay, self.k_cf)  # the shared afferent FIFO
         # pipelined: the network gets its own core, so its kernels run single-threaded
-        self.hold = cfg.efferent == "hold"
+        self.hold = cfg.efferent != "stamp"  # 'auto' is resolved by the experiment; alone it means hold
         # steps the network may run ahead of the tick that needs its output: afferent D, plus the
         # efferent D when outputs are held back; a chunk is half of that so one can be in flight
         slack = self.k_in + (self.k_delay if self.hold else 0)
