@@ -27,4 +27,6 @@ def make_fixture_runs(root: Path, log=lambda line: None) -> list[str]:
     for j in jobs:
         if j.study == "fig2_10_adaptation":
             j.args += ["events.0.at_trial=1", "events.1.at_trial=2", "events.2.at_trial=2", "events.3.at_trial=3"]
+        if j.study.startswith("interaction_"):
+            j.args += ["events.0.at_trial=2", "events.1.at_trial=3"]
     return execute(jobs, runner=in_process_runner, parallel=1, log=log)

@@ -15,7 +15,10 @@ sea                    a rotor joint per link (world-mounted, armature = rotor i
                        its link joint by a fixed tendon with stiffness/damping (Spong model);
                        the actuator drives the rotor, sensors read the link
 s1_spring              polynomial joint spring on s1 (MuJoCo ``jnt_stiffnesspoly``)
-events                 attach/detach_payload, elastic_band/remove_band, force_pulse
+events                 attach/detach_payload, elastic_band/remove_band, force_pulse, and human
+                       interaction (thesis §2.3.1, Fig. 2.10): finger_push (a half-sine force at
+                       the end-effector) and grab (a soft spring whose hand end drags the
+                       end-effector along a displacement, then lets go)
 =====================  =====================================================================
 """
 
@@ -121,6 +124,19 @@ JOINT_RANGE = (
 W2_RANGE = (-3.059, 3.059)
 _PAYLOAD_IDLE_MASS_KG = 1e-6
 _PAYLOAD_IDLE_INERTIA = 1e-9
+
+
+def half_sine(t_s: np.ndarray | float, duration_s: float) -> np.ndarray:
+    """Profile of a finger push: sin(pi t / T) on [0, T], else 0."""
+    t = np.asarray(t_s, dtype=float)
+    return np.where((t >= 0) & (t <= duration_s), np.sin(np.pi * np.clip(t / duration_s, 0.0, 1.0)), 0.0)
+
+
+def grab_anchor(t_s: np.ndarray | float, start_m: np.ndarray, displacement_m: np.ndarray, drag_s: float) -> np.ndarray:
+    """Where the grabbing hand holds the spring, ``t_s`` after the grab: from ``start_m`` along
+    ``displacement_m`` with a minimum-jerk profile over ``drag_s``, then still (shape (..., 3))."""
+    s = np.clip(np.asarray(t_s, dtype=float) / drag_s, 0.0, 1.0)[..., None]
+    return np.asarray(start_m) + (s**3 * (10 - 15 * s + 6 * s**2)) * np.asarray(displacement_m)
 
 
 def _f(values: Any) -> str:
@@ -286,6 +302,9 @@ class BaxterArm(Plant):
         self._pulse_end_s = 0.0
         self._pulse_force = np.zeros(3)
         self._pulse_at_ee = False
+        self._pulse_start_s = 0.0
+        self._pulse_shape = "step"
+        self._grab: tuple[float, np.ndarray, np.ndarray, float, float] | None = None  # t0, start, disp, drag, end
         self._ee_start = np.zeros(3)
         self._mass0 = m.body_mass.copy()
         self._ipos0 = m.body_ipos.copy()
@@ -300,6 +319,7 @@ class BaxterArm(Plant):
         m.tendon_stiffness[self._band] = 0.0
         d.xfrc_applied[:] = 0.0
         self._pulse_body = -1
+        self._grab = None
         q0 = np.asarray(q0, dtype=float)
         d.qpos[:6] = q0
         if self._rotor_q is not None:
@@ -329,12 +349,14 @@ class BaxterArm(Plant):
 
     def step(self) -> None:
         m, d = self.model, self.data
-        if self._pulse_body < 0:
+        if self._pulse_body < 0 and self._grab is None:
             mujoco.mj_step(m, d, self.substeps)
             return
         for _ in range(self.substeps):
             if self._pulse_body >= 0 and self._pulse_at_ee:
                 self._set_pulse_wrench()
+            if self._grab is not None:
+                self._move_grab()
             mujoco.mj_step(m, d)
             if self._pulse_body >= 0 and d.time >= self._pulse_end_s - 1e-9:
                 d.xfrc_applied[self._pulse_body] = 0.0
@@ -410,6 +432,36 @@ class BaxterArm(Plant):
         """A force on a body (at the end-effector point by default) for ``duration_ms``."""
         self._start_pulse(np.asarray(force_N, dtype=float), float(duration_ms), str(body))
 
+    def finger_push(self, force_N: np.ndarray, duration_ms: float) -> None:
+        """A push with one finger: a force at the end-effector rising and falling as a half sine
+        over ``duration_ms`` (peak ``force_N``)."""
+        self._start_pulse(np.asarray(force_N, dtype=float), float(duration_ms), "end_effector")
+        self._pulse_shape = "half_sine"
+        self._set_pulse_wrench()
+
+    def grab(self, stiffness_N_per_m: float, displacement_m: np.ndarray, drag_ms: float, hold_ms: float) -> None:
+        """A hand grabs the end-effector through a soft spring (rest length 0) and drags its end along
+        ``displacement_m`` (:func:`grab_anchor`) over ``drag_ms``, holds it for ``hold_ms``, then lets go.
+        Uses the band spring, so it replaces an elastic band."""
+        disp = np.asarray(displacement_m, dtype=float)
+        if stiffness_N_per_m <= 0 or drag_ms <= 0 or hold_ms < 0 or disp.shape != (3,):
+            raise ValueError("grab needs stiffness_N_per_m > 0, a 3-vector displacement_m, drag_ms > 0, hold_ms >= 0")
+        start = self.data.site_xpos[self._ee_site].copy()
+        t0 = float(self.data.time)
+        self._grab = (t0, start, disp, drag_ms / 1000.0, t0 + (drag_ms + hold_ms) / 1000.0)
+        self.model.tendon_stiffness[self._band] = float(stiffness_N_per_m)
+        self.model.tendon_lengthspring[self._band] = (0.0, 0.0)
+        self._move_grab()
+
+    def _move_grab(self) -> None:
+        t0, start, disp, drag, end = self._grab
+        t = float(self.data.time)
+        if t >= end - 1e-9:
+            self.model.tendon_stiffness[self._band] = 0.0
+            self._grab = None
+            return
+        self.model.site_pos[self._band_anchor] = grab_anchor(t - t0, start, disp, drag)
+
     def _restore_payload(self) -> None:
         m = self.model
         for b in (self._point, self._pend) if self.has_pendulum else (self._point,):
@@ -461,6 +513,8 @@ class BaxterArm(Plant):
             self.data.xfrc_applied[bid, :3] = force
             self.data.xfrc_applied[bid, 3:] = 0.0
         self._pulse_force = force.copy()
+        self._pulse_shape = "step"
+        self._pulse_start_s = float(self.data.time)
         self._pulse_end_s = float(self.data.time) + duration_ms / 1000.0
         if self._pulse_at_ee:
             self._set_pulse_wrench()
@@ -469,5 +523,8 @@ class BaxterArm(Plant):
         """Force at the end-effector point = force + moment about the hand's centre of mass."""
         d, b = self.data, self._hand
         arm = d.site_xpos[self._ee_site] - d.xipos[b]
-        d.xfrc_applied[b, :3] = self._pulse_force
-        d.xfrc_applied[b, 3:] = np.cross(arm, self._pulse_force)
+        force = self._pulse_force
+        if self._pulse_shape == "half_sine":
+            force = force * float(half_sine(d.time - self._pulse_start_s, self._pulse_end_s - self._pulse_start_s))
+        d.xfrc_applied[b, :3] = force
+        d.xfrc_applied[b, 3:] = np.cross(arm, force)
