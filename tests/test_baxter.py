@@ -260,3 +260,18 @@ def test_pendulum_body_only_when_an_experiment_schedules_one(load):
                 "events=[{at_trial: 1, action: {kind: attach_payload, mass_kg: 0.5, rod_length_m: 0.3}}]"])
     swinging = build_components(cfg).plant
     assert swinging.has_pendulum and swinging.model.nv == 9
+
+
+def test_torque_lag_is_first_order():
+    plant = make(gravity_compensation=True, torque_lag_ms=10.0)
+    tau = np.array([0.0, 0.0, 0.0, 0.0, 1.0, 0.0])
+    produced = []
+    for _ in range(5):  # 10 ms
+        plant.apply(tau)
+        plant.step()
+        produced.append(plant.data.ctrl[4])
+    np.testing.assert_allclose(produced, 1.0 - np.exp(-np.arange(1, 6) * 0.002 / 0.010), rtol=1e-9)
+    instant = make(gravity_compensation=True)
+    instant.apply(tau)
+    instant.step()
+    assert instant.data.ctrl[4] == 1.0

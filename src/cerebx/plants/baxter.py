@@ -15,6 +15,7 @@ sea                    a rotor joint per link (world-mounted, armature = rotor i
                        its link joint by a fixed tendon with stiffness/damping (Spong model);
                        the actuator drives the rotor, sensors read the link
 s1_spring              polynomial joint spring on s1 (MuJoCo ``jnt_stiffnesspoly``)
+torque_lag_ms          first-order lag from the commanded to the produced torque, per physics step
 events                 attach/detach_payload, elastic_band/remove_band, force_pulse, and human
                        interaction (thesis §2.3.1, Fig. 2.10): finger_push (a half-sine force at
                        the end-effector) and grab (a soft spring whose hand end drags the
@@ -274,6 +275,8 @@ class BaxterArm(Plant):
         m = self.model
         self._tau_max = np.asarray(self.cfg.torque_limit_Nm, dtype=float)
         self._tau = np.zeros(6)
+        lag_s = self.cfg.torque_lag_ms / 1000.0
+        self._lag_gain = 1.0 - np.exp(-self.physics_dt_s / lag_s) if lag_s > 0 else 1.0
         self._lo = np.array([r[0] for r in JOINT_RANGE])
         self._hi = np.array([r[1] for r in JOINT_RANGE])
         self._ee_site = m.site("end_effector").id
@@ -344,15 +347,19 @@ class BaxterArm(Plant):
 
     def apply(self, tau: np.ndarray) -> np.ndarray:
         np.minimum(np.maximum(tau, -self._tau_max, out=self._tau), self._tau_max, out=self._tau)
-        self.data.ctrl[:] = self._tau
+        if self._lag_gain == 1.0:
+            self.data.ctrl[:] = self._tau
         return self._tau.copy()
 
     def step(self) -> None:
         m, d = self.model, self.data
-        if self._pulse_body < 0 and self._grab is None:
+        lagged = self._lag_gain < 1.0
+        if self._pulse_body < 0 and self._grab is None and not lagged:
             mujoco.mj_step(m, d, self.substeps)
             return
         for _ in range(self.substeps):
+            if lagged:  # the produced torque approaches the command with the lag's time constant
+                d.ctrl[:] += self._lag_gain * (self._tau - d.ctrl)
             if self._pulse_body >= 0 and self._pulse_at_ee:
                 self._set_pulse_wrench()
             if self._grab is not None:
