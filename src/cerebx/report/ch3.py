@@ -780,20 +780,21 @@ def plant_realism(runs: RunSet, stem: Path) -> Figure:
         raise MissingRuns("no runs of the plant realism study (studies realism_pd, realism_snn)")
     fig, ax = plt.subplots(figsize=(10, 4))
     width = 0.2
-    table = [["plant", "PD 0 ms", "PD 50 ms", "SNN 0 ms", "SNN 50 ms", "PD/SNN at 50 ms"]]
+    table = [["quantity", "paper", "cerebx"]]
     notes = []
     for j, (ctrl, d) in enumerate((("pd", 0.0), ("pd", 50.0), ("snn", 0.0), ("snn", 50.0))):
         vals = [float(np.mean(cells[(p, ctrl, d)].mae)) if (p, ctrl, d) in cells else np.nan for p in REALISM_PLANTS]
         ax.bar(np.arange(len(REALISM_PLANTS)) + (j - 1.5) * width, vals, width, label=f"{ctrl.upper()} {d:.0f} ms")
     for p in REALISM_PLANTS:
-        row, vals = [p], {}
+        vals = {}
         for ctrl, d in (("pd", 0.0), ("pd", 50.0), ("snn", 0.0), ("snn", 50.0)):
             r = cells.get((p, ctrl, d))
             vals[(ctrl, d)] = float(np.mean(r.mae)) if r is not None else None
-            row.append(fmt(vals[(ctrl, d)]) if r is not None else "not run")
         pd50, snn50 = vals[("pd", 50.0)], vals[("snn", 50.0)]
-        row.append(f"{pd50 / snn50:.1f}" if pd50 and snn50 else "–")
-        table.append(row)
+        ratio = f"{pd50 / snn50:.1f}" if pd50 and snn50 else "–"
+        table.append([f"{p}: MAE (rad) PD 0 / 50 ms, SNN 0 / 50 ms; PD ÷ SNN at 50 ms",
+                      "real robot: PD 0.076 → ~0.12 at 50 ms; SNN flat",
+                      " / ".join(fmt(v) for v in vals.values()) + f"; {ratio}"])
         if any(v is None for v in vals.values()):
             notes.append(f"{p}: some runs missing")
     ax.set_xticks(np.arange(len(REALISM_PLANTS)), [p.replace("baxter_", "") for p in REALISM_PLANTS])
