@@ -50,9 +50,9 @@ def ramp_linear(s: np.ndarray, ramp: float) -> np.ndarray:
     """Position profile 0 -> 1 on s in [0, 1] whose velocity rises smoothly (half cosine) over the
     first ``ramp`` of the way, then stays constant to the end ("smooth ramp then linear", facts §5)."""
     s = np.clip(s, 0.0, 1.0)
-    v = 1.0 / (1.0 - ramp / 2)
     if ramp <= 0:
         return s
+    v = 1.0 / (1.0 - ramp / 2)  # the constant speed that still arrives at 1
     rising = v * (s / 2 - ramp / (2 * np.pi) * np.sin(np.pi * s / ramp))
     return np.where(s < ramp, rising, v * (ramp / 2 + (s - ramp)))
 
