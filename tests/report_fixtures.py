@@ -16,7 +16,7 @@ def shrink(job: Job) -> Job:
     exp, _ = load(job.args)
     job.trials = exp.warmup_trials + (3 if "reaching" in job.study else 4 if job.study == "fig2_10_adaptation" else 2)
     if exp.controller.kind == "snn":
-        small = "small_multikernel" if exp.network.name == "multikernel" else "small"
+        small = {"multikernel": "small_multikernel", "thesis_ch2": "small_ch2"}.get(exp.network.name, "small")
         job.args = [*job.args, f"network={small}", *SMALL]
     return job
 
@@ -27,4 +27,6 @@ def make_fixture_runs(root: Path, log=lambda line: None) -> list[str]:
     for j in jobs:
         if j.study == "fig2_10_adaptation":
             j.args += ["events.0.at_trial=1", "events.1.at_trial=2", "events.2.at_trial=2", "events.3.at_trial=3"]
+        if j.study.startswith("interaction_"):
+            j.args += ["events.0.at_trial=2", "events.1.at_trial=3"]
     return execute(jobs, runner=in_process_runner, parallel=1, log=log)

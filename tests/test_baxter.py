@@ -155,6 +155,42 @@ def test_elastic_band_pulls_toward_anchor():
     np.testing.assert_allclose(plant.end_effector(), ee0, atol=1e-3)
 
 
+def test_finger_push_is_a_half_sine_at_the_end_effector():
+    plant = make(gravity_compensation=True)
+    ee0 = plant.end_effector()
+    plant.handle_event(PlantEvent(0.0, "finger_push", {"force_N": (0.0, 4.0, 0.0), "duration_ms": 500.0}))
+    peak = []
+    for _ in range(250):  # 500 ms
+        peak.append(plant.data.xfrc_applied[plant._hand, 1])
+        hold(plant, 1, kp=20.0, kd=2.0)
+    peak = np.array(peak)
+    assert peak[0] < 0.1 and peak.max() == pytest.approx(4.0, abs=0.01) and 120 <= peak.argmax() <= 130
+    assert plant.end_effector()[1] - ee0[1] > 1e-3  # a soft arm yields to 4 N
+    hold(plant, 5, kp=20.0, kd=2.0)
+    assert np.all(plant.data.xfrc_applied == 0.0)
+
+
+def test_grab_drags_through_a_soft_spring_then_lets_go():
+    from cerebx.plants.baxter import grab_anchor
+
+    plant = make(gravity_compensation=True)
+    ee0 = plant.end_effector()
+    k, disp = 100.0, np.array([0.0, 0.0, 0.2])
+    plant.handle_event(PlantEvent(0.0, "grab", {"stiffness_N_per_m": k, "displacement_m": tuple(disp),
+                                                "drag_ms": 400.0, "hold_ms": 400.0}))
+    hold(plant, 300, kp=20.0, kd=2.0)  # 600 ms: dragged up, the spring pulls with k (anchor - ee)
+    anchor = plant.model.site_pos[plant._band_anchor]
+    np.testing.assert_allclose(anchor, grab_anchor(0.6, ee0, disp, 0.4), atol=1e-9)
+    np.testing.assert_allclose(anchor, ee0 + disp, atol=1e-9)
+    ee = plant.end_effector()
+    assert ee[2] - ee0[2] > 0.01  # a soft joint servo is dragged along
+    assert plant.model.tendon_stiffness[plant._band] == k
+    hold(plant, 150, kp=20.0, kd=2.0)  # past 800 ms: let go
+    assert plant.model.tendon_stiffness[plant._band] == 0.0
+    hold(plant, 1500)  # nothing pulls any more: the stiff servo brings the hand back
+    np.testing.assert_allclose(plant.end_effector(), ee0, atol=1e-3)
+
+
 def test_unknown_event_refused():
     with pytest.raises(ValueError):
         make().handle_event(PlantEvent(0.0, "teleport", {}))
@@ -224,3 +260,18 @@ def test_pendulum_body_only_when_an_experiment_schedules_one(load):
                 "events=[{at_trial: 1, action: {kind: attach_payload, mass_kg: 0.5, rod_length_m: 0.3}}]"])
     swinging = build_components(cfg).plant
     assert swinging.has_pendulum and swinging.model.nv == 9
+
+
+def test_torque_lag_is_first_order():
+    plant = make(gravity_compensation=True, torque_lag_ms=10.0)
+    tau = np.array([0.0, 0.0, 0.0, 0.0, 1.0, 0.0])
+    produced = []
+    for _ in range(5):  # 10 ms
+        plant.apply(tau)
+        plant.step()
+        produced.append(plant.data.ctrl[4])
+    np.testing.assert_allclose(produced, 1.0 - np.exp(-np.arange(1, 6) * 0.002 / 0.010), rtol=1e-9)
+    instant = make(gravity_compensation=True)
+    instant.apply(tau)
+    instant.step()
+    assert instant.data.ctrl[4] == 1.0

@@ -126,3 +126,77 @@ def test_every_global_option_validates(load, group):
         assert k.kernel_peak_ms - k.kernel_onset_ms == 30.0
         if group == "biodelay":
             assert k.kernel_peak_ms == 2 * cfg.controller.pathway_delay_ms + 50
+
+
+CH2_B = {"kpos": (1.5, 2.0, 3.0, 2.0, 3.0, 3.0), "alpha": (0.75, 1.0, 0.375, 0.5, 0.05, 0.05)}
+CH3_D = {"kpos": (1.5, 2.0, 3.0, 2.0, 2.0, 1.5), "alpha": (0.75, 1.1, 0.375, 0.63, 0.078, 0.078)}
+
+
+@pytest.mark.parametrize(("experiment", "ranges_q_min"), [
+    ("learn_circle", (-0.97, -0.48, -0.005, 0.58, -0.066, 0.24)),
+    ("learn_eight", (-0.96, -0.43, -0.023, 1.00, -0.021, 0.41)),
+    ("learn_reaching", (-0.97, -0.48, -0.005, 0.58, -0.066, 0.24)),
+])
+def test_table_2_3_2_4_presets_use_chapter_2_settings(load, experiment, ranges_q_min):
+    """Tables 2.3/2.4 ([B], IEEE T-Cyb 2019): PF-PC 1.6 nS, kernel peak/onset 100/70 ms, LTD -0.001,
+    [B] gains and decoder, CF 40 ms / MF 50 ms, and the [B] launch files' MF ranges."""
+    cfg = load([f"+experiment={experiment}"])
+    pf = cfg.network.projections["pf_pc"]
+    assert cfg.network.name == "thesis_ch2" and pf.weight_nS == 1.6
+    k = pf.plasticity
+    assert (k.kernel_peak_ms, k.kernel_onset_ms, k.ltp_nS, k.ltd_nS) == (100.0, 70.0, 0.002, -0.001)
+    c = cfg.controller
+    assert c.error.kpos == CH2_B["kpos"] and c.decoder.alpha_Nm_per_spike == CH2_B["alpha"]
+    assert (c.pathway_delay_ms, c.cf_pathway_delay_ms) == (50.0, 40.0)
+    assert c.mf.ranges.kind == "given" and c.mf.ranges.q_min == ranges_q_min
+    supervisor = [s for s in cfg.robot if s.kind == "supervisor"][0]
+    assert supervisor.bounds == "encoder"
+    if experiment == "learn_reaching":
+        assert supervisor.margin_rad == 0.1  # [B]: circle ranges +- 0.1 rad
+        assert c.mf.ranges.qd_max == (0.27, 0.39, 0.043, 0.95, 0.079, 0.556)
+        t = cfg.task
+        assert (t.space, t.profile) == ("joint", "ramp_linear")
+    else:
+        assert supervisor.margin_rad == 0.0
+
+
+def test_chapter_3_studies_keep_chapter_3_settings(load):
+    cfg = load(["+experiment=learn_circle_ch3"])
+    k = cfg.network.projections["pf_pc"].plasticity
+    assert cfg.network.name == "thesis_ch3" and (k.kernel_peak_ms, k.ltd_nS) == (150.0, -0.0008)
+    assert cfg.controller.error.kpos == CH3_D["kpos"] and cfg.controller.cf_pathway_delay_ms is None
+    assert cfg.controller.mf.ranges.kind == "from_task"
+    from cerebx.report.studies import load_studies
+
+    studies = load_studies()
+    for name in ("fig3_4_snn", "fig3_7_gamma", "fig3_8_wifi", "fig3_9_cloud"):
+        assert studies[name].init_from == "learn_circle_ch3", name
+
+
+@pytest.mark.parametrize("ranges", _options("ranges"))
+def test_every_ranges_preset_validates(load, ranges):
+    cfg = load(["+task=circle", f"+ranges={ranges}"])
+    lo, hi = cfg.controller.mf.ranges.bounds(6)
+    assert (lo < hi).all()
+
+
+@pytest.mark.parametrize(("overrides", "efferent", "receiver"), [
+    (["delay=none"], "hold", "mean"),
+    (["delay=constant", "delay.total_ms=80"], "stamp", "future_past"),
+    (["delay=gamma45", "controller=snn_ch2"], "stamp", "future_past"),
+    (["delay=gamma45", "controller.efferent=hold"], "hold", "mean"),  # an explicit choice is kept
+])
+def test_default_snn_is_delay_robust_under_any_delay(load, overrides, efferent, receiver):
+    cfg = load(["+task=circle", *overrides])
+    assert cfg.controller.efferent == efferent
+    assert cfg.robot[0].kind == receiver and cfg.robot[1].kind == "supervisor"
+
+
+def test_delayed_default_receiver_is_the_snn_delays_one(load):
+    from cerebx.schema.experiment import DELAYED_SNN_RECEIVER
+
+    explicit = load(["+task=circle", "controller=snn_delays", "delay=gamma45"])
+    auto = load(["+task=circle", "delay=gamma45"])
+    assert explicit.robot[0].model_dump() == auto.robot[0].model_dump()
+    assert explicit.robot[0].model_dump() == {**explicit.robot[0].model_dump(), **DELAYED_SNN_RECEIVER}
+    assert explicit.controller.model_dump() == {**auto.controller.model_dump(), "efferent": "stamp"}

@@ -105,7 +105,7 @@ def test_study_runner_reuses_finished_runs_and_skips_dependents_of_failures(tmp_
 
     def fake(job: Job) -> int:
         ran.append(job.name)
-        if job.study == "learn_circle":
+        if job.study == "learn_circle_ch3":
             return 1
         job.run_dir.mkdir(parents=True, exist_ok=True)
         (job.run_dir / "summary.json").write_text(json.dumps({
@@ -114,10 +114,10 @@ def test_study_runner_reuses_finished_runs_and_skips_dependents_of_failures(tmp_
         return 0
 
     jobs = plan("quick", tmp_path, ["fig3_4_pd", "fig3_4_snn"])
-    assert [j.study for j in jobs].count("fig3_4_pd") == 5 and "learn_circle" in [j.study for j in jobs]
+    assert [j.study for j in jobs].count("fig3_4_pd") == 5 and "learn_circle_ch3" in [j.study for j in jobs]
     failed = execute(jobs, runner=fake, parallel=2, log=lambda line: None)
-    assert sorted(ran) == sorted(["learn_circle/run"] + [j.name for j in jobs if j.study == "fig3_4_pd"])
-    assert len(failed) == 6 and any("fig3_4_snn" in f and "learn_circle/run" in f for f in failed)
+    assert sorted(ran) == sorted(["learn_circle_ch3/run"] + [j.name for j in jobs if j.study == "fig3_4_pd"])
+    assert len(failed) == 6 and any("fig3_4_snn" in f and "learn_circle_ch3/run" in f for f in failed)
     ran.clear()
     execute(plan("quick", tmp_path, ["fig3_4_pd"]), runner=fake, log=lambda line: None)
     assert ran == []  # every fig3_4_pd run is complete: reused

@@ -185,3 +185,44 @@ def test_stamped_efferent_sends_what_hold_applies_later(pipeline):
         held, sent = out["hold"][k + D], out["stamp"][k]
         assert sent.stamp_s == pytest.approx(held.stamp_s)
         np.testing.assert_array_equal(sent.tau, held.tau)
+
+
+@pytest.mark.parametrize("pipeline", [True, False])
+def test_cf_pathway_delay_shorter_than_mf(pipeline):
+    """[B]: CF spikes reach the network 40 ms after their sample, MF spikes 50 ms after."""
+    ctrl = make_ctrl(pathway_delay_ms=50.0, cf_pathway_delay_ms=40.0, pipeline=pipeline)
+    ctrl.reset(np.random.default_rng(0))
+    seen: list[np.ndarray] = []
+    step_many = ctrl.net.step_many
+
+    def spy(inputs):
+        seen.extend(np.asarray(a) for a in inputs)
+        return step_many(inputs)
+
+    ctrl.net.step_many = spy
+    for k in range(60):  # samples only at ticks 0-9, with a large error (CF near 10 Hz)
+        t = k * 0.002
+        q, qd = np.full(6, 0.2), np.zeros(6)
+        s = SensorMsg(t, q - 0.3, qd) if k < 10 else None
+        ctrl.step(ControlInput(k, t, q, qd, s))
+    ctrl.end_trial(0)
+    mf, cf = ctrl.sl_mf, ctrl.sl_cf
+    mf_steps = [i for i, a in enumerate(seen) if ((a >= mf.start) & (a < mf.stop)).any()]
+    cf_steps = [i for i, a in enumerate(seen) if ((a >= cf.start) & (a < cf.stop)).any()]
+    assert mf_steps == list(range(25, 35))
+    assert cf_steps and set(cf_steps) <= set(range(20, 30))
+
+
+def test_cf_pathway_delay_default_and_resume(tmp_path):
+    same = make_ctrl(pathway_delay_ms=20.0, cf_pathway_delay_ms=20.0)
+    default = make_ctrl(pathway_delay_ms=20.0)
+    for c in (same, default):
+        c.reset(np.random.default_rng(4))
+    np.testing.assert_array_equal(drive(same, 80), drive(default, 80))
+    a = make_ctrl(pathway_delay_ms=20.0, cf_pathway_delay_ms=12.0)
+    a.reset(np.random.default_rng(0))
+    drive(a, 60)
+    a.save_state(tmp_path / "s.npz")
+    b = make_ctrl(pathway_delay_ms=20.0, cf_pathway_delay_ms=12.0)
+    b.load_state(tmp_path / "s.npz")
+    np.testing.assert_array_equal(drive(a, 40, 60), drive(b, 40, 60))

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from cerebx import registry
-from cerebx.plants.baxter import JOINT_RANGE, kinematic_mjcf
+from cerebx.plants.baxter import JOINT_RANGE, W2_RANGE, kinematic_mjcf
 from cerebx.registry import load_plugins
 from cerebx.schema import task as T
 from cerebx.tasks import cartesian
@@ -24,6 +24,7 @@ CONFIGS = {
     "inclined_circle": T.InclinedCircleTask(),
     "circle_eight": T.CircleEightTask(),
     "reaching": T.ReachingTask(),
+    "reaching_joint": T.ReachingTask(space="joint", profile="ramp_linear"),
 }
 R = 0.12
 
@@ -45,16 +46,67 @@ def fk():
     return ik.fk
 
 
+@pytest.fixture(scope="module")
+def fk7():
+    lo, hi = np.append(LO, W2_RANGE[0]), np.append(HI, W2_RANGE[1])
+    return SiteIK(mujoco.MjModel.from_xml_string(kinematic_mjcf(w2=True)), "end_effector", 7, lo, hi).fk
+
+
 @pytest.mark.parametrize("kind", list(CONFIGS))
-def test_joint_paths_reproduce_cartesian_paths(kind, tasks, fk):
+def test_joint_paths_reproduce_cartesian_paths(kind, tasks, fk, fk7):
+    """The 6-joint path (w2 dropped) puts the hand on the Cartesian path; the 7-joint solution also
+    holds the orientation, and dropping w2 only turns the hand about the w2 axis."""
     task = tasks[kind]
     for v in range(task.variants):
-        q, xyz = task._q[v], task._xyz[v]
+        q, q7, xyz = task._q[v], task._q7[v], task._xyz[v]
+        np.testing.assert_array_equal(q, q7[:, :6])
         pos_err = max(np.linalg.norm(fk(qi)[0] - xi) for qi, xi in zip(q[::5], xyz[::5], strict=True))
-        rot_err = max(rotation_angle(fk(qi)[1], task.orientation) for qi in q[::5])
         assert pos_err < 1e-3, f"{kind} variant {v}: {pos_err * 1e3:.3f} mm"
-        assert np.rad2deg(rot_err) < 1.0
+        if kind != "reaching_joint":  # joint-space legs hold the orientation only at home and target
+            rot_err = max(rotation_angle(fk7(qi)[1], task.orientation) for qi in q7[::5])
+            assert np.rad2deg(rot_err) < 1.0
+        # without w2 the hand differs from the held orientation exactly by the w2 angle
+        turn = [rotation_angle(fk(qi[:6])[1], fk7(qi)[1]) for qi in q7[::25]]
+        np.testing.assert_allclose(turn, np.abs(q7[::25, 6]), atol=1e-6)
         assert np.all(q >= LO) and np.all(q <= HI)
+
+
+# facts/original_implementation.md §5: per-joint min/max (s0..w1) of the original's joint paths
+FACTS_ENVELOPE = {
+    "circle": ([-0.9645, -0.4745, 0.0101, 0.5934, -0.0652, 0.2496], [-0.5591, -0.0393, 0.0352, 1.7914, 0.0180, 1.0145]),
+    "eight": ([-0.9495, -0.4231, -0.0220, 1.0062, -0.0185, 0.4140], [-0.5446, -0.2194, 0.0105, 1.5791, 0.0361, 0.7834]),
+    "inclined_circle": ([-0.9632, -0.3396, 0.0100, 0.9123, -0.0629, 0.2603],
+                        [-0.5636, -0.2716, 0.0328, 1.6141, 0.0214, 0.9291]),
+    "reaching": ([-0.9619, -0.4745, 0.0, 0.5944, -0.0626, 0.2499], [-0.5664, -0.0398, 0.0344, 1.7909, 0.0162, 1.0140]),
+    "reaching_joint": ([-0.9619, -0.4745, 0.0, 0.5944, -0.0626, 0.2499],
+                       [-0.5664, -0.0398, 0.0344, 1.7909, 0.0162, 1.0140]),
+}
+
+
+@pytest.mark.parametrize("kind", list(FACTS_ENVELOPE))
+def test_joint_envelopes_match_the_original_paths(kind, tasks):
+    qmin, qmax, _, _ = tasks[kind].envelope()
+    lo, hi = (np.array(a) for a in FACTS_ENVELOPE[kind])
+    assert np.abs(qmin - lo).max() < 0.05, f"{kind} min {np.round(qmin, 3)} vs {lo}"
+    assert np.abs(qmax - hi).max() < 0.05, f"{kind} max {np.round(qmax, 3)} vs {hi}"
+
+
+def test_circle_paths_close_and_stay_slow():
+    """The redundancy is resolved towards home, so the circle closes; e0 and w0 move by a few
+    hundredths of a radian at ~0.1 rad/s (the 6-joint IK swung them by ~0.5 rad at ~2 rad/s)."""
+    task = registry.tasks.build(CONFIGS["circle"], SimpleNamespace(cache_dir=None))
+    q = task._q[0]
+    assert np.abs(q[-1] - q[0]).max() < 0.01
+    qd = task._qd[0]
+    assert np.abs(qd[:, [2, 4]]).max() < 0.3
+
+
+def test_joint_reaching_ramp_matches_the_original_velocity_ranges(tasks):
+    """The [B] launch file's velocity ranges are the envelope of the original reaching file."""
+    _, _, qdmin, qdmax = tasks["reaching_joint"].envelope()
+    b = np.array([0.27, 0.39, 0.043, 0.95, 0.079, 0.556])
+    assert np.all(np.maximum(-qdmin, qdmax) <= b + 0.01)
+    np.testing.assert_allclose(qdmax[[1, 3, 5]], b[[1, 3, 5]], atol=0.02)
 
 
 @pytest.mark.parametrize("kind", list(CONFIGS))
@@ -128,6 +180,7 @@ def test_ik_is_cached_on_disk(cache, tasks, monkeypatch):
     files = [f for f in cache.glob("ik_circle_*.npz") if not f.name.startswith("ik_circle_eight")]
     assert len(files) == 1
     monkeypatch.setattr(cartesian, "solve_paths", lambda *a: pytest.fail("IK was re-run despite the cache"))
+    monkeypatch.setattr(cartesian, "_arm_ik", lambda *a: pytest.fail("IK was re-run despite the cache"))
     again = registry.tasks.build(CONFIGS["circle"], SimpleNamespace(cache_dir=cache))
     np.testing.assert_array_equal(again._q, tasks["circle"]._q)
     assert cartesian.cache_key(T.CircleTask(radius_m=0.1)) != cartesian.cache_key(CONFIGS["circle"])

@@ -5,7 +5,10 @@ sample time + D and the DCN output with the network time + D. Here both are FIFO
 round(D / 2 ms) control steps: spikes encoded from the sample of step n enter the network at step
 n + k (afferent), and the torque the network decodes at step m is returned at step m + k
 (efferent), stamped with the step's own time. The CF error pairs the measured state with the
-desired state of the same sample time (the sensor message's stamp).
+desired state of the same sample time (the sensor message's stamp). ``cf_pathway_delay_ms`` gives
+the CF spikes their own afferent delay (the [B] setup shifted CF spikes by 40 ms and MF spikes by
+50 ms): the shared input FIFO is as long as the shorter of the two, and the longer one's spikes
+wait the difference in a FIFO of their own first.
 
 Pipelining: because the network's output is not needed until k steps after its input exists,
 the network can run ahead on a second thread, one chunk of k steps at a time, while the loop
@@ -49,11 +52,14 @@ class SNNControllerImpl(Controller):
         self.cfg = cfg
         self.net_cfg = ctx.cfg.network
         self.k_delay = int(round(cfg.pathway_delay_ms / (STEP_S * 1000)))
+        cf_ms = cfg.pathway_delay_ms if cfg.cf_pathway_delay_ms is None else cfg.cf_pathway_delay_ms
+        self.k_cf = int(round(cf_ms / (STEP_S * 1000)))
+        self.k_in = min(self.k_delay, self.k_cf)  # the shared afferent FIFO
         # pipelined: the network gets its own core, so its kernels run single-threaded
-        self.hold = cfg.efferent == "hold"
+        self.hold = cfg.efferent != "stamp"  # 'auto' is resolved by the experiment; alone it means hold
         # steps the network may run ahead of the tick that needs its output: afferent D, plus the
         # efferent D when outputs are held back; a chunk is half of that so one can be in flight
-        slack = self.k_delay * (2 if self.hold else 1)
+        slack = self.k_in + (self.k_delay if self.hold else 0)
         self.chunk = max(1, slack // 2)
         self.pipeline = cfg.pipeline and slack >= 2
         self._worker: tuple[threading.Thread, dict] | None = None
@@ -92,7 +98,11 @@ class SNNControllerImpl(Controller):
     def _reset_loop_state(self) -> None:
         self._join()
         k = self.k_delay
-        self._pending: deque[np.ndarray] = deque([np.zeros(0, np.int32)] * k)  # inputs not yet simulated
+        empty = np.zeros(0, np.int32)
+        self._pending: deque[np.ndarray] = deque([empty] * self.k_in)  # inputs not yet simulated
+        # MF / CF spikes waiting for the shared FIFO (the longer pathway's extra delay)
+        self._mf_lag: deque[np.ndarray] = deque([empty] * (k - self.k_in))
+        self._cf_lag: deque[np.ndarray] = deque([empty] * (self.k_cf - self.k_in))
         # torques not yet emitted (held back by the efferent delay unless they are stamped instead)
         self._ready: deque[np.ndarray] = deque([np.zeros(self.n_ctrl)] * (k if self.hold else 0))
         self._net_step = 0  # network steps simulated so far (step m is stamped m * 2 ms)
@@ -195,15 +205,16 @@ class SNNControllerImpl(Controller):
         self._des.pop(inp.tick - 2000, None)
         s = inp.sensor
         if s is None:
-            spikes_in = np.zeros(0, np.int32)
+            mf = cf = np.zeros(0, np.int32)
         else:
             q_des, qd_des = self._desired_at(s.stamp_s, inp)
-            mf = self.mf.active(q_des, s.q, qd_des, s.qd)
+            mf = (self.mf.active(q_des, s.q, qd_des, s.qd) + self.sl_mf.start).astype(np.int32)
             e = self.cf.error(q_des, s.q, qd_des, s.qd)
             self.last_error = e
-            cf = self.cf.active(e)
-            spikes_in = np.concatenate([mf + self.sl_mf.start, cf + self.sl_cf.start]).astype(np.int32)
-        self._pending.append(spikes_in)
+            cf = (self.cf.active(e) + self.sl_cf.start).astype(np.int32)
+        self._mf_lag.append(mf)
+        self._cf_lag.append(cf)
+        self._pending.append(np.concatenate([self._mf_lag.popleft(), self._cf_lag.popleft()]))
         self._advance()
         self._steps += 1
         tau = np.zeros(self.n_joints)
@@ -243,6 +254,7 @@ class SNNControllerImpl(Controller):
             "plastic_synapses": self.net.n_plastic,
             "build_s": round(self.build_s, 3),
             "pathway_delay_steps": self.k_delay,
+            "cf_pathway_delay_steps": self.k_cf,
             "fingerprint": self.fingerprint,
         }
 
@@ -256,6 +268,8 @@ class SNNControllerImpl(Controller):
         meta = {"version": STATE_VERSION, "fingerprint": self.fingerprint, "config": self.config_hash,
                 "network": self.net_cfg.name, "rng": self.cf.rng.bit_generator.state}
         arrays["in_fifo"] = np.array(json.dumps([a.tolist() for a in self._pending]))
+        arrays["lag_fifos"] = np.array(json.dumps([[a.tolist() for a in self._mf_lag],
+                                                   [a.tolist() for a in self._cf_lag]]))
         save_state_npz(path, meta, **arrays)
 
     def load_state(self, path: Path) -> None:
@@ -274,6 +288,11 @@ class SNNControllerImpl(Controller):
         self.cf.rng.bit_generator.state = meta["rng"]
         fifo = json.loads(str(data["in_fifo"]))
         self._join()
-        if len(fifo) + len(data["out_fifo"]) == self.k_delay * (2 if self.hold else 1):  # resume exactly
+        lags = json.loads(str(data["lag_fifos"])) if "lag_fifos" in data.files else [[], []]
+        same = (len(fifo) + len(data["out_fifo"]) == self.k_in + (self.k_delay if self.hold else 0)
+                and len(lags[0]) == self.k_delay - self.k_in and len(lags[1]) == self.k_cf - self.k_in)
+        if same:  # resume exactly
             self._pending = deque(np.asarray(a, dtype=np.int32) for a in fifo)
             self._ready = deque(np.asarray(r, dtype=float) for r in data["out_fifo"])
+            self._mf_lag = deque(np.asarray(a, dtype=np.int32) for a in lags[0])
+            self._cf_lag = deque(np.asarray(a, dtype=np.int32) for a in lags[1])

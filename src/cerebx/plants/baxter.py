@@ -15,7 +15,11 @@ sea                    a rotor joint per link (world-mounted, armature = rotor i
                        its link joint by a fixed tendon with stiffness/damping (Spong model);
                        the actuator drives the rotor, sensors read the link
 s1_spring              polynomial joint spring on s1 (MuJoCo ``jnt_stiffnesspoly``)
-events                 attach/detach_payload, elastic_band/remove_band, force_pulse
+torque_lag_ms          first-order lag from the commanded to the produced torque, per physics step
+events                 attach/detach_payload, elastic_band/remove_band, force_pulse, and human
+                       interaction (thesis §2.3.1, Fig. 2.10): finger_push (a half-sine force at
+                       the end-effector) and grab (a soft spring whose hand end drags the
+                       end-effector along a displacement, then lets go)
 =====================  =====================================================================
 """
 
@@ -118,16 +122,31 @@ JOINT_RANGE = (
     (-3.059, 3.059),
     (-1.57079632679, 2.094),
 )
+W2_RANGE = (-3.059, 3.059)
 _PAYLOAD_IDLE_MASS_KG = 1e-6
 _PAYLOAD_IDLE_INERTIA = 1e-9
+
+
+def half_sine(t_s: np.ndarray | float, duration_s: float) -> np.ndarray:
+    """Profile of a finger push: sin(pi t / T) on [0, T], else 0."""
+    t = np.asarray(t_s, dtype=float)
+    return np.where((t >= 0) & (t <= duration_s), np.sin(np.pi * np.clip(t / duration_s, 0.0, 1.0)), 0.0)
+
+
+def grab_anchor(t_s: np.ndarray | float, start_m: np.ndarray, displacement_m: np.ndarray, drag_s: float) -> np.ndarray:
+    """Where the grabbing hand holds the spring, ``t_s`` after the grab: from ``start_m`` along
+    ``displacement_m`` with a minimum-jerk profile over ``drag_s``, then still (shape (..., 3))."""
+    s = np.clip(np.asarray(t_s, dtype=float) / drag_s, 0.0, 1.0)[..., None]
+    return np.asarray(start_m) + (s**3 * (10 - 15 * s + 6 * s**2)) * np.asarray(displacement_m)
 
 
 def _f(values: Any) -> str:
     return " ".join(f"{float(v):.10g}" for v in values)
 
 
-def _chain_xml(link_attrs: list[str], body_attrs: str, hand_children: str) -> str:
-    """The nested arm bodies; ``link_attrs[i]`` are extra joint attributes of joint i."""
+def _chain_xml(link_attrs: list[str], body_attrs: str, hand_children: str, w2: bool = False) -> str:
+    """The nested arm bodies; ``link_attrs[i]`` are extra joint attributes of joint i; ``w2`` adds
+    the wrist roll joint (kinematics only: the simulated arm holds w2 at 0 as a rigid wrist)."""
     open_tags = []
     for (body, joint, pos, quat, mass, com, inertia), extra in zip(_LINKS, link_attrs, strict=True):
         lo, hi = JOINT_RANGE[JOINTS.index(joint)]
@@ -137,9 +156,10 @@ def _chain_xml(link_attrs: list[str], body_attrs: str, hand_children: str) -> st
             f'<joint name="{joint}" axis="0 0 1" range="{lo} {hi}"{extra}/>'
         )
     wrist, hand = _WRIST, _HAND
+    w2_joint = f'<joint name="w2" axis="0 0 1" range="{W2_RANGE[0]} {W2_RANGE[1]}"/>' if w2 else ""
     tail = (
         f'<body name="{wrist[0]}" pos="{wrist[1]}" quat="{wrist[2]}"{body_attrs}>'
-        f'<inertial pos="{wrist[4]}" mass="{wrist[3]}" fullinertia="{wrist[5]}"/>'
+        f'<inertial pos="{wrist[4]}" mass="{wrist[3]}" fullinertia="{wrist[5]}"/>{w2_joint}'
         f'<body name="{hand[0]}" pos="{hand[1]}" quat="{hand[2]}"{body_attrs}>'
         f'<inertial pos="{hand[4]}" mass="{hand[3]}" fullinertia="{hand[5]}"/>'
         f'<site name="end_effector" pos="0 0 0"/>{hand_children}</body></body>'
@@ -153,12 +173,13 @@ def _chain_xml(link_attrs: list[str], body_attrs: str, hand_children: str) -> st
     )
 
 
-def kinematic_mjcf() -> str:
-    """The bare kinematic chain (no actuators or options): what inverse kinematics needs.
+def kinematic_mjcf(w2: bool = False) -> str:
+    """The bare kinematic chain (no actuators or options): what inverse kinematics needs; ``w2``
+    adds the wrist roll joint (7 joints, as the original's MoveIt planning chain).
 
     Its text is part of the IK cache key, so any change to the arm geometry invalidates caches.
     """
-    chain = _chain_xml([""] * 6, "", "")
+    chain = _chain_xml([""] * 6, "", "", w2)
     return (
         '<mujoco model="baxter_left_arm_kinematics"><compiler angle="radian"/>'
         f"<worldbody>{chain}</worldbody></mujoco>"
@@ -254,6 +275,8 @@ class BaxterArm(Plant):
         m = self.model
         self._tau_max = np.asarray(self.cfg.torque_limit_Nm, dtype=float)
         self._tau = np.zeros(6)
+        lag_s = self.cfg.torque_lag_ms / 1000.0
+        self._lag_gain = 1.0 - np.exp(-self.physics_dt_s / lag_s) if lag_s > 0 else 1.0
         self._lo = np.array([r[0] for r in JOINT_RANGE])
         self._hi = np.array([r[1] for r in JOINT_RANGE])
         self._ee_site = m.site("end_effector").id
@@ -282,6 +305,9 @@ class BaxterArm(Plant):
         self._pulse_end_s = 0.0
         self._pulse_force = np.zeros(3)
         self._pulse_at_ee = False
+        self._pulse_start_s = 0.0
+        self._pulse_shape = "step"
+        self._grab: tuple[float, np.ndarray, np.ndarray, float, float] | None = None  # t0, start, disp, drag, end
         self._ee_start = np.zeros(3)
         self._mass0 = m.body_mass.copy()
         self._ipos0 = m.body_ipos.copy()
@@ -296,6 +322,7 @@ class BaxterArm(Plant):
         m.tendon_stiffness[self._band] = 0.0
         d.xfrc_applied[:] = 0.0
         self._pulse_body = -1
+        self._grab = None
         q0 = np.asarray(q0, dtype=float)
         d.qpos[:6] = q0
         if self._rotor_q is not None:
@@ -320,17 +347,23 @@ class BaxterArm(Plant):
 
     def apply(self, tau: np.ndarray) -> np.ndarray:
         np.minimum(np.maximum(tau, -self._tau_max, out=self._tau), self._tau_max, out=self._tau)
-        self.data.ctrl[:] = self._tau
+        if self._lag_gain == 1.0:
+            self.data.ctrl[:] = self._tau
         return self._tau.copy()
 
     def step(self) -> None:
         m, d = self.model, self.data
-        if self._pulse_body < 0:
+        lagged = self._lag_gain < 1.0
+        if self._pulse_body < 0 and self._grab is None and not lagged:
             mujoco.mj_step(m, d, self.substeps)
             return
         for _ in range(self.substeps):
+            if lagged:  # the produced torque approaches the command with the lag's time constant
+                d.ctrl[:] += self._lag_gain * (self._tau - d.ctrl)
             if self._pulse_body >= 0 and self._pulse_at_ee:
                 self._set_pulse_wrench()
+            if self._grab is not None:
+                self._move_grab()
             mujoco.mj_step(m, d)
             if self._pulse_body >= 0 and d.time >= self._pulse_end_s - 1e-9:
                 d.xfrc_applied[self._pulse_body] = 0.0
@@ -406,6 +439,36 @@ class BaxterArm(Plant):
         """A force on a body (at the end-effector point by default) for ``duration_ms``."""
         self._start_pulse(np.asarray(force_N, dtype=float), float(duration_ms), str(body))
 
+    def finger_push(self, force_N: np.ndarray, duration_ms: float) -> None:
+        """A push with one finger: a force at the end-effector rising and falling as a half sine
+        over ``duration_ms`` (peak ``force_N``)."""
+        self._start_pulse(np.asarray(force_N, dtype=float), float(duration_ms), "end_effector")
+        self._pulse_shape = "half_sine"
+        self._set_pulse_wrench()
+
+    def grab(self, stiffness_N_per_m: float, displacement_m: np.ndarray, drag_ms: float, hold_ms: float) -> None:
+        """A hand grabs the end-effector through a soft spring (rest length 0) and drags its end along
+        ``displacement_m`` (:func:`grab_anchor`) over ``drag_ms``, holds it for ``hold_ms``, then lets go.
+        Uses the band spring, so it replaces an elastic band."""
+        disp = np.asarray(displacement_m, dtype=float)
+        if stiffness_N_per_m <= 0 or drag_ms <= 0 or hold_ms < 0 or disp.shape != (3,):
+            raise ValueError("grab needs stiffness_N_per_m > 0, a 3-vector displacement_m, drag_ms > 0, hold_ms >= 0")
+        start = self.data.site_xpos[self._ee_site].copy()
+        t0 = float(self.data.time)
+        self._grab = (t0, start, disp, drag_ms / 1000.0, t0 + (drag_ms + hold_ms) / 1000.0)
+        self.model.tendon_stiffness[self._band] = float(stiffness_N_per_m)
+        self.model.tendon_lengthspring[self._band] = (0.0, 0.0)
+        self._move_grab()
+
+    def _move_grab(self) -> None:
+        t0, start, disp, drag, end = self._grab
+        t = float(self.data.time)
+        if t >= end - 1e-9:
+            self.model.tendon_stiffness[self._band] = 0.0
+            self._grab = None
+            return
+        self.model.site_pos[self._band_anchor] = grab_anchor(t - t0, start, disp, drag)
+
     def _restore_payload(self) -> None:
         m = self.model
         for b in (self._point, self._pend) if self.has_pendulum else (self._point,):
@@ -457,6 +520,8 @@ class BaxterArm(Plant):
             self.data.xfrc_applied[bid, :3] = force
             self.data.xfrc_applied[bid, 3:] = 0.0
         self._pulse_force = force.copy()
+        self._pulse_shape = "step"
+        self._pulse_start_s = float(self.data.time)
         self._pulse_end_s = float(self.data.time) + duration_ms / 1000.0
         if self._pulse_at_ee:
             self._set_pulse_wrench()
@@ -465,5 +530,8 @@ class BaxterArm(Plant):
         """Force at the end-effector point = force + moment about the hand's centre of mass."""
         d, b = self.data, self._hand
         arm = d.site_xpos[self._ee_site] - d.xipos[b]
-        d.xfrc_applied[b, :3] = self._pulse_force
-        d.xfrc_applied[b, 3:] = np.cross(arm, self._pulse_force)
+        force = self._pulse_force
+        if self._pulse_shape == "half_sine":
+            force = force * float(half_sine(d.time - self._pulse_start_s, self._pulse_end_s - self._pulse_start_s))
+        d.xfrc_applied[b, :3] = force
+        d.xfrc_applied[b, 3:] = np.cross(arm, force)

@@ -44,3 +44,13 @@ def remove_band(cfg: Any, plant: Any) -> Callable[[], None]:
 def force_pulse(cfg: Any, plant: Any) -> Callable[[], None]:
     fn = _method(plant, cfg.plant_method)
     return lambda: fn(np.asarray(cfg.force_N, float), cfg.duration_ms, cfg.body)
+
+
+def finger_push(cfg: Any, plant: Any) -> Callable[[], None]:
+    fn = _method(plant, cfg.plant_method)
+    return lambda: fn(np.asarray(cfg.force_N, float), cfg.duration_ms)
+
+
+def grab(cfg: Any, plant: Any) -> Callable[[], None]:
+    fn = _method(plant, cfg.plant_method)
+    return lambda: fn(cfg.stiffness_N_per_m, np.asarray(cfg.displacement_m, float), cfg.drag_ms, cfg.hold_ms)

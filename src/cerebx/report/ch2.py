@@ -22,7 +22,8 @@ from cerebx.report import stages  # noqa: E402
 from cerebx.report.registry import Figure, MissingRuns, figure, mean_std, panel_letter, save  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
 
-THESIS_KERNEL_MS = 150.0
+THESIS_KERNEL_MS = 150.0  # chapter 3 ([D]) kernel peak
+CH2_KERNEL_MS = 100.0  # chapter 2 ([B]) kernel peak
 # Tables 2.3 / 2.4: thesis run length, snn windows (start, stop, mean, std), factory position MAE as printed
 PAPER_STAGES: dict[str, tuple[int, list[tuple[int, int, float, float]], str]] = {
     "circle": (500, [(0, 100, 0.115, 0.055), (100, 200, 0.036, 0.013), (400, 500, 0.019, 0.003)], "0.077 ± 0.0004"),
@@ -38,10 +39,11 @@ TASK_NAMES = {"circle": "horizontal circle", "inclined_circle": "inclined circle
 
 
 # ---- run selection ---------------------------------------------------------------------------------
-def from_scratch(runs: RunSet, task: str) -> Run | None:
-    """The longest snn run learning ``task`` from scratch without delay."""
+def from_scratch(runs: RunSet, task: str, kernel_ms: float = THESIS_KERNEL_MS) -> Run | None:
+    """The longest snn run learning ``task`` from scratch without delay, with the kernel peaking at
+    ``kernel_ms`` (the chapter's network)."""
     return runs.where(lambda r: r.learned_from is None and not r.events and r.trials > 0
-                      and r.kernel_peaks_ms == [THESIS_KERNEL_MS],
+                      and r.kernel_peaks_ms == [kernel_ms],
                       task=task, controller="snn", delay="none").best()
 
 
@@ -99,7 +101,7 @@ def _baseline_text(base: list[tuple[str, Run]]) -> str:
 
 
 def _trajectory_learning(runs: RunSet, stem: Path, task: str, fig_no: str, study: str) -> Figure:
-    run = from_scratch(runs, task)
+    run = from_scratch(runs, task, CH2_KERNEL_MS)
     if run is None:
         raise MissingRuns(f"no {task} run of snn learning from scratch (study {study})")
     base = baselines(runs, task)
@@ -138,7 +140,7 @@ def fig2_7(runs: RunSet, stem: Path) -> Figure:
                  "baselines_reaching"))
 def table2_3(runs: RunSet, stem: Path) -> Figure:
     """The thesis's stage windows (mean ± std) beside ours for every task learnt from scratch, as bars."""
-    found = {task: from_scratch(runs, task) for task in PAPER_STAGES}
+    found = {task: from_scratch(runs, task, CH2_KERNEL_MS) for task in PAPER_STAGES}
     found = {t: r for t, r in found.items() if r is not None}
     if not found:
         raise MissingRuns("no run of snn learning circle, eight or reaching from scratch (studies learn_circle, "
@@ -229,7 +231,7 @@ def _speed(tr: dict[str, np.ndarray], key: str) -> np.ndarray:
 @figure("fig2_9", "Reaching learnt from scratch: paths, speed profiles and MAE (Fig. 2.9, Table 2.4)",
         studies=("learn_reaching", "baselines_reaching"))
 def fig2_9(runs: RunSet, stem: Path) -> Figure:
-    run = from_scratch(runs, "reaching")
+    run = from_scratch(runs, "reaching", CH2_KERNEL_MS)
     if run is None:
         raise MissingRuns("no reaching run of snn learning from scratch (study learn_reaching)")
     n, n_targets = run.trials, int(run.get("task.targets", 8))
@@ -335,9 +337,87 @@ def phases(events: list[tuple[float, str]], n: int) -> list[tuple[int, int, str]
     return out
 
 
-@figure("fig2_10", "Adaptation to a payload and an elastic band (Fig. 2.10)", studies=("fig2_10_adaptation",))
+INTERACTIONS = ("finger_push", "grab")
+
+
+def _has_events(run: Run, kinds: tuple[str, ...] | dict) -> bool:
+    return any(e.get("action", {}).get("kind") in kinds for e in run.events)
+
+
+def interaction_metrics(run: Run) -> list[dict[str, float | str]]:
+    """Per human-interaction event of ``run`` (thesis §2.3.1): the peak interaction force on the hand
+    (N: the push's configured peak; the grab spring's k |anchor - hand|, from the logged hand path and
+    the event's anchor path), the peak displacement of the hand from where it was at the same phase
+    of the trial before the event, during the event and 1 s after (mm), their ratio (mm/N), and that
+    displacement averaged over the last 0.5 s of the trial after the event trial (mm), and the position
+    MAE (rad) of the trial before the event, the event's trial and the two after (back on the path?)."""
+    from cerebx.plants.baxter import grab_anchor, half_sine
+
+    period, out = run.period_s, []
+    mae = list(run.summary.get("mae_per_trial") or [])
+    for e in run.events:
+        act = e.get("action", {})
+        if act.get("kind") not in INTERACTIONS or e.get("at_trial") is None:
+            continue
+        t0 = float(e["at_trial"]) * period
+        if act["kind"] == "finger_push":
+            dur = float(act.get("duration_ms", 500.0)) / 1000.0
+        else:
+            dur = (float(act.get("drag_ms", 1000.0)) + float(act.get("hold_ms", 1000.0))) / 1000.0
+        c = run.control(["ee"], t0 - period, t0 + 2 * period)
+        t, ee = c["t"], np.asarray(c["ee"])
+        ref = t < t0
+        if ref.sum() < 2 or (~ref).sum() < 2:
+            continue
+        # the undisturbed hand path: the trial before the event, by phase
+        phase = np.mod(t - t0, period)
+        base = np.stack([np.interp(phase, np.mod(t[ref] - t0, period), ee[ref, k], period=period) for k in range(3)], 1)
+        dist = np.linalg.norm(ee - base, axis=1) * 1000.0
+        if act["kind"] == "finger_push":
+            force = np.linalg.norm(act.get("force_N", (0, 0, 0))) * half_sine(t - t0, dur)
+        else:
+            start = ee[np.argmin(np.abs(t - t0))]
+            anchor = grab_anchor(t - t0, start, np.asarray(act["displacement_m"], float),
+                                 float(act.get("drag_ms", 1000.0)) / 1000.0)
+            force = float(act["stiffness_N_per_m"]) * np.linalg.norm(anchor - ee, axis=1)
+            force[(t < t0) | (t > t0 + dur)] = 0.0
+        during = (t >= t0) & (t <= t0 + dur + 1.0)
+        end = t >= t0 + 2 * period - 0.5
+        f_peak, d_peak = float(force.max()), float(dist[during].max())
+        out.append({"kind": act["kind"], "force_N": f_peak, "displacement_mm": d_peak,
+                    "mm_per_N": d_peak / f_peak if f_peak > 0 else float("nan"),
+                    "end_mm": float(dist[end].mean()) if end.any() else float("nan"),
+                    "mae_trials": [float(mae[k]) for k in range(int(e["at_trial"]) - 1, int(e["at_trial"]) + 3)
+                                   if 0 <= k < len(mae)]})
+    return out
+
+
+def _interaction_rows(runs: RunSet) -> tuple[list[list[str]], list[str]]:
+    rows, notes = [], []
+    inter = runs.where(lambda r: _has_events(r, INTERACTIONS) and r.trials > 0, delay="none")
+    found = [("SNN", inter.where(controller="snn").best()),
+             ("PD", inter.where(controller="pd", controller_preset="pd").best()),
+             ("factory position", inter.where(lambda r: r.is_factory_position).best())]
+    for name, run in found:
+        if run is None:
+            notes.append(f"no {name} run with human-interaction events (studies interaction_*)")
+            continue
+        for m in interaction_metrics(run):
+            what = "finger push" if m["kind"] == "finger_push" else "grab (soft spring)"
+            claim = ("yields to a very low force, returns to the path" if name == "SNN"
+                     else "figure only")
+            rows.append([f"{name}, {what}: peak force (N) / peak hand displacement (mm) / mm per N",
+                         claim, f"{m['force_N']:.2f} / {m['displacement_mm']:.1f} / {m['mm_per_N']:.2f}"])
+            rows.append([f"{name}, {what}: MAE (rad) trial before / of the event / 1 after / 2 after",
+                         "returns to the path" if name == "SNN" else "figure only",
+                         " / ".join(f"{v:.3f}" for v in m["mae_trials"])])
+    return rows, notes
+
+
+@figure("fig2_10", "Adaptation to a payload and an elastic band; human interaction (Fig. 2.10)",
+        studies=("fig2_10_adaptation", "interaction_snn", "interaction_baselines"))
 def fig2_10(runs: RunSet, stem: Path) -> Figure:
-    run = runs.where(lambda r: bool(r.events) and r.trials > 0, controller="snn").best()
+    run = runs.where(lambda r: _has_events(r, CONDITIONS) and r.trials > 0, controller="snn").best()
     if run is None:
         raise MissingRuns("no snn run with plant events (study fig2_10_adaptation)")
     events, mae, period = run_events(run), run.mae, run.period_s
@@ -380,10 +460,15 @@ def fig2_10(runs: RunSet, stem: Path) -> Figure:
                           f"{seg[:k].mean():.3f} → {seg[-k:].mean():.3f}"])
         claim = "figure only"
     notes = [] if events else ["the run's events were neither logged nor configured"]
+    rows, more = _interaction_rows(runs)
+    table += rows
+    notes += more
     origin = _rel(run.learned_from) if run.learned_from else "scratch"
     caption = (f"Thesis Fig. 2.10: the snn controller, learnt state from {origin}, performing "
                f"the {TASK_NAMES.get(run.task, run.task)} while the plant is disturbed (run {_rel(run)}, {len(mae)} "
                f"trials of {period:.0f} s). Shaded: payload / elastic band attached; dotted: events "
                f"({', '.join(f'{k} at trial {x:g}' for x, k in events)}); red: mean MAE of each phase. "
-               "The thesis's human-robot interactions (iii) are not simulated.")
+               "Human interaction (iii), in the table: a one-finger push and a grab through a soft spring on the "
+               "learned circle (studies interaction_snn / interaction_baselines; constructed forces) for the SNN, "
+               "PD and the factory stand-in.")
     return Figure(files, caption, table, notes)

@@ -44,6 +44,8 @@ registry.events.register(e.DetachPayload, "cerebx.plants.events:detach_payload")
 registry.events.register(e.ElasticBand, "cerebx.plants.events:elastic_band")
 registry.events.register(e.RemoveBand, "cerebx.plants.events:remove_band")
 registry.events.register(e.ForcePulse, "cerebx.plants.events:force_pulse")
+registry.events.register(e.FingerPush, "cerebx.plants.events:finger_push")
+registry.events.register(e.Grab, "cerebx.plants.events:grab")
 
 # mossy encoders take (cfg, lo, hi); climbing encoders (cfg, n_joints, fibres_per_joint, kpos, kvel, rng)
 registry.encoders.register(c.BoxEncoder, "cerebx.snn.encoders:MossyEncoder")

@@ -176,11 +176,15 @@ class SNNController(ControllerConfig):
     error: ErrorGains = ErrorGains()
     decoder: DCNDecoderConfig = DCNDecoderConfig()
     pathway_delay_ms: NonNegFloat = Field(50.0, description="afferent = efferent sensorimotor delay D")
-    efferent: Literal["hold", "stamp"] = Field(
+    cf_pathway_delay_ms: NonNegFloat | None = Field(
+        None, description="afferent delay of the CF (error) spikes; null = pathway_delay_ms ([B]: 40 ms "
+        "with 50 ms for the MF)")
+    efferent: Literal["auto", "hold", "stamp"] = Field(
         "hold",
         description="'hold': a torque is emitted D after the network computed it; 'stamp': it is sent at "
         "once, stamped with its application time (network time + D), for the plant-side future/past "
-        "filter (Eq. 3.6) as in the original delay setup",
+        "filter (Eq. 3.6) as in the original delay setup; 'auto' (the snn preset): 'stamp' with the "
+        "Eq. 3.6 receiver whenever the experiment's delay is not 'none', else 'hold'",
     )
     plasticity: bool = True
     parallel: bool = Field(True, description="use numba threads in the network kernels (when not pipelined)")

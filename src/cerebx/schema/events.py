@@ -45,3 +45,25 @@ class ForcePulse(Strict):
     force_N: tuple[float, float, float]
     duration_ms: PositiveFloat = 50.0
     body: str = "end_effector"
+
+
+class FingerPush(Strict):
+    """A person pushes the end-effector with one finger (thesis §2.3.1, Fig. 2.10): a half-sine force
+    of peak ``force_N`` over ``duration_ms``."""
+
+    plant_method: ClassVar[str] = "finger_push"  # what a plant offers to support it
+    kind: Literal["finger_push"] = "finger_push"
+    force_N: tuple[float, float, float] = (0.0, 4.0, 0.0)
+    duration_ms: PositiveFloat = 500.0
+
+
+class Grab(Strict):
+    """A person grabs the end-effector through a soft spring and drags it along ``displacement_m``
+    (minimum jerk over ``drag_ms``), holds for ``hold_ms``, then lets go (thesis §2.3.1, Fig. 2.10)."""
+
+    plant_method: ClassVar[str] = "grab"  # what a plant offers to support it
+    kind: Literal["grab"] = "grab"
+    stiffness_N_per_m: PositiveFloat = 50.0
+    displacement_m: tuple[float, float, float] = (0.0, 0.0, 0.15)
+    drag_ms: PositiveFloat = 1000.0
+    hold_ms: NonNegFloat = 1000.0

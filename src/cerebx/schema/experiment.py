@@ -61,6 +61,28 @@ def tuple_union(types: tuple[type, ...]) -> Any:
 
 
 BODY_SLOTS = ("spinal", "muscle")
+
+# The receiver of the delay-robust SNN (conf/controller/snn_delays.yaml, facts §7): the mean of the
+# nearest future and past stamped torques (Eq. 3.6), decaying by 0.998 per step when starved.
+DELAYED_SNN_RECEIVER = {"kind": "future_past", "min_future_samples": 2, "past_samples": 10, "decay_per_step": 0.998}
+
+
+def delay_robust_default(data: Any) -> Any:
+    """Resolve ``controller.efferent: auto`` of a spiking controller: with any delay other than
+    ``none`` the torques are stamped and a ``mean`` receiver becomes the Eq. 3.6 future/past filter
+    (the thesis's delay-robust controller, what ``controller=snn_delays`` sets explicitly); without
+    delay the torques are held as before."""
+    if not isinstance(data, dict):
+        return data
+    ctrl, delay = data.get("controller"), data.get("delay")
+    if not (isinstance(ctrl, dict) and ctrl.get("kind") == "snn" and ctrl.get("efferent") == "auto"):
+        return data
+    delayed = isinstance(delay, dict) and delay.get("kind", "none") != "none"
+    out = {**data, "controller": {**ctrl, "efferent": "stamp" if delayed else "hold"}}
+    robot = list(data.get("robot") or [])
+    if delayed and robot and isinstance(robot[0], dict) and robot[0].get("kind") == "mean":
+        out["robot"] = [dict(DELAYED_SNN_RECEIVER), *robot[1:]]
+    return out
 """Named robot-side stage slots, in the order they run between the receiver and the ``robot`` list."""
 
 
@@ -96,6 +118,11 @@ class _ExperimentBase(Strict):
     start_at: Literal["home", "path"] = Field(
         "home", description="where the arm starts: the task's home pose, or at rest on the path's first sample "
         "(as consecutive trials do; used when a learned controller is evaluated)")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _delay_robust_default(cls, data: Any) -> Any:
+        return delay_robust_default(data)
 
     @model_validator(mode="after")
     def _cross_checks(self) -> _ExperimentBase:

@@ -103,6 +103,10 @@ class BaxterConfig(PlantSchema):
     gripper_mass_kg: NonNegFloat = Field(
         0.0, description="lumped mass at the gripper base (hand z + 0.025 m)"
     )
+    torque_lag_ms: NonNegFloat = Field(
+        0.0, description="time constant of a first-order lag between the commanded and the produced joint "
+        "torque (motor current loop); 0 = none"
+    )
 
     @model_validator(mode="after")
     def _six(self) -> BaxterConfig:

@@ -70,11 +70,22 @@ class CircleEightTask(_CartesianTask):
 
 
 class ReachingTask(_CartesianTask):
-    """Eight targets on the circle every pi/4; out and back with bell-shaped velocity; random order."""
+    """Eight targets on the circle every pi/4; out and back; random order. Each leg follows
+    ``profile``: ``min_jerk`` (bell-shaped velocity) or ``ramp_linear`` (the original's "smooth ramp
+    then linear segment", facts §5: velocity rises over ``ramp_fraction`` of the leg, then is constant)."""
 
     kind: Literal["reaching"] = "reaching"
     targets: int = Field(8, gt=0)
     out_s: PositiveFloat = 1.0
+    space: Literal["cartesian", "joint"] = Field(
+        "cartesian", description="'cartesian': straight hand legs; 'joint': joints interpolated from the "
+        "home pose to each target's IK solution (the original's target-reaching files)")
+    profile: Literal["min_jerk", "ramp_linear"] = "min_jerk"
+    ramp_fraction: float = Field(
+        0.4, gt=0.0, le=1.0,
+        description="ramp_linear: fraction of each leg over which the velocity rises (constructed: "
+        "with space joint, 0.4 gives the original's peak e1 speed, 0.94 rad/s)",
+    )
 
     @model_validator(mode="after")
     def _fits(self) -> ReachingTask:

@@ -2,7 +2,12 @@
 
 The end-effector is the Baxter model's ``end_effector`` site (origin of the URDF ``left_hand`` frame,
 base frame). The path is centred on the end-effector position of the home pose; the orientation is
-held at the home orientation. IK runs once per task definition and is cached on disk under
+held at the home orientation. As in the original (facts §5: MoveIt on the 7-joint arm, then w2 held
+at 0 by the supervisor), IK solves the 7-joint chain including the wrist roll w2 and the task keeps
+s0..w1: the end-effector lies on the w2 axis, so dropping w2 keeps the position exactly and turns
+the hand about that axis only. The redundancy is resolved towards the home pose (w2 = 0), a
+*constructed* choice (MoveIt's is not recorded) that reproduces the original paths' joint envelopes
+to within 0.03 rad. IK runs once per task definition and is cached on disk under
 ``ctx.cache_dir`` keyed by a hash of the task config and the arm's kinematic MJCF.
 """
 
@@ -17,12 +22,12 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from cerebx.plants.baxter import JOINT_RANGE, kinematic_mjcf
+from cerebx.plants.baxter import JOINT_RANGE, W2_RANGE, kinematic_mjcf
 from cerebx.tasks.base import Task, TrialReference
 from cerebx.tasks.ik import SiteIK
 
 CONTROL_DT_S = 0.002
-IK_VERSION = "dls-1"
+IK_VERSION = "dls7-posture-1"
 
 
 def _circle(t: np.ndarray, period: float, r: float, phase: float = np.pi) -> np.ndarray:
@@ -39,6 +44,17 @@ def min_jerk(s: np.ndarray) -> np.ndarray:
     """Minimum-jerk position profile 0 -> 1 on s in [0, 1] (bell-shaped velocity)."""
     s = np.clip(s, 0.0, 1.0)
     return s**3 * (10 - 15 * s + 6 * s**2)
+
+
+def ramp_linear(s: np.ndarray, ramp: float) -> np.ndarray:
+    """Position profile 0 -> 1 on s in [0, 1] whose velocity rises smoothly (half cosine) over the
+    first ``ramp`` of the way, then stays constant to the end ("smooth ramp then linear", facts §5)."""
+    s = np.clip(s, 0.0, 1.0)
+    if ramp <= 0:
+        return s
+    v = 1.0 / (1.0 - ramp / 2)  # the constant speed that still arrives at 1
+    rising = v * (s / 2 - ramp / (2 * np.pi) * np.sin(np.pi * s / ramp))
+    return np.where(s < ramp, rising, v * (ramp / 2 + (s - ramp)))
 
 
 def _steps(cfg: Any) -> np.ndarray:
@@ -70,18 +86,32 @@ def circle_eight_offsets(cfg: Any) -> list[np.ndarray]:
     return [np.concatenate([_circle(th, half, r, np.pi / 2), _eight(th, half, r, -1.0)])]
 
 
-def reaching_offsets(cfg: Any) -> list[np.ndarray]:
-    """One out-and-back path per target, evenly spaced on a circle of ``radius_m``."""
+def reaching_profile(cfg: Any) -> np.ndarray:
+    """Fraction of the way to the target at each step of a trial: out in ``out_s``, back in the
+    rest, each leg following ``cfg.profile``."""
     steps = len(_steps(cfg))
     n_out = int(round(cfg.out_s / CONTROL_DT_S))
     n_back = steps - n_out
-    s = np.concatenate([min_jerk(np.arange(n_out) / n_out), 1.0 - min_jerk(np.arange(n_back) / n_back)])
+    if cfg.profile == "min_jerk":
+        leg = min_jerk
+    else:
+        def leg(x: np.ndarray) -> np.ndarray:
+            return ramp_linear(x, cfg.ramp_fraction)
+    return np.concatenate([leg(np.arange(n_out) / n_out), 1.0 - leg(np.arange(n_back) / n_back)])
+
+
+def reaching_targets(cfg: Any) -> np.ndarray:
+    """(targets, 3) offsets from the centre, evenly spaced on a circle of ``radius_m`` from angle pi
+    (where the circle starts)."""
+    a = np.pi + 2 * np.pi * np.arange(cfg.targets) / cfg.targets
     r = cfg.radius_m
-    out = []
-    for k in range(cfg.targets):
-        a = np.pi + 2 * np.pi * k / cfg.targets
-        out.append(s[:, None] * np.array([r * np.cos(a), r * np.sin(a), 0.0]))
-    return out
+    return np.stack([r * np.cos(a), r * np.sin(a), np.zeros_like(a)], 1)
+
+
+def reaching_offsets(cfg: Any) -> list[np.ndarray]:
+    """One straight out-and-back Cartesian path per target."""
+    s = reaching_profile(cfg)
+    return [s[:, None] * target for target in reaching_targets(cfg)]
 
 
 Offsets = Callable[[Any], list[np.ndarray]]
@@ -92,36 +122,70 @@ def periodic_derivative(q: np.ndarray, dt: float) -> np.ndarray:
     return (np.roll(q, -1, 0) - np.roll(q, 1, 0)) / (2 * dt)
 
 
+def _arm_ik() -> SiteIK:
+    """IK of the end-effector on the 7-joint chain (s0..w1 and w2)."""
+    model = mujoco.MjModel.from_xml_string(kinematic_mjcf(w2=True))
+    lo = np.array([r[0] for r in JOINT_RANGE] + [W2_RANGE[0]])
+    hi = np.array([r[1] for r in JOINT_RANGE] + [W2_RANGE[1]])
+    return SiteIK(model, "end_effector", 7, lo, hi)
+
+
+def _paths(q7: np.ndarray, xyz: np.ndarray, home: np.ndarray, centre: np.ndarray, rot: np.ndarray) -> dict:
+    return {"q": q7[..., :6].copy(), "q7": q7, "xyz": xyz, "home": home, "centre": centre, "rot": rot}
+
+
 def solve_paths(cfg: Any, offsets_of: Offsets) -> dict[str, np.ndarray]:
-    """Run IK for every variant of ``cfg``: arrays q (V, steps, 6), xyz (V, steps, 3), errors."""
-    model = mujoco.MjModel.from_xml_string(kinematic_mjcf())
-    lo = np.array([r[0] for r in JOINT_RANGE])
-    hi = np.array([r[1] for r in JOINT_RANGE])
-    ik = SiteIK(model, "end_effector", 6, lo, hi)
+    """Run IK on the 7-joint chain for every variant of ``cfg``: arrays q (V, steps, 6: s0..w1, w2
+    dropped), q7 (V, steps, 7: the solution with w2), xyz (V, steps, 3), home, centre, rot."""
+    ik = _arm_ik()
     home = np.asarray(cfg.home_q_rad, dtype=float)
-    centre, rot = ik.fk(home)
+    home7 = np.append(home, 0.0)
+    centre, rot = ik.fk(home7)
     qs, xyzs = [], []
     for offsets in offsets_of(cfg):
         xyz = centre + offsets
-        q = np.empty((len(xyz), 6))
-        prev = home
+        q = np.empty((len(xyz), 7))
+        prev = home7
         for i, p in enumerate(xyz):
-            prev, _ = ik.solve(prev, p, rot)
+            prev, _ = ik.solve(prev, p, rot, posture=home7, max_iter=200)
             q[i] = prev
         qs.append(q)
         xyzs.append(xyz)
-    return {"q": np.stack(qs), "xyz": np.stack(xyzs), "home": home, "centre": centre, "rot": rot}
+    return _paths(np.stack(qs), np.stack(xyzs), home, centre, rot)
+
+
+def solve_reaching(cfg: Any) -> dict[str, np.ndarray]:
+    """Reaching paths: straight Cartesian legs (``space: cartesian``, IK at every sample), or, as the
+    original (facts §5: joint-space targets, joint-space ramps), IK at the targets only and the joints
+    interpolated from the home pose (``space: joint``; the hand then moves on a slightly curved line)."""
+    if cfg.space == "cartesian":
+        return solve_paths(cfg, reaching_offsets)
+    ik = _arm_ik()
+    home = np.asarray(cfg.home_q_rad, dtype=float)
+    home7 = np.append(home, 0.0)
+    centre, rot = ik.fk(home7)
+    s = reaching_profile(cfg)[:, None]
+    qs, xyzs = [], []
+    for target in reaching_targets(cfg):
+        q_end, _ = ik.solve(home7, centre + target, rot, posture=home7, max_iter=400)
+        q = home7 + s * (q_end - home7)
+        qs.append(q)
+        xyzs.append(np.stack([ik.fk(qi)[0] for qi in q]))
+    return _paths(np.stack(qs), np.stack(xyzs), home, centre, rot)
 
 
 def cache_key(cfg: Any) -> str:
-    text = json.dumps(cfg.model_dump(mode="json"), sort_keys=True) + kinematic_mjcf() + IK_VERSION
+    text = json.dumps(cfg.model_dump(mode="json"), sort_keys=True) + kinematic_mjcf(w2=True) + IK_VERSION
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 
-def load_or_solve(cfg: Any, cache_dir: Path | None, offsets_of: Offsets) -> dict[str, np.ndarray]:
-    """Joint paths from the cache, or solved and written there (atomically)."""
+Solver = Callable[[Any], dict[str, np.ndarray]]
+
+
+def load_or_solve(cfg: Any, cache_dir: Path | None, solve: Solver) -> dict[str, np.ndarray]:
+    """Joint paths from the cache, or solved by ``solve(cfg)`` and written there (atomically)."""
     if cache_dir is None:
-        return solve_paths(cfg, offsets_of)
+        return solve(cfg)
     path = Path(cache_dir) / f"ik_{cfg.kind}_{cache_key(cfg)}.npz"
     if path.exists():
         try:
@@ -129,7 +193,7 @@ def load_or_solve(cfg: Any, cache_dir: Path | None, offsets_of: Offsets) -> dict
                 return {k: f[k] for k in f.files}
         except (OSError, ValueError):
             pass
-    data = solve_paths(cfg, offsets_of)
+    data = solve(cfg)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(f".{np.random.default_rng().integers(1 << 30)}.tmp.npz")
     np.savez(tmp, **data)
@@ -147,6 +211,7 @@ class CartesianTask(Task):
         self.kind = cfg.kind
         self.period_s = float(cfg.period_s)
         self._q = paths["q"]
+        self._q7 = paths.get("q7")
         self._qd = np.stack([periodic_derivative(q, CONTROL_DT_S) for q in self._q])
         self._xyz = paths["xyz"]
         self._home = np.asarray(paths["home"], dtype=float)
@@ -177,12 +242,19 @@ class CartesianTask(Task):
         return q.min(0), q.max(0), qd.min(0), qd.max(0)
 
 
-def _builder(offsets_of: Offsets) -> Callable[[Any, Any], CartesianTask]:
+def _builder(offsets_of: Offsets | None = None, solve: Solver | None = None) -> Callable[[Any, Any], CartesianTask]:
+    if solve is None:
+        def solve(cfg: Any) -> dict[str, np.ndarray]:
+            return solve_paths(cfg, offsets_of)
+        name = offsets_of.__name__
+    else:
+        name = solve.__name__
+
     def build(cfg: Any, ctx: Any = None) -> CartesianTask:
         cache = getattr(ctx, "cache_dir", None) if ctx is not None else None
-        return CartesianTask(cfg, load_or_solve(cfg, cache, offsets_of))
+        return CartesianTask(cfg, load_or_solve(cfg, cache, solve))
 
-    build.__doc__ = f"Registry builder: the Cartesian task whose path is ``{offsets_of.__name__}``."
+    build.__doc__ = f"Registry builder: the Cartesian task whose path is ``{name}``."
     return build
 
 
@@ -190,4 +262,4 @@ build_circle = _builder(circle_offsets)
 build_eight = _builder(eight_offsets)
 build_inclined_circle = _builder(inclined_circle_offsets)
 build_circle_eight = _builder(circle_eight_offsets)
-build_reaching = _builder(reaching_offsets)
+build_reaching = _builder(solve=solve_reaching)

@@ -1,4 +1,9 @@
-"""Damped least-squares inverse kinematics of a MuJoCo site, holding a fixed orientation."""
+"""Damped least-squares inverse kinematics of a MuJoCo site, holding a fixed orientation.
+
+On a redundant chain (more joints than the 6 task coordinates) an optional rest posture is pursued
+in the Jacobian's null space, so each solution is the one nearest that posture: the joint path of
+a closed Cartesian path then closes too (plain least-squares steps drift from lap to lap).
+"""
 
 from __future__ import annotations
 
@@ -50,8 +55,12 @@ class SiteIK:
         tol: float = 1e-9,
         damping: float = 1e-4,
         max_iter: int = 100,
+        posture: np.ndarray | None = None,
     ) -> tuple[np.ndarray, float]:
-        """Newton iterations with damped least squares from ``q0``; returns (q, final error norm)."""
+        """Newton iterations with damped least squares from ``q0``; returns (q, final error norm).
+
+        With ``posture`` (redundant chains) each step also moves towards it in the null space of the
+        Jacobian, and iterating stops once that step is negligible too."""
         m, d, n = self.model, self.data, self.n
         q = np.array(q0, dtype=float)
         err = np.zeros(6)
@@ -63,10 +72,13 @@ class SiteIK:
             err[:3] = pos - d.site_xpos[self.site]
             err[3:] = rotation_error(d.site_xmat[self.site].reshape(3, 3), rot)
             norm = float(np.linalg.norm(err))
-            if norm < tol:
-                break
             mujoco.mj_jacSite(m, d, self._jac[:3], self._jac[3:], self.site)
             j = self._jac[:, :n]
-            dq = j.T @ np.linalg.solve(j @ j.T + damping**2 * np.eye(6), err)
+            pinv = j.T @ np.linalg.inv(j @ j.T + damping**2 * np.eye(6))
+            dq = pinv @ err
+            if posture is not None:
+                dq += (np.eye(n) - pinv @ j) @ (posture - q)
+            if norm < tol and (posture is None or np.linalg.norm(dq) < tol):
+                break
             q = np.clip(q + dq, self.lower, self.upper)
         return q, norm
