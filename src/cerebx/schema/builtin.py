@@ -50,3 +50,9 @@ registry.events.register(e.ForcePulse, "cerebx.plants.events:force_pulse")
 # mossy encoders take (cfg, lo, hi); climbing encoders (cfg, n_joints, fibres_per_joint, kpos, kvel, rng)
 registry.encoders.register(c.BoxEncoder, "cerebx.snn.encoders:MossyEncoder")
 registry.encoders.register(c.CFEncoder, "cerebx.snn.encoders:ClimbingEncoder")
+
+# Luque et al. 2011: crude inverse dynamics + the corrective spiking cerebellum (composite parts)
+from cerebx.schema import luque as lq  # noqa: E402
+
+registry.controllers.register(lq.CrudeInverseDynamics, "cerebx.controllers.inverse_dynamics:CrudeInverseDynamicsStage")
+registry.controllers.register(lq.Luque2011Cerebellum, "cerebx.controllers.luque2011:Luque2011Stage")
