@@ -49,86 +49,76 @@ class Luque2011Stage(Stage):
         lo, hi = np.concatenate([lo[:, 0], lo[:, 2]]), np.concatenate([hi[:, 0], hi[:, 2]])  # desired q, qd
         self.centres = np.concatenate([np.linspace(a, b, n_per) for a, b in zip(lo, hi)])
         self.sigma = cfg.inputs.sigma_spacing * (hi - lo) / (n_per - 1)
-        self.dt_ms = cfg.substep_ms
-        self.n_sub = int(round(STEP_MS / self.dt_ms))
-        self.in_decay = math.exp(-self.dt_ms / cfg.inputs.tau_ms)
-        self.kern = k.kernel_table(cfg.plasticity.kernel_peak_ms, self.dt_ms)
-        self.p_pc, self.p_dcn = lif_params(cfg.pc, self.dt_ms), lif_params(cfg.dcn, self.dt_ms)
-        t = cfg.teaching
+        self.enc = np.stack([self.centres, np.repeat(0.5 / self.sigma**2, n_per)])
+        dt_ms = cfg.substep_ms
+        self.kern = k.kernel_table(cfg.plasticity.kernel_peak_ms, dt_ms)
+        self.p_pc, self.p_dcn = lif_params(cfg.pc, dt_ms), lif_params(cfg.dcn, dt_ms)
+        pl, t = cfg.plasticity, cfg.teaching
+        self.pars = np.array([round(STEP_MS / dt_ms), dt_ms, math.exp(-dt_ms / cfg.inputs.tau_ms),
+                              cfg.inputs.drive_at_centre, n_per, pl.weight_max_nS, pl.ltp_nS, pl.ltd_nS,
+                              float(pl.enabled), cfg.pf_dcn_nS, cfg.pc_dcn_nS, t.eps_full_scale,
+                              t.rate_max_hz * STEP_MS / 1000.0])
         self.kp, self.kv = np.asarray(t.kp, float), np.asarray(t.kv, float)
         self.buffer = max(1, int(round(cfg.output.buffer_ms / STEP_MS)))
         self.gain = np.asarray(cfg.output.gain_Nm_per_hz, float)
         self.rng = np.random.default_rng(0)
+        self.w = np.full((N_PC, self.n_in), cfg.pf_pc_initial_nS)
         self._allocate()
 
     def _allocate(self) -> None:
+        """Fresh neuron, history and buffer state (the weights are kept)."""
         cfg = self.cfg
         self.v_in = np.zeros(self.n_in)
         self.v_pc, self.ge_pc, self.gi_pc = np.full(N_PC, cfg.pc.rest_mV), np.zeros(N_PC), np.zeros(N_PC)
         self.r_pc = np.zeros(N_PC, np.int64)
         self.v_dcn, self.ge_dcn, self.gi_dcn = np.full(N_DCN, cfg.dcn.rest_mV), np.zeros(N_DCN), np.zeros(N_DCN)
         self.r_dcn = np.zeros(N_DCN, np.int64)
-        self.w = np.full((N_PC, self.n_in), cfg.pf_pc_initial_nS)
         self.hist = np.full((self.n_in, HISTORY), -1, np.int64)
         self.head = np.zeros(self.n_in, np.int64)
-        self.now = 0
+        self.clock = np.zeros(3, np.int64)  # sub-step index, tick index, IO spikes since the last trial end
         self.counts = np.zeros((self.buffer, N_DCN), np.int64)  # DCN spikes of the last `buffer` ticks
+        self.io_spike = np.zeros(N_IO, np.bool_)
+        self.drive = np.zeros(self.n_in)
         self.desired = np.zeros((DESIRED_TICKS, 2 * N_JOINTS))
+        self.uniform = np.zeros((0, N_IO))
         self._sensed: Any = None
+        self._no_eps = np.full(N_JOINTS, np.nan)
         self.tau = np.zeros(N_JOINTS)
-        self.io_spikes = 0
-        self.ticks = 0
 
     def reset(self, rng: np.random.Generator) -> None:
-        w = self.w.copy()
         self._allocate()
-        self.w = w  # learned weights survive a reset (init_from loads them before it)
         self.rng = rng
 
-    def drive(self, x: np.ndarray) -> np.ndarray:
-        """R I of every input cell for the desired state ``x`` = (q1..q3, qd1..qd3)."""
-        return self.cfg.inputs.drive_at_centre * k.rbf_currents(x, self.centres, self.sigma, self.n_per)
-
-    def teaching_error(self, frame: Frame) -> np.ndarray | None:
-        """eps per joint for a measurement that arrived this tick (None when none did)."""
+    def teaching_error(self, frame: Frame) -> np.ndarray:
+        """eps per joint (Eq. 7) for a measurement that arrived this tick; NaN when none did."""
         sensed = frame.sensed
         if sensed is None or sensed is self._sensed:
-            return None
+            return self._no_eps
         self._sensed = sensed
         tick = int(round(sensed.stamp_s * 1000.0 / STEP_MS))
         if tick > frame.tick or frame.tick - tick >= DESIRED_TICKS:
-            return None
+            return self._no_eps
         d = self.desired[tick % DESIRED_TICKS]
         return self.kp * (d[:N_JOINTS] - sensed["joint.q"]) + self.kv * (d[N_JOINTS:] - sensed["joint.qd"])
 
     def step(self, frame: Frame) -> None:
         s = frame.signals
-        x = np.concatenate([s["ref.q"], s["ref.qd"]])
-        self.desired[frame.tick % DESIRED_TICKS] = x
+        x = self.desired[frame.tick % DESIRED_TICKS]
+        x[:N_JOINTS], x[N_JOINTS:] = s["ref.q"], s["ref.qd"]
         eps = self.teaching_error(frame)
-        if eps is None:
-            io = np.zeros(N_IO, np.bool_)
-        else:
-            t = self.cfg.teaching
-            p = np.repeat(k.io_probability(eps, t.eps_full_scale, t.rate_max_hz, STEP_MS / 1000.0), N_IO // 6)
-            io = self.rng.random(N_IO) < p
-            self.io_spikes += int(io.sum())
-        pl = self.cfg.plasticity
-        slot = self.counts[self.ticks % self.buffer]
-        slot[:] = 0
-        self.now = k.tick(self.drive(x), io, self.n_sub, self.dt_ms, self.in_decay, self.v_in, self.v_pc, self.ge_pc,
-                          self.gi_pc, self.r_pc, self.v_dcn, self.ge_dcn, self.gi_dcn, self.r_dcn, self.w,
-                          pl.weight_max_nS, pl.ltp_nS, pl.ltd_nS, self.kern, self.hist, self.head, self.now,
-                          self.p_pc, self.p_dcn, self.cfg.pf_dcn_nS, self.cfg.pc_dcn_nS, slot, pl.enabled)
-        self.ticks += 1
-        rate = self.counts.sum(0).reshape(2 * N_JOINTS, 4).mean(1) / (self.buffer * STEP_MS / 1000.0)  # Hz per cell
-        self.tau = self.gain * (rate[0::2] - rate[1::2])
-        self.emit(frame, "joint.torque", self.tau.copy())
+        row = int(self.clock[1]) % 1024
+        if row == 0 or self.uniform.shape[0] == 0:  # IO random numbers, drawn 1024 ticks at a time
+            self.uniform = self.rng.random((1024, N_IO))
+        self.tau = np.empty(N_JOINTS)
+        k.tick(x, eps, self.uniform[row], self.enc, self.pars, self.v_in, self.v_pc, self.ge_pc, self.gi_pc, self.r_pc,
+               self.v_dcn, self.ge_dcn, self.gi_dcn, self.r_dcn, self.w, self.kern, self.hist, self.head, self.clock,
+               self.p_pc, self.p_dcn, self.counts, self.io_spike, self.drive, self.gain, self.tau)
+        self.emit(frame, "joint.torque", self.tau)
 
     def end_trial(self, trial: int) -> dict[str, float]:
         out = {"w_mean_nS": float(self.w.mean()), "w_min_nS": float(self.w.min()), "w_max_nS": float(self.w.max()),
-               "io_spikes": float(self.io_spikes)}
-        self.io_spikes = 0
+               "io_spikes": float(self.clock[2])}
+        self.clock[2] = 0
         return out
 
     def record(self) -> dict[str, Any]:

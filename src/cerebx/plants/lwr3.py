@@ -35,6 +35,8 @@ def lwr3_model(cfg: LWR3Config, object_mass_kg: float | None = None) -> mujoco.M
     model = mujoco.MjModel.from_xml_path(str(MJCF))
     model.opt.timestep = cfg.physics_dt_ms / 1000.0
     model.dof_damping[:] = cfg.damping_Nms_per_rad
+    model.jnt_stiffness[:] = cfg.stiffness_Nm_per_rad
+    model.qpos_spring[:] = cfg.spring_ref_rad
     model.actuator_ctrlrange[:] = np.stack([-np.asarray(cfg.torque_limit_Nm), np.asarray(cfg.torque_limit_Nm)], 1)
     set_object(model, cfg.object_mass_kg if object_mass_kg is None else object_mass_kg)
     return model

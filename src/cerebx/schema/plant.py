@@ -128,6 +128,10 @@ class LWR3Config(PlantSchema):
         (176.0, 176.0, 100.0), description="actuator saturation of A1, A2, A4 (LWR 4+ limits, facts §1.2)"
     )
     damping_Nms_per_rad: NonNegFloat = Field(1.0, description="viscous joint damping (the Gazebo URDF's 1.0)")
+    stiffness_Nm_per_rad: tuple[NonNegFloat, NonNegFloat, NonNegFloat] = Field(
+        (0.0, 0.0, 0.0), description="passive joint springs toward spring_ref_rad (a non-stiff, elastic arm)"
+    )
+    spring_ref_rad: tuple[float, float, float] = Field((0.0, 0.0, 0.0), description="where the springs are slack")
     object_mass_kg: NonNegFloat = Field(
         0.0, description="mass held at the end of the last segment from the start (paper: 0.5, 1, 1.5 or 2 kg)"
     )

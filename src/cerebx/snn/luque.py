@@ -73,36 +73,69 @@ def _lif(v, ge, gi, refr, p, dt):
 
 
 @njit(cache=True)
-def tick(drive, io_spike, n_sub, dt_ms, in_decay, v_in, v_pc, ge_pc, gi_pc, r_pc, v_dcn, ge_dcn, gi_dcn, r_dcn,
-         w, w_max, ltp, ltd, kern, hist, head, now, p_pc, p_dcn, w_dcn, w_inh, dcn_count, learn):
-    """Advance one control step. ``drive``: R I of each input cell (held over the step); ``io_spike``:
-    bool per IO cell (fires at the step's start); ``hist``/``head``: each input cell's recent spike times
-    (sub-step index, -1 = empty) as a ring; ``now``: the sub-step index at the step's start.
-    Adds each DCN cell's spikes to ``dcn_count``; returns the sub-step index after the step."""
-    n_in = v_in.shape[0]
-    n_pc = v_pc.shape[0]
-    depth = hist.shape[1]
-    span = kern.shape[0]
-    if learn and ltd > 0.0:
-        any_io = False
-        for i in range(n_pc):
-            any_io = any_io or io_spike[i]
-        if any_io:
-            elig = np.zeros(n_in)
+def _encode(x, centres, inv2s2, n_per, scale, drive):
+    """Eq. 2.A for every input cell, times the drive at a centre (in place into ``drive``)."""
+    for j in range(centres.shape[0]):
+        d = x[j // n_per] - centres[j]
+        drive[j] = scale * math.exp(-d * d * inv2s2[j])
+
+
+@njit(cache=True)
+def _olive(eps, u, full_scale, p_max, per_group, io_spike):
+    """IO spikes of this step: cell i of group g = 2 j + s fires when u_i < p_max min(1, max(0, +-eps_j) / full)."""
+    any_io = False
+    for i in range(io_spike.shape[0]):
+        g = i // per_group
+        e = eps[g // 2] if g % 2 == 0 else -eps[g // 2]
+        p = e / full_scale
+        p = 0.0 if p < 0.0 else (1.0 if p > 1.0 else p)
+        io_spike[i] = u[i] < p_max * p
+        any_io = any_io or io_spike[i]
+    return any_io
+
+
+@njit(cache=True)
+def _depress(w, io_spike, ltd, kern, hist, now):
+    """Eq. 6.A: each PC whose IO cell fired loses ltd x sum_k kern(now - t_k) on each PF's synapse."""
+    n_in, depth, span = hist.shape[0], hist.shape[1], kern.shape[0]
+    elig = np.zeros(n_in)
+    for j in range(n_in):
+        s = 0.0
+        for h in range(depth):
+            t = hist[j, h]
+            if t >= 0 and now - t < span:
+                s += kern[now - t]
+        elig[j] = s
+    for i in range(w.shape[0]):
+        if io_spike[i]:
             for j in range(n_in):
-                s = 0.0
-                for h in range(depth):
-                    t = hist[j, h]
-                    if t >= 0:
-                        age = now - t
-                        if age < span:
-                            s += kern[age]
-                elig[j] = s
+                x = w[i, j] - ltd * elig[j]
+                w[i, j] = x if x > 0.0 else 0.0
+
+
+@njit(cache=True)
+def tick(x, eps, u, enc, pars, v_in, v_pc, ge_pc, gi_pc, r_pc, v_dcn, ge_dcn, gi_dcn, r_dcn, w, kern, hist, head,
+         clock, p_pc, p_dcn, counts, io_spike, drive, gain, torque):
+    """Advance one 2 ms control step and write the corrective ``torque``.
+
+    ``x``: desired (q1..q3, qd1..qd3); ``eps``: teaching error per joint (NaN: no measurement arrived);
+    ``u``: a uniform number per IO cell; ``enc`` = (centres, 1 / 2 sigma^2) per input cell; ``pars`` = (n_sub,
+    dt_ms, input decay, drive at centre, n_per, w_max, ltp, ltd, learn, w_dcn, w_inh, eps full scale,
+    IO p_max per step); ``clock`` = [sub-step index, tick index, IO spike count]; ``hist``/``head``: each
+    input cell's recent spike sub-steps as a ring (-1 empty); ``counts``: DCN spikes per buffered tick."""
+    n_sub, dt, in_decay, scale, n_per = int(pars[0]), pars[1], pars[2], pars[3], int(pars[4])
+    w_max, ltp, ltd, learn, w_dcn, w_inh = pars[5], pars[6], pars[7], pars[8] > 0.0, pars[9], pars[10]
+    n_in, n_pc, depth = v_in.shape[0], v_pc.shape[0], hist.shape[1]
+    now = clock[0]
+    _encode(x, enc[0], enc[1], n_per, scale, drive)
+    if not math.isnan(eps[0]):
+        if _olive(eps, u, pars[11], pars[12], n_pc // 6, io_spike):
             for i in range(n_pc):
-                if io_spike[i]:
-                    for j in range(n_in):
-                        x = w[i, j] - ltd * elig[j]
-                        w[i, j] = x if x > 0.0 else 0.0
+                clock[2] += io_spike[i]
+            if learn and ltd > 0.0:
+                _depress(w, io_spike, ltd, kern, hist, now)
+    slot = counts[clock[1] % counts.shape[0]]
+    slot[:] = 0
     for _ in range(n_sub):
         for j in range(n_in):
             d = drive[j]
@@ -114,13 +147,26 @@ def tick(drive, io_spike, n_sub, dt_ms, in_decay, v_in, v_pc, ge_pc, gi_pc, r_pc
                 for i in range(n_pc):
                     ge_pc[i] += w[i, j]
                     if learn:
-                        x = w[i, j] + ltp
-                        w[i, j] = x if x < w_max else w_max
+                        y = w[i, j] + ltp
+                        w[i, j] = y if y < w_max else w_max
                 for k in range(ge_dcn.shape[0]):
                     ge_dcn[k] += w_dcn
-        for i in _lif(v_pc, ge_pc, gi_pc, r_pc, p_pc, dt_ms):
+        for i in _lif(v_pc, ge_pc, gi_pc, r_pc, p_pc, dt):
             gi_dcn[i // 2] += w_inh
-        for k in _lif(v_dcn, ge_dcn, gi_dcn, r_dcn, p_dcn, dt_ms):
-            dcn_count[k] += 1
+        for k in _lif(v_dcn, ge_dcn, gi_dcn, r_dcn, p_dcn, dt):
+            slot[k] += 1
         now += 1
-    return now
+    clock[0] = now
+    clock[1] += 1
+    # buffered DCN rate per cell (Hz), + group minus - group, per joint
+    n_dcn = v_dcn.shape[0]
+    per = n_dcn // 6
+    window_s = counts.shape[0] * n_sub * dt / 1000.0
+    for j in range(torque.shape[0]):
+        pos = 0
+        neg = 0
+        for b in range(counts.shape[0]):
+            for k in range(per):
+                pos += counts[b, 2 * j * per + k]
+                neg += counts[b, (2 * j + 1) * per + k]
+        torque[j] = gain[j] * (pos - neg) / (per * window_s)
