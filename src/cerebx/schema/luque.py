@@ -93,7 +93,7 @@ class CorrectiveOutput(Strict):
 
     buffer_ms: PositiveFloat = Field(20.0, description="averaging window (constructed)")
     gain_Nm_per_hz: tuple[float, float, float] = Field(
-        (0.05, 0.1, 0.05), description="N·m per Hz of DCN group-rate difference (constructed)"
+        (0.1, 0.2, 0.1), description="N·m per Hz of DCN group-rate difference (constructed)"
     )
 
 
@@ -108,7 +108,9 @@ class Luque2011Cerebellum(ControllerConfig):
     pc: ConductanceLIF = Field(PC_TABLE_I, description="Purkinje cells (Table I)")
     dcn: ConductanceLIF = Field(DCN_TABLE_I, description="DCN cells (Table I)")
     pf_pc_initial_nS: NonNegFloat = Field(15.0, description="paper: initial PF-PC conductance")
-    pf_dcn_nS: NonNegFloat = Field(0.5, description="input cell -> DCN weight (constructed)")
+    pf_dcn_nS: NonNegFloat = Field(
+        20.0, description="input cell -> DCN weight (constructed: the DCN fire ~150 Hz at the start, a bias both ways)"
+    )
     pc_dcn_nS: NonNegFloat = Field(30.0, description="PC -> DCN weight (Table I: 30 nS x 1 synapse)")
     plasticity: LTDLTP = LTDLTP()
     teaching: TeachingSignal = TeachingSignal()
