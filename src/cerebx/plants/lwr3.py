@@ -111,13 +111,14 @@ class LWR3Arm(Plant):
 
     # ---- plant events ----------------------------------------------------------------------
     def attach_payload(self, mass: float, rod: float = 0.0) -> None:
-        """Hold an object of ``mass`` kg at the end of the last segment (no rod: ``rod`` must be 0)."""
+        """Hold an object of ``mass`` kg at the end of the last segment instead of the configured one (no rod:
+        ``rod`` must be 0)."""
         if mass <= 0 or rod != 0:
             raise ValueError("lwr3 attach_payload needs mass_kg > 0 and rod_length_m = 0 (the object is held)")
         set_object(self.model, mass)
         mujoco.mj_forward(self.model, self.data)
 
     def detach_payload(self) -> None:
-        """Let go of the object."""
-        set_object(self.model, 0.0)
+        """Back to the configured arm (its ``object_mass_kg``, 0 = empty hand)."""
+        set_object(self.model, self.cfg.object_mass_kg)
         mujoco.mj_forward(self.model, self.data)
