@@ -36,6 +36,20 @@ def test_kernel_peak_moves_with_its_setting():
     assert np.argmax(table) == 400 and len(table) * 0.25 > 100.0 + math.pi * 100.0 / math.atan(20.0)
 
 
+def test_ltd_on_pf_io_pairing_at_the_kernel_peak():
+    kern = k.kernel_table(100.0, 0.25)
+    w = np.full((4, 3), 15.0)
+    hist = np.full((3, 8), -1, np.int64)
+    now = 1000
+    hist[0, 0] = now - 400  # a PF spike 100 ms before the IO spike: the kernel's peak
+    hist[1, 0] = now - 200  # 50 ms before
+    io = np.array([False, True, False, False])
+    k._depress(w, io, 0.075, kern, hist, now)
+    assert w[1, 0] == pytest.approx(15.0 - 0.075)
+    assert w[1, 1] == pytest.approx(15.0 - 0.075 * k.ltd_kernel(np.array([50.0]), 100.0)[0])
+    assert w[1, 2] == 15.0 and np.all(w[[0, 2, 3]] == 15.0)  # silent PF, PCs without an IO spike: unchanged
+
+
 # ---- encoder (Eq. 2) and inferior olive (Eq. 7) --------------------------------------------------------------
 
 
