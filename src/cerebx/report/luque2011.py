@@ -17,11 +17,21 @@ HEADER = ["quantity", "paper", "cerebx"]
 N_JOINTS = 3
 # Fig. 11 caption: error reduction after 200 / 400 trials, by object mass (kg)
 PAPER_IMPROVEMENT = {0.5: (40.4, 49.0), 1.0: (64.6, 64.5), 1.5: (72.5, 74.4), 2.0: (78.6, 79.3)}
-CER = "controller.parts.1"
+
+
+def _cer(r: Run, dotted: str):
+    """A field of the run's cerebellum part (the composite's part of kind luque2011_cerebellum)."""
+    parts = r.get("controller.parts") or []
+    node = next((p for p in parts if isinstance(p, dict) and p.get("kind") == "luque2011_cerebellum"), None)
+    for key in dotted.split("."):
+        if not isinstance(node, dict):
+            return None
+        node = node.get(key)
+    return node
 
 
 def _luque(runs: RunSet) -> RunSet:
-    return runs.where(lambda r: r.task == "luque_eight" and r.get(f"{CER}.kind") == "luque2011_cerebellum")
+    return runs.where(lambda r: r.task == "luque_eight" and _cer(r, "kind") == "luque2011_cerebellum")
 
 
 def _mae_sum(r: Run) -> np.ndarray:
@@ -45,14 +55,14 @@ def _finish(fig, stem: Path, axes: list) -> Path:
 
 def _default_1kg(r: Run) -> bool:
     return (r.get("plant.object_mass_kg") == 1.0 and r.delay_total_ms == 100.0
-            and r.get(f"{CER}.plasticity.kernel_peak_ms") == 100.0)
+            and _cer(r, "plasticity.kernel_peak_ms") == 100.0)
 
 
 # ---- Fig. 8 ----------------------------------------------------------------------------------------------------
 @figure("luque2011_fig8", "Luque 2011 Fig. 8: LTD x LTP trade-off", studies=("luque2011_fig8",))
 def fig8(runs: RunSet, stem: Path) -> Figure:
     rs = _luque(runs).where(_default_1kg)
-    cells = rs.by(lambda r: (r.get(f"{CER}.plasticity.ltd_nS"), r.get(f"{CER}.plasticity.ltp_nS")))
+    cells = rs.by(lambda r: (_cer(r, "plasticity.ltd_nS"), _cer(r, "plasticity.ltp_nS")))
     if len(cells) < 4:
         raise MissingRuns("fewer than 4 LTD x LTP points of the 1 kg eight (study luque2011_fig8)")
     ltds = sorted({k[0] for k in cells})
@@ -116,7 +126,7 @@ def _curves_and_final(rs: dict, stem: Path, xlabel: str, label) -> tuple[Path, l
 @figure("luque2011_fig9", "Luque 2011 Fig. 9: delays with the kernel matched", studies=("luque2011_fig9",))
 def fig9(runs: RunSet, stem: Path) -> Figure:
     rs = _luque(runs).where(lambda r: r.get("plant.object_mass_kg") == 1.0
-                            and r.get(f"{CER}.plasticity.kernel_peak_ms") == r.delay_total_ms)
+                            and _cer(r, "plasticity.kernel_peak_ms") == r.delay_total_ms)
     by_delay = rs.by(lambda r: r.delay_total_ms)
     if len(by_delay) < 2:
         raise MissingRuns("fewer than 2 delays with a matched kernel (study luque2011_fig9)")
@@ -132,7 +142,7 @@ def fig9(runs: RunSet, stem: Path) -> Figure:
 @figure("luque2011_fig10", "Luque 2011 Fig. 10: kernel peak vs delay mismatch", studies=("luque2011_fig10",))
 def fig10(runs: RunSet, stem: Path) -> Figure:
     rs = _luque(runs).where(lambda r: r.get("plant.object_mass_kg") == 1.0 and r.delay_total_ms == 100.0)
-    by_dev = rs.by(lambda r: r.get(f"{CER}.plasticity.kernel_peak_ms") - 100.0)
+    by_dev = rs.by(lambda r: _cer(r, "plasticity.kernel_peak_ms") - 100.0)
     if len(by_dev) < 2:
         raise MissingRuns("fewer than 2 kernel peaks at the 100 ms delay (study luque2011_fig10)")
     png, rows = _curves_and_final(by_dev, stem, "kernel peak - delay (ms)", lambda d: f"mismatch {d:+g} ms")
@@ -145,7 +155,7 @@ def fig10(runs: RunSet, stem: Path) -> Figure:
 # ---- Fig. 11 / 12 and Fig. 7c ---------------------------------------------------------------------------------------
 @figure("luque2011_fig12", "Luque 2011 Fig. 12: objects of 0.5-2 kg", studies=("luque2011_fig12",))
 def fig12(runs: RunSet, stem: Path) -> Figure:
-    rs = _luque(runs).where(lambda r: r.delay_total_ms == 100.0 and r.get(f"{CER}.plasticity.kernel_peak_ms") == 100.0)
+    rs = _luque(runs).where(lambda r: r.delay_total_ms == 100.0 and _cer(r, "plasticity.kernel_peak_ms") == 100.0)
     by_mass = rs.by(lambda r: r.get("plant.object_mass_kg"))
     if len(by_mass) < 2:
         raise MissingRuns("fewer than 2 object masses (study luque2011_fig12)")
