@@ -12,6 +12,7 @@ import numpy as np
 from cerebx import metrics
 from cerebx.report.registry import Figure, MissingRuns, figure, fmt, panel_letter, plt, save
 from cerebx.report.runs import Run, RunSet
+from cerebx.schema.luque import Luque2011Cerebellum
 
 HEADER = ["quantity", "paper", "cerebx"]
 N_JOINTS = 3
@@ -32,6 +33,12 @@ def _cer(r: Run, dotted: str):
 
 def _luque(runs: RunSet) -> RunSet:
     return runs.where(lambda r: r.task == "luque_eight" and _cer(r, "kind") == "luque2011_cerebellum")
+
+
+def _default_plasticity(r: Run) -> bool:
+    """LTD and LTP at the preset's balanced values (the runs of Fig. 9-12, not the Fig. 8 grid)."""
+    default = Luque2011Cerebellum().plasticity
+    return _cer(r, "plasticity.ltd_nS") == default.ltd_nS and _cer(r, "plasticity.ltp_nS") == default.ltp_nS
 
 
 def _mae_sum(r: Run) -> np.ndarray:
@@ -125,7 +132,7 @@ def _curves_and_final(rs: dict, stem: Path, xlabel: str, label) -> tuple[Path, l
 
 @figure("luque2011_fig9", "Luque 2011 Fig. 9: delays with the kernel matched", studies=("luque2011_fig9",))
 def fig9(runs: RunSet, stem: Path) -> Figure:
-    rs = _luque(runs).where(lambda r: r.get("plant.object_mass_kg") == 1.0
+    rs = _luque(runs).where(lambda r: r.get("plant.object_mass_kg") == 1.0 and _default_plasticity(r)
                             and _cer(r, "plasticity.kernel_peak_ms") == r.delay_total_ms)
     by_delay = rs.by(lambda r: r.delay_total_ms)
     if len(by_delay) < 2:
@@ -141,7 +148,8 @@ def fig9(runs: RunSet, stem: Path) -> Figure:
 
 @figure("luque2011_fig10", "Luque 2011 Fig. 10: kernel peak vs delay mismatch", studies=("luque2011_fig10",))
 def fig10(runs: RunSet, stem: Path) -> Figure:
-    rs = _luque(runs).where(lambda r: r.get("plant.object_mass_kg") == 1.0 and r.delay_total_ms == 100.0)
+    rs = _luque(runs).where(lambda r: r.get("plant.object_mass_kg") == 1.0 and r.delay_total_ms == 100.0
+                            and _default_plasticity(r))
     by_dev = rs.by(lambda r: _cer(r, "plasticity.kernel_peak_ms") - 100.0)
     if len(by_dev) < 2:
         raise MissingRuns("fewer than 2 kernel peaks at the 100 ms delay (study luque2011_fig10)")
@@ -155,7 +163,8 @@ def fig10(runs: RunSet, stem: Path) -> Figure:
 # ---- Fig. 11 / 12 and Fig. 7c ---------------------------------------------------------------------------------------
 @figure("luque2011_fig12", "Luque 2011 Fig. 12: objects of 0.5-2 kg", studies=("luque2011_fig12",))
 def fig12(runs: RunSet, stem: Path) -> Figure:
-    rs = _luque(runs).where(lambda r: r.delay_total_ms == 100.0 and _cer(r, "plasticity.kernel_peak_ms") == 100.0)
+    rs = _luque(runs).where(lambda r: r.delay_total_ms == 100.0 and _cer(r, "plasticity.kernel_peak_ms") == 100.0
+                            and _default_plasticity(r))
     by_mass = rs.by(lambda r: r.get("plant.object_mass_kg"))
     if len(by_mass) < 2:
         raise MissingRuns("fewer than 2 object masses (study luque2011_fig12)")
@@ -165,8 +174,8 @@ def fig12(runs: RunSet, stem: Path) -> Figure:
     for i, (mass, r) in enumerate(by_mass.items()):
         m = list(_mae_sum(r))
         ax_a.plot(m, lw=1, color=f"C{i}", label=f"{mass:g} kg")
-        at = [t for t in (200, 400) if t <= len(m)]
-        ours = [metrics.improvement_pct(m, t) for t in at]
+        at = [t for t in (200, 400) if t <= len(m) + r.warmup]  # trials counted from the run's start
+        ours = [metrics.improvement_pct(m, min(t, len(m))) for t in at]
         paper = PAPER_IMPROVEMENT.get(float(mass))
         gains.append((mass, metrics.accuracy_gain(m), ours))
         for t, v in zip(at, ours):
@@ -196,7 +205,8 @@ def fig12(runs: RunSet, stem: Path) -> Figure:
 
 @figure("luque2011_fig7c", "Luque 2011 Fig. 7c: learned PF-PC weights", studies=("luque2011_fig12",))
 def fig7c(runs: RunSet, stem: Path) -> Figure:
-    rs = _luque(runs).where(lambda r: _default_1kg(r) and (r.dir / "controller_state.part1.npz").exists())
+    rs = _luque(runs).where(lambda r: _default_1kg(r) and _default_plasticity(r)
+                            and (r.dir / "controller_state.part1.npz").exists())
     r = rs.best()
     if r is None:
         raise MissingRuns("no 1 kg run with a saved cerebellum state (study luque2011_fig12)")
