@@ -128,6 +128,6 @@ class Luque2011Cerebellum(ControllerConfig):
 
     def cross_check(self, exp: Any) -> list[str]:
         if exp.plant.n_joints != 3:
-            return [f"controller: luque2011_cerebellum drives 3 joints, plant {exp.plant.kind} has "
+            return [f"kind: luque2011_cerebellum drives 3 joints, plant {exp.plant.kind} has "
                     f"{exp.plant.n_joints}"]
         return []
