@@ -121,9 +121,6 @@ class Luque2011Stage(Stage):
         self.clock[2] = 0
         return out
 
-    def record(self) -> dict[str, Any]:
-        return {"tau_cerebellum": self.tau.copy()}
-
     def save_state(self, path: Path) -> bool:
         save_state_npz(Path(path), {"kind": "luque2011_cerebellum", "n_in": self.n_in}, w=self.w,
                        centres=self.centres)
