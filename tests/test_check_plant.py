@@ -63,3 +63,8 @@ def test_checker_catches_nondeterminism():
 
     with pytest.raises(PlantContractError, match="identical"):
         check_plant(Jittery)
+
+
+def test_lwr3_with_object_and_springs_satisfies_contract():
+    check_plant(_factory("lwr3", object_mass_kg=0.5, stiffness_Nm_per_rad=(300.0, 300.0, 300.0),
+                         spring_ref_rad=(0.0, 0.6, 0.6), damping_Nms_per_rad=15.0))

@@ -16,6 +16,8 @@ def _options(group: str) -> list[str]:
 
 
 def _plant_for(task: str) -> list[str]:
+    if task == "luque_eight":
+        return ["plant=lwr3", "controller=luque2011"]
     return ["plant=planar2", "controller=pd_planar2"] if task == "joint_sine" else []
 
 
@@ -38,6 +40,8 @@ def test_every_option_validates(load, group):
         extra = []
         if option.endswith("planar2") or option == "planar2":
             extra = ["+task=joint_sine", "plant=planar2", "controller=pd_planar2"]
+        elif option in ("lwr3", "luque2011"):
+            extra = ["+task=luque_eight", "plant=lwr3", "controller=luque2011"]
         else:
             extra = ["+task=circle"]
         load([*extra, f"{group}={option}"])

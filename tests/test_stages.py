@@ -31,6 +31,9 @@ KINDS = {
         "position": ["+task=circle", "controller=position"],
         "snn": ["+task=circle", "+experiment=small_snn"],
         "ann": ["+task=circle", "controller=ann"],
+        "crude_inverse_dynamics": ["+experiment=luque2011_eight", "~controller",
+                                   "+controller={kind: crude_inverse_dynamics}"],
+        "luque2011_cerebellum": ["+experiment=luque2011_eight"],
         "composite": [*DEMO, "controller=pd_planar2",
                       "~controller", "+controller={kind: composite, parts: [{kind: pd, kp: [60.0, 40.0], "
                       "kd: [4.0, 2.5], tau_max_Nm: [30.0, 20.0]}, {kind: pd, kp: [5.0, 5.0], kd: [0.0, 0.0], "

@@ -77,3 +77,33 @@ def trials_to_threshold(mae_per_trial: list[float], threshold: float) -> int | N
         if v <= threshold:
             return i
     return None
+
+
+# ---- Luque et al. 2011, Eq. 8-11: learning estimators over a MAE curve (one value per trial) ----------
+
+def final_error(mae_per_trial: list[float], n: int = 30) -> float:
+    """Eq. 9: mean MAE of the last ``n`` trials."""
+    return float(np.mean(np.asarray(mae_per_trial, float)[-n:]))
+
+
+def accuracy_gain(mae_per_trial: list[float], n: int = 30) -> float:
+    """Eq. 8: MAE of the first trial minus the final error (same unit as the MAE)."""
+    return float(mae_per_trial[0]) - final_error(mae_per_trial, n)
+
+
+def final_error_stability(mae_per_trial: list[float], n: int = 30) -> float:
+    """Eq. 10: standard deviation of the MAE over the last ``n`` trials (lower = more stable)."""
+    return float(np.std(np.asarray(mae_per_trial, float)[-n:]))
+
+
+def convergence_speed(mae_per_trial: list[float], n: int = 30) -> int:
+    """Eq. 11: the first trial whose MAE is at or below the final error (trials to converge)."""
+    mae = np.asarray(mae_per_trial, float)
+    return int(np.argmax(mae <= final_error(mae_per_trial, n)))
+
+
+def improvement_pct(mae_per_trial: list[float], at_trial: int, n: int = 30) -> float:
+    """Error reduction in % by ``at_trial`` (Fig. 11/12): 100 (1 - mean MAE of the ``n`` trials before it /
+    MAE of the first trial)."""
+    mae = np.asarray(mae_per_trial, float)
+    return float(100.0 * (1.0 - mae[max(0, at_trial - n):at_trial].mean() / mae[0]))

@@ -85,8 +85,9 @@ class ClosedLoop:
             self.rec.write("/events", "cerebx.PlantEvent", t_s, {"t": t_s, "kind": action.kind, "params": params})
 
     def step(self, q_des: np.ndarray, qd_des: np.ndarray, acc: TrialAccumulator | None = None, trial: int = 0,
-             ee_des: np.ndarray | None = None) -> np.ndarray:
-        """One tick, every phase in the order of :data:`PHASES`; returns the applied command."""
+             ee_des: np.ndarray | None = None, extra: dict[str, np.ndarray] | None = None) -> np.ndarray:
+        """One tick, every phase in the order of :data:`PHASES`; returns the applied command. ``extra``:
+        further reference signals (``ref.<name>``) for the brain side."""
         plant, link, rec = self.plant, self.link, self.rec
         tick = self.tick
         t = tick * self.dt_s
@@ -100,6 +101,8 @@ class ClosedLoop:
             self._sensed = arrived[-1]
         # brain
         signals = {"ref.q": q_des, "ref.qd": qd_des}
+        if extra:
+            signals.update(extra)
         if self._sensed is not None:
             signals.update(self._sensed.values)
         frame = Frame(tick, t, signals, self._sensed)
@@ -160,8 +163,10 @@ class ClosedLoop:
             rec.write("/task/cartesian_path", "cerebx.CartesianPath", 0.0,
                       {"x": ref.xyz[:, 0].copy(), "y": ref.xyz[:, 1].copy(), "z": ref.xyz[:, 2].copy()})
         xyz = ref.xyz
+        extra = [(f"ref.{name}", v) for name, v in ref.extra.items()]
         for i in range(ref.steps):
-            self.step(ref.q[i], ref.qd[i], acc, trial, xyz[i] if xyz is not None else None)
+            self.step(ref.q[i], ref.qd[i], acc, trial, xyz[i] if xyz is not None else None,
+                      {name: v[i] for name, v in extra} if extra else None)
         why = self.plant.is_diverged()
         if why:
             raise Diverged(f"trial {trial}: {why}")

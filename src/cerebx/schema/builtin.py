@@ -16,9 +16,11 @@ registry.tasks.register(t.EightTask, "cerebx.tasks.cartesian:build_eight")
 registry.tasks.register(t.InclinedCircleTask, "cerebx.tasks.cartesian:build_inclined_circle")
 registry.tasks.register(t.CircleEightTask, "cerebx.tasks.cartesian:build_circle_eight")
 registry.tasks.register(t.ReachingTask, "cerebx.tasks.cartesian:build_reaching")
+registry.tasks.register(t.LuqueEightTask, "cerebx.tasks.luque_eight:LuqueEight")
 
 registry.plants.register(p.Planar2Config, "cerebx.plants.planar2:Planar2Arm")
 registry.plants.register(p.BaxterConfig, "cerebx.plants.baxter:BaxterArm")
+registry.plants.register(p.LWR3Config, "cerebx.plants.lwr3:LWR3Arm")
 
 registry.controllers.register(c.PDController, "cerebx.controllers.pd:PD")
 registry.controllers.register(c.PositionController, "cerebx.controllers.position:PositionServo")
@@ -50,3 +52,9 @@ registry.events.register(e.Grab, "cerebx.plants.events:grab")
 # mossy encoders take (cfg, lo, hi); climbing encoders (cfg, n_joints, fibres_per_joint, kpos, kvel, rng)
 registry.encoders.register(c.BoxEncoder, "cerebx.snn.encoders:MossyEncoder")
 registry.encoders.register(c.CFEncoder, "cerebx.snn.encoders:ClimbingEncoder")
+
+# Luque et al. 2011: crude inverse dynamics + the corrective spiking cerebellum (composite parts)
+from cerebx.schema import luque as lq  # noqa: E402
+
+registry.controllers.register(lq.CrudeInverseDynamics, "cerebx.controllers.inverse_dynamics:CrudeInverseDynamicsStage")
+registry.controllers.register(lq.Luque2011Cerebellum, "cerebx.controllers.luque2011:Luque2011Stage")

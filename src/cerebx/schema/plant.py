@@ -118,3 +118,29 @@ class BaxterConfig(PlantSchema):
     @property
     def n_joints(self) -> int:
         return 6
+
+
+class LWR3Config(PlantSchema):
+    """Three joints (A1, A2, A4) of a KUKA LWR 4+ as a stand-in for the DLR LWR-III of Luque et al. 2011;
+    link masses, lengths and inertias from a published URDF (facts luque2011_capolei2020.md §1), the other
+    joints fixed at 0. An object can hang at the end of the last segment (``object_mass_kg`` from the start,
+    or the ``attach_payload`` event)."""
+
+    kind: Literal["lwr3"] = "lwr3"
+    physics_dt_ms: PhysicsStepMs = 0.5
+    torque_limit_Nm: tuple[PositiveFloat, PositiveFloat, PositiveFloat] = Field(
+        (176.0, 176.0, 100.0), description="actuator saturation of A1, A2, A4 (LWR 4+ limits, facts §1.2)"
+    )
+    damping_Nms_per_rad: NonNegFloat = Field(1.0, description="viscous joint damping (the Gazebo URDF's 1.0)")
+    stiffness_Nm_per_rad: tuple[NonNegFloat, NonNegFloat, NonNegFloat] = Field(
+        (0.0, 0.0, 0.0), description="passive joint springs toward spring_ref_rad (a non-stiff, elastic arm)"
+    )
+    spring_ref_rad: tuple[float, float, float] = Field((0.0, 0.0, 0.0), description="where the springs are slack")
+    object_mass_kg: NonNegFloat = Field(
+        0.0, description="mass held at the end of the last segment from the start (paper: 0.5, 1, 1.5 or 2 kg)"
+    )
+    sensor_noise_rad: NonNegFloat = Field(0.0, description="std of Gaussian noise on measured joint positions")
+
+    @property
+    def n_joints(self) -> int:
+        return 3

@@ -4,7 +4,7 @@ small plants."""
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import ClassVar, Literal
 
 from pydantic import Field, model_validator
 
@@ -92,3 +92,24 @@ class ReachingTask(_CartesianTask):
         if self.out_s >= self.period_s:
             raise ValueError(f"out_s ({self.out_s}) must be shorter than period_s ({self.period_s})")
         return self
+
+
+class LuqueEightTask(Strict):
+    """Luque et al. 2011 Eq. 1, three joints: q1 = A1 sin(w t) + C1, q2 = A2 sin(w t + theta) + C2,
+    q3 = A2 sin(w t + 2 theta) + C3, one trial = one period. The paper gives no constants and writes
+    sin(pi t) for a 1 s trial, which does not close; here w = 2 pi / period_s, and the constants are
+    constructed so that the LWR hand traces an eight (seen from above, one self-crossing) as in its Fig. 2.
+    Also gives the desired acceleration ``ref.qdd`` (for the crude inverse dynamics)."""
+
+    extra_reference: ClassVar[dict[str, str]] = {"qdd": "rad/s^2"}
+
+    kind: Literal["luque_eight"] = "luque_eight"
+    period_s: PositiveFloat = Field(1.0, description="one trial (paper: 1 s)")
+    amplitude1_rad: float = Field(0.5, description="A1 (constructed)")
+    amplitude2_rad: float = Field(0.5, description="A2, shared by q2 and q3 (constructed)")
+    theta_rad: float = Field(2.356194490192345, description="theta, phase step between joints (constructed: 3 pi/4)")
+    offset_rad: tuple[float, float, float] = Field((0.0, 0.6, 0.6), description="C1, C2, C3 (constructed)")
+
+    @property
+    def n_joints(self) -> int:
+        return 3

@@ -86,6 +86,16 @@ class Receiver(ABC):
         """Prepare for a run."""
 
 
+def reference_signals(exp: Any) -> dict[str, Signal]:
+    """What the task gives the brain side: ``ref.q``, ``ref.qd`` and the extra references its schema
+    declares in ``extra_reference`` (name -> unit, e.g. ``{"qdd": "rad/s^2"}``)."""
+    n = exp.plant.n_joints
+    ref = {"ref.q": Signal("ref.q", n, "rad"), "ref.qd": Signal("ref.qd", n, "rad/s")}
+    for name, unit in getattr(exp.task, "extra_reference", {}).items():
+        ref[f"ref.{name}"] = Signal(f"ref.{name}", n, unit)
+    return ref
+
+
 def _fmt(signals: dict[str, Signal]) -> str:
     return ", ".join(str(s) for s in signals.values()) or "nothing"
 
@@ -132,7 +142,7 @@ def wire(exp: Any) -> Wiring:
     plant = exp.plant
     n = plant.n_joints
     sensors, commands = plant.sensor_signals(), plant.command_signals()
-    ref = {"ref.q": Signal("ref.q", n, "rad"), "ref.qd": Signal("ref.qd", n, "rad/s")}
+    ref = reference_signals(exp)
     brain = [(f"controller ({exp.controller.kind})", exp.controller.io(n))]
     brain += [(f"brain stage {i} ({s.kind})", s.io(n)) for i, s in enumerate(exp.brain)]
     have = check_chain("brain", "the task and the link", {**ref, **sensors}, brain)

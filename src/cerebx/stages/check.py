@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from cerebx.signals import Frame, Message, Signal
-from cerebx.stages.base import Receiver, Stage
+from cerebx.stages.base import Receiver, Stage, reference_signals
 
 
 class StageContractError(AssertionError):
@@ -61,10 +61,9 @@ def _run(stage: Stage, available: dict[str, Signal], ticks: int, seed: int, sens
 
 
 def _available(ctx: Any, side: str) -> dict[str, Signal]:
-    n = ctx.plant.n_joints
     available = dict(ctx.plant.sensor_signals())
     if side == "brain":
-        available.update({"ref.q": Signal("ref.q", n, "rad"), "ref.qd": Signal("ref.qd", n, "rad/s")})
+        available.update(reference_signals(ctx.cfg))
     else:
         available.update({s.name: s for s in ctx.sent})
     return available

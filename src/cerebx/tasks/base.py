@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -13,13 +13,16 @@ class TrialReference:
     """Desired joint positions/velocities for one trial, one row per control step.
 
     ``q`` and ``qd`` have shape (steps, n_joints); ``xyz`` is the desired Cartesian path
-    (steps, 3) when the task is defined in Cartesian space, else None.
+    (steps, 3) when the task is defined in Cartesian space, else None. ``extra`` holds further
+    reference arrays (steps, n_joints) by name, e.g. ``{"qdd": ...}``: the loop puts row i into the
+    brain frame as ``ref.<name>`` (the task's schema declares them in ``extra_reference``).
     """
 
     q: np.ndarray
     qd: np.ndarray
     xyz: np.ndarray | None = None
     label: str = ""
+    extra: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def steps(self) -> int:
