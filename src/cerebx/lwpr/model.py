@@ -26,6 +26,8 @@ class _SubModel:
         self.vec = np.zeros((capacity, K.N_VEC, n_in))
         self.sca = np.zeros((capacity, K.N_SCA))
         self.n_rf = 0
+        self.n_created = 0
+        self.n_pruned = 0
 
     def ensure_free_slot(self) -> None:
         if self.n_rf < self.mat.shape[0]:
@@ -84,8 +86,11 @@ class LWPR:
         out = np.empty(self.n_out)
         for d, sub in enumerate(self.subs):
             sub.ensure_free_slot()
+            before = sub.n_rf
             out[d], sub.n_rf, _ = K.update(sub.mat, sub.vec, sub.sca, sub.n_rf, xn, yn[d],
                                            self.init_M, self.init_D, self.init_alpha, self.hp)
+            sub.n_created += sub.n_rf > before
+            sub.n_pruned += sub.n_rf < before
         self.n_updates += 1
         return out * self.norm_out
 
@@ -118,6 +123,32 @@ class LWPR:
     def n_receptive_fields(self) -> list[int]:
         """RFs per output dimension."""
         return [sub.n_rf for sub in self.subs]
+
+    @property
+    def n_created(self) -> list[int]:
+        """RFs created so far per output dimension (pruned ones included)."""
+        return [sub.n_created for sub in self.subs]
+
+    def state(self) -> dict[str, np.ndarray]:
+        """The learned arrays (for saving); :meth:`load` restores them."""
+        out: dict[str, np.ndarray] = {}
+        for d, sub in enumerate(self.subs):
+            n = sub.n_rf
+            out.update({f"lwpr{d}_mat": sub.mat[:n], f"lwpr{d}_vec": sub.vec[:n], f"lwpr{d}_sca": sub.sca[:n],
+                        f"lwpr{d}_counts": np.array([sub.n_created, sub.n_pruned])})
+        return out
+
+    def load(self, state: dict[str, np.ndarray]) -> None:
+        for d, sub in enumerate(self.subs):
+            mat = state[f"lwpr{d}_mat"]
+            if mat.shape[1:] != sub.mat.shape[1:]:
+                raise ValueError(f"LWPR state: {mat.shape[2]} inputs saved, this model has {self.n_in}")
+            n = mat.shape[0]
+            cap = max(self.params.initial_capacity, 2 * n)
+            sub.mat, sub.vec, sub.sca = (np.zeros((cap, *a.shape[1:])) for a in (sub.mat, sub.vec, sub.sca))
+            sub.mat[:n], sub.vec[:n], sub.sca[:n] = mat, state[f"lwpr{d}_vec"], state[f"lwpr{d}_sca"]
+            sub.n_rf = n
+            sub.n_created, sub.n_pruned = (int(v) for v in state[f"lwpr{d}_counts"])
 
     def distance_metric(self, out: int, rf: int) -> np.ndarray:
         """D of RF ``rf`` of output ``out`` (in normalised input units)."""

@@ -2,6 +2,7 @@
 code (never in configuration) so heavy modules (MuJoCo, numba kernels) load only when used."""
 
 from cerebx import registry
+from cerebx.schema import capolei as cap
 from cerebx.schema import controller as c
 from cerebx.schema import delay as d
 from cerebx.schema import events as e
@@ -16,6 +17,7 @@ registry.tasks.register(t.EightTask, "cerebx.tasks.cartesian:build_eight")
 registry.tasks.register(t.InclinedCircleTask, "cerebx.tasks.cartesian:build_inclined_circle")
 registry.tasks.register(t.CircleEightTask, "cerebx.tasks.cartesian:build_circle_eight")
 registry.tasks.register(t.ReachingTask, "cerebx.tasks.cartesian:build_reaching")
+registry.tasks.register(t.WristOscillationTask, "cerebx.tasks.wrist_oscillation:WristOscillation")
 
 registry.plants.register(p.Planar2Config, "cerebx.plants.planar2:Planar2Arm")
 registry.plants.register(p.BaxterConfig, "cerebx.plants.baxter:BaxterArm")
@@ -26,6 +28,9 @@ registry.controllers.register(c.PositionController, "cerebx.controllers.position
 registry.controllers.register(c.SNNController, "cerebx.controllers.snn:SNNControllerImpl")
 registry.controllers.register(ANNController, "cerebx.controllers.ann:ANN")
 registry.controllers.register(c.CompositeController, "cerebx.build:build_composite")
+registry.controllers.register(cap.PIDVelocity, "cerebx.capolei.stages:build_pid")
+registry.controllers.register(cap.CapoleiForward, "cerebx.capolei.stages:build_forward")
+registry.controllers.register(cap.CapoleiInverse, "cerebx.capolei.stages:build_inverse")
 
 # receivers take (cfg, ctx, signals the link delivers); other stages (cfg, ctx)
 registry.stages.register(s.HoldConfig, "cerebx.stages.receivers:build_hold")
