@@ -90,9 +90,9 @@ class ModularCerebellarCircuit:
 
     def load(self, state: dict[str, np.ndarray]) -> None:
         for name in ("w_pf_pc", "w_pc_dcn", "w_mf_dcn", "w_io_dcn", "dcn"):
-            got = np.asarray(state[name])
-            if got.shape != getattr(self, name).shape:
-                raise ValueError(f"cerebellar state: {name} has shape {got.shape}, expected {getattr(self, name).shape}")
+            got, want = np.asarray(state[name]), getattr(self, name).shape
+            if got.shape != want:
+                raise ValueError(f"cerebellar state: {name} has shape {got.shape}, expected {want}")
             setattr(self, name, got.copy())
         self.granular.load(state)
 
