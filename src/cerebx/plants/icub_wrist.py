@@ -5,7 +5,8 @@ prosup -> pitch -> yaw, as on the robot). The rest of the arm is fixed. The MJCF
 says which numbers are from the NRP iCub model and which are constructed. The encoders are sampled
 at ``sample_rate_hz`` and held between samples; ``sensor_noise`` adds U(-a, a) to each sampled
 position and velocity. The ball starts at rest ``ball_drop_height_m`` above the table centre when
-the plant is reset (it is dropped on the table in the first trial) and is put back there whenever
+the plant is reset (it is dropped on the table in the first trial; the drop point is drawn within
+``ball_drop_jitter_m`` of the centre from the run's seed, so repetitions differ) and is put back there whenever
 it falls ``ball_lost_below_m`` below the table.
 """
 
@@ -69,7 +70,9 @@ class ICubWrist(Plant):
         if self._ball_q is None:
             return
         a, v = self._ball_q, self._ball_v
-        self.data.qpos[a:a + 3] = self.data.site_xpos[self._table] + (0.0, 0.0, self.cfg.ball_drop_height_m)
+        j = self.cfg.ball_drop_jitter_m
+        dx, dy = self._rng.uniform(-j, j, 2) if j > 0 else (0.0, 0.0)
+        self.data.qpos[a:a + 3] = self.data.site_xpos[self._table] + (dx, dy, self.cfg.ball_drop_height_m)
         self.data.qpos[a + 3:a + 7] = (1.0, 0.0, 0.0, 0.0)
         self.data.qvel[v:v + 6] = 0.0
         mujoco.mj_forward(self.model, self.data)

@@ -133,6 +133,8 @@ class ICubWristConfig(PlantSchema):
     ball: bool = Field(True, description="a free ball rolls on the table")
     ball_drop_height_m: NonNegFloat = Field(0.1, description="the ball starts at rest this high above the "
                                             "table centre at reset")
+    ball_drop_jitter_m: NonNegFloat = Field(0.03, description="the drop point is drawn from U(-j, j) in x and y "
+                                            "about the table centre (constructed: makes seeds differ)")
     ball_reset: bool = Field(True, description="drop the ball again when it falls off the table")
     ball_lost_below_m: PositiveFloat = Field(0.1, description="the ball counts as fallen this far below the table")
 
