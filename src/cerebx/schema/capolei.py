@@ -108,7 +108,7 @@ class CerebellarModule(ControllerConfig):
     mf_dcn: SynapseKernel = _DCN
     io_dcn: SynapseKernel
     io_range: PerJointPair = Field(
-        ((0.2, 0.5),) * 3, description="|error| mapped to |io| = 1 per joint, [position rad, velocity rad/s] "
+        ((0.05, 0.2),) * 3, description="|error| mapped to |io| = 1 per joint, [position rad, velocity rad/s] "
         "(constructed)")
     signal_range: tuple[PositiveFloat, ...] = Field(
         (1.0, 1.0, 1.0), description="|PC| and |DCN| mapped to 1 before the PC-DCN rules, per joint (constructed)")
@@ -164,7 +164,8 @@ class CapoleiInverse(CerebellarModule):
     pf_pc: SynapseKernel = INVERSE_PF_PC
     io_dcn: SynapseKernel = INVERSE_IO_DCN
     output_gain: tuple[float, ...] = Field(
-        (0.2, 0.2, 0.2), description="DCN output (in -1..1) to N·m, per joint (constructed)")
+        (0.45, 0.65, 0.65), description="DCN output (in -1..1) to N·m, per joint (constructed: the iCub wrist "
+        "effort limits)")
 
     def io(self, n_joints: int) -> StageIO:
         return StageIO(("ref.q", "ref.qd", VELOCITY_ERROR, "joint.torque"),
