@@ -112,27 +112,24 @@ def fig5(runs: RunSet, stem: Path) -> Figure:
     png = save(fig, stem)
 
     table = [["claim (paper)", "paper", "cerebx"]]
-    k1 = k_corr + 5
+    k5 = k_corr + 5  # 0-based index of the trial 5 trials after the first corrected one
     for j, paper in ((0, "12 %"), (1, "90 %")):
-        d = _drop(g, j, k1 - 1, k1)
-        table.append([f"IV vs I, joint {j + 1}, MAE drop at trial {k1} (5 trials after corrections start)", paper,
-                      "–" if d is None else f"{d:.0f} %"])
-    late = {}
-    for (label, case), rs in sorted(g.items()):
-        m = mae_per_joint(rs)
-        late[(label, case)] = m[:, k_corr:k_corr + 8, 2].mean()
+        d = _drop(g, j, k5, k5 + 1)
+        table.append([f"IV vs I, joint {j + 1}: MAE drop at trial {k5 + 1} (corrections from trial {k_corr + 1})",
+                      paper, "–" if d is None else f"{d:.0f} %"])
+    late = {label: mae_per_joint(rs)[:, k_corr:k_corr + 8, 2].mean() for (label, case), rs in g.items() if case == "A"}
     if late:
-        best = min((v, k) for k, v in late.items() if k[1] == "A")[1][0] if any(k[1] == "A" for k in late) else "–"
-        vals = ", ".join(f"{k[0]} {v:.4f}" for k, v in sorted(late.items()) if k[1] == "A")
-        table.append([f"joint 3 deviation corrected between trials {k_corr + 1} and {k_corr + 8} (mean MAE, case A)",
-                      "only IV", f"lowest: {best} ({vals})"])
-    for label in ("I", "III", "IV"):
+        vals = ", ".join(f"{label} {v:.4f}" for label, v in sorted(late.items()))
+        table.append([f"joint 3 deviation corrected in trials {k_corr + 1}-{k_corr + 8} (mean MAE, case A, rad)",
+                      "only IV", f"lowest: {min(late, key=late.get)} ({vals})"])
+    for label in ("I", "II", "III", "IV"):
         if (label, "A") in g and (label, "B") in g:
-            a = mae_per_joint(g[(label, "A")])[:, -5:].mean()
-            b = mae_per_joint(g[(label, "B")])[:, -5:].mean()
-            paper = "clearly worse" if label == "I" else "barely affected"
-            table.append([f"{label}: noise B vs A, mean MAE of the last 5 trials", paper,
-                          f"{b:.4f} vs {a:.4f} ({100 * (b - a) / a:+.0f} %)"])
+            a = mae_per_joint(g[(label, "A")])[:, -5:].mean((0, 1))
+            b = mae_per_joint(g[(label, "B")])[:, -5:].mean((0, 1))
+            paper = {"I": "clearly worse", "III": "barely affected", "IV": "barely affected"}.get(label, "–")
+            change = ", ".join(f"j{j + 1} {bj:.4f} vs {aj:.4f} ({100 * (bj - aj) / aj:+.0f} %)"
+                               for j, (aj, bj) in enumerate(zip(a, b)))
+            table.append([f"{label}: MAE of the last 5 trials, B vs A", paper, change])
     return Figure([png], "MAE per joint and trial: mean over the repetitions (line) and mean ± 3 SD (99.7 % band); "
                   f"green line: corrections start (trial {k_corr + 1}).", table)
 
