@@ -42,7 +42,8 @@ def test_plasticity_directions_follow_the_io_signal():
     np.testing.assert_allclose(c.w_pf_pc, np.asarray(c.cfg.pf_pc.ltp) / 2.0 ** np.asarray(c.cfg.pf_pc.alpha)
                                - np.asarray(c.cfg.pf_pc.ltd))
     assert np.all(c.w_pf_pc < 0)
-    np.testing.assert_allclose(c.w_io_dcn, np.asarray(c.cfg.io_dcn.ltp) - np.asarray(c.cfg.io_dcn.ltd) / 2.0 ** np.asarray(c.cfg.io_dcn.alpha))
+    mtp, mtd, a = (np.asarray(v) for v in (c.cfg.io_dcn.ltp, c.cfg.io_dcn.ltd, c.cfg.io_dcn.alpha))
+    np.testing.assert_allclose(c.w_io_dcn, mtp - mtd / 2.0**a)
     assert np.all(c.w_io_dcn > 0)
     # the IO-DCN path then drives the DCN with the sign of the error
     out = c.step(mf, x, big, learn=False)

@@ -72,11 +72,13 @@ def _correct_from(rs: list[Run]) -> int:
 
 
 def _drop(g, joint: int, k0: int, k1: int) -> float | None:
-    """Relative MAE change of IV against I, mean over trials k0..k1-1 (0-based)."""
+    """Relative MAE change of IV against I, mean over trials k0..k1-1 (0-based); None when the runs are shorter."""
     if ("I", "A") not in g or ("IV", "A") not in g:
         return None
-    a = mae_per_joint(g[("I", "A")])[:, k0:k1, joint].mean()
-    b = mae_per_joint(g[("IV", "A")])[:, k0:k1, joint].mean()
+    a, b = mae_per_joint(g[("I", "A")]), mae_per_joint(g[("IV", "A")])
+    if min(a.shape[1], b.shape[1]) < k1:
+        return None
+    a, b = a[:, k0:k1, joint].mean(), b[:, k0:k1, joint].mean()
     return 100.0 * (a - b) / a
 
 
@@ -117,7 +119,8 @@ def fig5(runs: RunSet, stem: Path) -> Figure:
         d = _drop(g, j, k5, k5 + 1)
         table.append([f"IV vs I, joint {j + 1}: MAE drop at trial {k5 + 1} (corrections from trial {k_corr + 1})",
                       paper, "–" if d is None else f"{d:.0f} %"])
-    late = {label: mae_per_joint(rs)[:, k_corr:k_corr + 8, 2].mean() for (label, case), rs in g.items() if case == "A"}
+    late = {label: mae_per_joint(rs)[:, k_corr:k_corr + 8, 2].mean() for (label, case), rs in g.items()
+            if case == "A" and mae_per_joint(rs).shape[1] >= k_corr + 8}
     if late:
         vals = ", ".join(f"{label} {v:.4f}" for label, v in sorted(late.items()))
         table.append([f"joint 3 deviation corrected in trials {k_corr + 1}-{k_corr + 8} (mean MAE, case A, rad)",
