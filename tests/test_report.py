@@ -122,6 +122,15 @@ def test_study_runner_reuses_finished_runs_and_skips_dependents_of_failures(tmp_
     assert ran == []  # every fig3_4_pd run is complete: reused
 
 
+def test_a_profile_can_sweep_fewer_values(tmp_path):
+    f = tmp_path / "studies.yaml"
+    f.write_text("studies:\n  a:\n    args: [+experiment=demo]\n    sweep: {seed: [0, 1, 2], trials: [1]}\n"
+                 "    quick: {trials: 1, sweep: {seed: [0]}}\n    full: {trials: 2}\n")
+    studies = load_studies(f)
+    assert [j.label for j in plan("quick", tmp_path, studies=studies)] == ["seed=0,trials=1"]
+    assert len(plan("full", tmp_path, studies=studies)) == 3
+
+
 def test_bad_studies_file_is_one_line(tmp_path):
     bad = tmp_path / "studies.yaml"
     bad.write_text("studies:\n  a:\n    args: [+experiment=demo]\n    init_from: nowhere\n"

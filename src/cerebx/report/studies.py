@@ -37,6 +37,8 @@ class ProfileSpec(Strict):
     trials: int = Field(ge=1, description="trials of every job")
     args: list[str] = Field(default_factory=list, description="extra overrides in this profile")
     init_from: str | None = Field("inherit", description="start from this study's run instead (null: scratch)")
+    sweep: dict[str, list[str | int | float]] = Field(
+        default_factory=dict, description="sweep values replacing the study's for these keys in this profile")
 
 
 class StudySpec(Strict):
@@ -129,8 +131,9 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
     for n in wanted:
         s = studies[n]
         p: ProfileSpec = getattr(s, profile)
-        keys = list(s.sweep)
-        combos = itertools.product(*(s.sweep[k] for k in keys)) if keys else [()]
+        sweep = {**s.sweep, **{k: v for k, v in p.sweep.items() if k in s.sweep}}
+        keys = list(sweep)
+        combos = itertools.product(*(sweep[k] for k in keys)) if keys else [()]
         src = _init_from(s, profile)
         for combo in combos:
             sweep_args = [f"{k}={v}" for k, v in zip(keys, combo)]
