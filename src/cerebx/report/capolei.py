@@ -125,6 +125,10 @@ def fig5(runs: RunSet, stem: Path) -> Figure:
         vals = ", ".join(f"{label} {v:.4f}" for label, v in sorted(late.items()))
         table.append([f"joint 3 deviation corrected in trials {k_corr + 1}-{k_corr + 8} (mean MAE, case A, rad)",
                       "only IV", f"lowest: {min(late, key=late.get)} ({vals})"])
+    noisy = {label: mae_per_joint(rs)[:, -5:].mean((0, 1)) for (label, case), rs in g.items() if case == "B"}
+    if noisy:
+        table.append(["case B: MAE per joint of the last 5 trials (rad)", "I degrades; III, IV filter the noise",
+                      "; ".join(f"{label} " + "/".join(f"{v:.3f}" for v in vals) for label, vals in sorted(noisy.items()))])
     for label in ("I", "II", "III", "IV"):
         if (label, "A") in g and (label, "B") in g:
             a = mae_per_joint(g[(label, "A")])[:, -5:].mean((0, 1))
