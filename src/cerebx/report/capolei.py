@@ -128,7 +128,8 @@ def fig5(runs: RunSet, stem: Path) -> Figure:
     noisy = {label: mae_per_joint(rs)[:, -5:].mean((0, 1)) for (label, case), rs in g.items() if case == "B"}
     if noisy:
         table.append(["case B: MAE per joint of the last 5 trials (rad)", "I degrades; III, IV filter the noise",
-                      "; ".join(f"{label} " + "/".join(f"{v:.3f}" for v in vals) for label, vals in sorted(noisy.items()))])
+                      "; ".join(f"{label} " + "/".join(f"{v:.3f}" for v in vals)
+                                for label, vals in sorted(noisy.items()))])
     for label in ("I", "II", "III", "IV"):
         if (label, "A") in g and (label, "B") in g:
             a = mae_per_joint(g[(label, "A")])[:, -5:].mean((0, 1))
