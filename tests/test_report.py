@@ -93,7 +93,8 @@ def test_every_study_job_is_a_valid_experiment(fixture_runs):
     for profile in ("quick", "full"):
         for job in plan(profile, fixture_runs.parent):
             ov = [f"init_from={state}" if o.startswith("init_from=") else o for o in job.overrides()]
-            key = tuple(o for o in ov if not o.startswith("trials="))  # the profiles mostly differ in trials
+            # the profiles mostly differ in trials; seeds do not change what validates
+            key = tuple(o for o in ov if not o.startswith(("trials=", "seed=")))
             if key not in seen:
                 seen.add(key)
                 # the fixture state stands in for every study's start (small SNN): it need not fit the job
@@ -121,6 +122,22 @@ def test_study_runner_reuses_finished_runs_and_skips_dependents_of_failures(tmp_
     ran.clear()
     execute(plan("quick", tmp_path, ["fig3_4_pd"]), runner=fake, log=lambda line: None)
     assert ran == []  # every fig3_4_pd run is complete: reused
+
+
+def test_a_profile_can_sweep_fewer_values(tmp_path):
+    from cerebx.report.studies import group
+
+    f = tmp_path / "studies.yaml"
+    f.write_text("studies:\n  a:\n    args: [+experiment=fig3_4_pd]\n"
+                 "    quick: {trials: 1, args: ['delay.total_ms=0,40']}\n    full: {trials: 2}\n")
+    studies = load_studies(f)
+    quick = plan("quick", tmp_path, studies=studies)
+    assert [j.label for j in quick] == ["delay.total_ms=0", "delay.total_ms=40"]
+    assert "delay.total_ms=0,40" not in quick[0].overrides() and "delay.total_ms=40" in quick[1].overrides()
+    ov = group(quick)[0].overrides()
+    assert "delay.total_ms=0,40" in ov  # the multirun sweeps those values, not the preset's five
+    assert "delay.total_ms" not in next(o for o in ov if o.startswith("hydra.job.config.override_dirname.exclude"))
+    assert len(plan("full", tmp_path, studies=studies)) == 5
 
 
 def test_bad_studies_file_is_one_line(tmp_path):
@@ -162,7 +179,7 @@ def test_studies_are_multiruns_of_their_presets(tmp_path):
     assert preset_sweep(["+experiment=baselines", "controller=pd"]) == [[]]  # an arg fixes the swept key
     jobs = plan("quick", tmp_path, ["fig3_4_snn"])
     studies = group(jobs)
-    assert [s.name for s in studies] == ["learn_circle", "fig3_4_snn"]
+    assert [s.name for s in studies] == ["learn_circle_ch3", "fig3_4_snn"]
     assert studies[1].deps == [studies[0]] and len(studies[1].jobs) == 5
     assert jobs[1].run_dir == tmp_path / "quick" / "fig3_4_snn" / "delay.total_ms=0"
     ov = studies[1].overrides(["hydra/launcher=slurm"])

@@ -38,6 +38,10 @@ KINDS = {
                       "~controller", "+controller={kind: composite, parts: [{kind: pd, kp: [60.0, 40.0], "
                       "kd: [4.0, 2.5], tau_max_Nm: [30.0, 20.0]}, {kind: pd, kp: [5.0, 5.0], kd: [0.0, 0.0], "
                       "tau_max_Nm: [1.0, 1.0]}]}"],
+        # Capolei 2020 parts, each in the architecture preset that composes it
+        "pid_velocity": ["+experiment=capolei2020_arch1", "trials=1"],
+        "capolei_forward": ["+experiment=capolei2020_arch3", "trials=1"],
+        "capolei_inverse": ["+experiment=capolei2020_arch2", "trials=1"],
     },
     "stage": {
         "hold": [*DEMO, "robot=[{kind: hold}]"],

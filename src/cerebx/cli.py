@@ -22,6 +22,7 @@ commands:
   validate +task=NAME [...]                            check a config without running; print it
   inspect RUN_DIR|FILE.mcap                            a run's summary and its MCAP channels
   bench [--seconds S] [--networks a,b]                 speed of plant, network and closed loop (JSON)
+  bench --lwpr                                         LWPR updates per second (cross benchmark)
   report [RUN_DIR ...]                                 build reports/ from run logs
   summarize MULTIRUN_DIR                               one table of a sweep's jobs (CSV, Markdown, plot)
   tune [--out PATH] OVERRIDES...                       Ziegler-Nichols PD gains on the simulated plant

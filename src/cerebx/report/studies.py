@@ -46,7 +46,8 @@ class StudySpec(Strict):
     """One experiment preset run once or as a sweep."""
 
     args: list[str] = Field(min_length=1, description="overrides of every job, the experiment preset first (its "
-                            "hydra.sweeper.params make the study a sweep; an arg setting a swept key fixes it)")
+                            "hydra.sweeper.params make the study a sweep; an arg setting a swept key fixes it, "
+                            "or with a sweep value (seed=0,1,2) sweeps those values instead)")
     init_from: str | None = Field(None, description="single-run study whose learned state starts each job")
     quick: ProfileSpec = Field(description="the quick profile (< 30 min on 2 cores in all)")
     full: ProfileSpec = Field(description="the full profile (the thesis's trial counts)")
@@ -78,15 +79,28 @@ def _key(override: str) -> str:
     return override.split("=", 1)[0].lstrip("+~")
 
 
+def is_sweep(override: str) -> bool:
+    """Whether an override gives several values (``seed=0,1,2``, ``x=range(3)``), as ``cerebx run -m`` reads it."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+    from hydra.errors import HydraException
+
+    try:
+        return OverridesParser.create().parse_overrides([override])[0].is_sweep_override()
+    except HydraException:
+        return False
+
+
 def preset_sweep(args: list[str]) -> list[list[str]]:
     """The job overrides of the sweep the preset in ``args`` declares (``hydra.sweeper.params``), less the
-    keys ``args`` sets; ``[[]]`` when there is none (one job)."""
+    keys ``args`` sets to one value, with the values of the keys ``args`` sweeps itself; ``[[]]`` when there
+    is none (one job)."""
     return [list(c) for c in _preset_sweep(tuple(args))]
 
 
 @functools.lru_cache(maxsize=256)
 def _preset_sweep(args: tuple[str, ...]) -> tuple[tuple[str, ...], ...]:
-    args = list(args)
+    given = [a for a in args if is_sweep(a)]
+    args = [a for a in args if not is_sweep(a)]
     from hydra import compose, initialize_config_module
     from hydra.core.global_hydra import GlobalHydra
     from hydra.errors import HydraException
@@ -102,8 +116,8 @@ def _preset_sweep(args: tuple[str, ...]) -> tuple[tuple[str, ...], ...]:
         raise ConfigError(f"study {' '.join(args)}: {str(err).splitlines()[0]}") from None
     node = hydra_cfg.sweeper.get("params")
     params = OmegaConf.to_container(node, resolve=False) if node else {}
-    fixed = {_key(a) for a in args}
-    sweep = [f"{k}={v}" for k, v in params.items() if _key(k) not in fixed]
+    fixed = {_key(a) for a in [*args, *given]}
+    sweep = [f"{k}={v}" for k, v in params.items() if _key(k) not in fixed] + given
     return tuple(tuple(sorted(c)) for c in expand_sweep(sweep)) if sweep else ((),)
 
 
@@ -131,9 +145,10 @@ class Job:
     def overrides(self) -> list[str]:
         return [*self.common(), *self.sweep_args]
 
-    def common(self) -> list[str]:
-        """The overrides every job of the study shares."""
-        out = [*self.args, f"trials={self.trials}"]
+    def common(self, sweeps: bool = False) -> list[str]:
+        """The overrides every job of the study shares (``sweeps``: with the args that sweep several values,
+        as the study's ``cerebx run -m`` gives them)."""
+        out = [a for a in self.args if sweeps or not is_sweep(a)] + [f"trials={self.trials}"]
         if self.after is not None:
             out.append(f"init_from='{self.deps[0].run_dir}'")
         return out
@@ -233,7 +248,7 @@ class Study:
         """``cerebx run -m`` overrides: the shared ones, then where the jobs go, then ``extra`` (a launcher)."""
         common = self.jobs[0].common()
         swept = bool(self.jobs[0].sweep_args)
-        out = ["-m", *common, "resume=auto", "recording.progress=off", f"hydra.sweep.dir='{self.sweep_dir}'"]
+        out = ["-m", *self.jobs[0].common(sweeps=True), "resume=auto", "recording.progress=off", f"hydra.sweep.dir='{self.sweep_dir}'"]
         if swept:
             keys = sorted({_key(a) for a in [*common, "resume=", "recording.progress="]})
             out += ["hydra.sweep.subdir=${hydra.job.override_dirname}",

@@ -2,6 +2,7 @@
 code (never in configuration) so heavy modules (MuJoCo, numba kernels) load only when used."""
 
 from cerebx import registry
+from cerebx.schema import capolei as cap
 from cerebx.schema import controller as c
 from cerebx.schema import delay as d
 from cerebx.schema import events as e
@@ -17,16 +18,21 @@ registry.tasks.register(t.InclinedCircleTask, "cerebx.tasks.cartesian:build_incl
 registry.tasks.register(t.CircleEightTask, "cerebx.tasks.cartesian:build_circle_eight")
 registry.tasks.register(t.ReachingTask, "cerebx.tasks.cartesian:build_reaching")
 registry.tasks.register(t.LuqueEightTask, "cerebx.tasks.luque_eight:LuqueEight")
+registry.tasks.register(t.WristOscillationTask, "cerebx.tasks.wrist_oscillation:WristOscillation")
 
 registry.plants.register(p.Planar2Config, "cerebx.plants.planar2:Planar2Arm")
 registry.plants.register(p.BaxterConfig, "cerebx.plants.baxter:BaxterArm")
 registry.plants.register(p.LWR3Config, "cerebx.plants.lwr3:LWR3Arm")
+registry.plants.register(p.ICubWristConfig, "cerebx.plants.icub_wrist:ICubWrist")
 
 registry.controllers.register(c.PDController, "cerebx.controllers.pd:PD")
 registry.controllers.register(c.PositionController, "cerebx.controllers.position:PositionServo")
 registry.controllers.register(c.SNNController, "cerebx.controllers.snn:SNNControllerImpl")
 registry.controllers.register(ANNController, "cerebx.controllers.ann:ANN")
 registry.controllers.register(c.CompositeController, "cerebx.build:build_composite")
+registry.controllers.register(cap.PIDVelocity, "cerebx.capolei.stages:build_pid")
+registry.controllers.register(cap.CapoleiForward, "cerebx.capolei.stages:build_forward")
+registry.controllers.register(cap.CapoleiInverse, "cerebx.capolei.stages:build_inverse")
 
 # receivers take (cfg, ctx, signals the link delivers); other stages (cfg, ctx)
 registry.stages.register(s.HoldConfig, "cerebx.stages.receivers:build_hold")

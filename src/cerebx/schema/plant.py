@@ -144,3 +144,30 @@ class LWR3Config(PlantSchema):
     @property
     def n_joints(self) -> int:
         return 3
+
+
+class ICubWristConfig(PlantSchema):
+    """iCub right wrist (prosup, yaw, pitch) holding a table with a free ball (Capolei 2020); MJCF in
+    ``plants/icub_wrist.xml``. Efforts and damping from the NRP iCub model; armature constructed."""
+
+    kind: Literal["icub_wrist"] = "icub_wrist"
+    physics_dt_ms: PhysicsStepMs = 0.5
+    torque_limit_Nm: tuple[PositiveFloat, PositiveFloat, PositiveFloat] = Field(
+        (0.45, 0.65, 0.65), description="effort limits prosup, yaw, pitch (NRP iCub model)")
+    damping_Nms_per_rad: NonNegFloat = Field(1.0, description="joint damping (NRP iCub model)")
+    armature_kgm2: NonNegFloat = Field(0.03, description="reflected rotor inertia per joint (constructed)")
+    sample_rate_hz: PositiveFloat = Field(50.0, le=500.0, description="encoder sampling rate; readings are "
+                                          "held between samples (the paper's f_samp)")
+    sensor_noise: NonNegFloat = Field(0.0, description="a: U(-a, a) added to each sampled position (rad) and "
+                                      "velocity (rad/s); the paper's case B uses 0.1")
+    ball: bool = Field(True, description="a free ball rolls on the table")
+    ball_drop_height_m: NonNegFloat = Field(0.1, description="the ball starts at rest this high above the "
+                                            "table centre at reset")
+    ball_drop_jitter_m: NonNegFloat = Field(0.03, description="the drop point is drawn from U(-j, j) in x and y "
+                                            "about the table centre (constructed: makes seeds differ)")
+    ball_reset: bool = Field(True, description="drop the ball again when it falls off the table")
+    ball_lost_below_m: PositiveFloat = Field(0.1, description="the ball counts as fallen this far below the table")
+
+    @property
+    def n_joints(self) -> int:
+        return 3

@@ -113,3 +113,27 @@ class LuqueEightTask(Strict):
     @property
     def n_joints(self) -> int:
         return 3
+
+
+class WristOscillationTask(Strict):
+    """Capolei et al. 2020 Eq. 1-2: q_r = A sin(2 pi f t + phi), qdot_r = 2 pi f A cos(2 pi f t + phi);
+    one trial is one period 1/f."""
+
+    kind: Literal["wrist_oscillation"] = "wrist_oscillation"
+    frequency_hz: PositiveFloat = Field(0.25, description="f")
+    amplitude_rad: tuple[float, ...] = Field((0.1727, 0.1363, 0.0345), description="A per joint (prosup, yaw, pitch)")
+    phase_rad: tuple[float, ...] = Field((1.5707963267948966, 1.5707963267948966, 0.0), description="phi per joint")
+
+    @model_validator(mode="after")
+    def _same_length(self) -> WristOscillationTask:
+        if len(self.amplitude_rad) != len(self.phase_rad):
+            raise ValueError("amplitude_rad and phase_rad need one value per joint each")
+        return self
+
+    @property
+    def period_s(self) -> float:
+        return 1.0 / self.frequency_hz
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.amplitude_rad)

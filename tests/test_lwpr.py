@@ -1,0 +1,93 @@
+"""LWPR known answers: the reference library's cross benchmark, a 1-D function, RF creation by the
+activation threshold, distance-metric adaptation, storage growth and input checks."""
+
+import numpy as np
+import pytest
+
+from cerebx.lwpr import LWPR, LWPRParams
+from cerebx.lwpr.bench import cross
+
+
+def test_cross_function_matches_reference_library():
+    """example_c/cross.c protocol (facts §3.2): reference nMSE 0.021-0.025 with 53-61 RFs."""
+    rng = np.random.default_rng(1)
+    model = LWPR(2, 1, init_D=50.0, init_alpha=250.0, w_gen=0.2)
+    for _ in range(20):
+        xs = rng.uniform(-1, 1, (1000, 2))
+        ys = cross(xs) + rng.uniform(-0.05, 0.05, 1000)
+        for x, y in zip(xs, ys):
+            model.update(x, [y])
+    grid = np.linspace(-1, 1, 41)
+    test = np.array([[a, b] for a in grid for b in grid])
+    pred = np.array([model.predict(x)[0] for x in test])
+    nmse = np.mean((pred - cross(test)) ** 2) / np.var(cross(test))
+    assert 0.01 < nmse < 0.035
+    assert 45 <= model.n_receptive_fields[0] <= 70
+
+
+def test_one_dimensional_function():
+    rng = np.random.default_rng(0)
+    model = LWPR(1, 1)
+    f = lambda x: np.sin(3 * x) + 0.5 * x  # noqa: E731
+    for x in rng.uniform(-1, 1, 5000):
+        model.update([x], [f(x) + rng.normal(0, 0.05)])
+    test = np.linspace(-0.95, 0.95, 200)
+    pred = np.array([model.predict([x])[0] for x in test])
+    assert np.mean((pred - f(test)) ** 2) / np.var(f(test)) < 0.01
+    assert 3 <= model.n_receptive_fields[0] <= 30
+
+
+def test_receptive_field_created_only_below_w_gen():
+    """Gaussian RF with D = 25: activation at distance d is exp(-12.5 d^2); w_gen = 0.1 is crossed at
+    d = sqrt(2 ln 10 / 25) = 0.429."""
+    model = LWPR(1, 1, update_D=False)
+    model.update([0.0], [1.0])
+    assert model.n_receptive_fields == [1]
+    model.update([0.40], [1.0])  # activation 0.135 > w_gen: no new RF
+    assert model.n_receptive_fields == [1]
+    model.update([0.45], [1.0])  # 0.079 <= w_gen: a new RF centred there
+    assert model.n_receptive_fields == [2]
+    np.testing.assert_allclose(model.centres(0)[:, 0], [0.0, 0.45])
+    np.testing.assert_allclose(model.activations([0.45])[0], [np.exp(-12.5 * 0.45**2), 1.0])
+
+
+def test_distance_metric_adapts_only_when_enabled():
+    rng = np.random.default_rng(3)
+    xs = rng.uniform(-1, 1, (3000, 2))
+    ys = cross(xs)
+    fixed, adaptive = LWPR(2, 1, update_D=False), LWPR(2, 1, update_D=True)
+    for x, y in zip(xs, ys):
+        fixed.update(x, [y])
+        adaptive.update(x, [y])
+    init = 25.0 * np.eye(2)
+    for k in range(fixed.n_receptive_fields[0]):
+        np.testing.assert_array_equal(fixed.distance_metric(0, k), init)
+    changed = [not np.allclose(adaptive.distance_metric(0, k), init) for k in range(adaptive.n_receptive_fields[0])]
+    assert sum(changed) >= adaptive.n_receptive_fields[0] // 2
+    D0 = adaptive.distance_metric(0, 0)
+    assert D0[0, 1] == 0.0 and D0[1, 0] == 0.0  # diag_only keeps D diagonal
+
+
+def test_storage_grows_and_outputs_are_independent():
+    model = LWPR(1, 2, init_D=400.0, initial_capacity=2)
+    for _ in range(5):
+        for x in np.linspace(-1, 1, 41):
+            model.update([x], [x, -2 * x])
+    assert model.n_receptive_fields[0] > 2 and model.n_receptive_fields[0] == model.n_receptive_fields[1]
+    y = model.predict([0.3])
+    assert y[0] == pytest.approx(0.3, abs=0.05) and y[1] == pytest.approx(-0.6, abs=0.1)
+    _, acts = model.predict_with_activations([0.3])
+    assert len(acts) == 2 and acts[0].shape == (model.n_receptive_fields[0],) and acts[0].max() > 0.5
+
+
+def test_normalisation_and_bad_input():
+    model = LWPR(1, 1, norm_in=10.0, norm_out=100.0, init_D=25.0)
+    for x in np.linspace(-10, 10, 400):
+        model.update([x], [50.0 * x])
+    assert model.predict([5.0])[0] == pytest.approx(250.0, rel=0.05)
+    with pytest.raises(ValueError, match="input needs 1"):
+        model.predict([1.0, 2.0])
+    with pytest.raises(ValueError, match="norm_in: needs 1 or 2"):
+        LWPR(2, 1, norm_in=(1.0, 2.0, 3.0))
+    with pytest.raises(ValueError):
+        LWPRParams(w_gen=1.5)
