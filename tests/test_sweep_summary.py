@@ -23,7 +23,8 @@ def _sweep(root: Path) -> Path:
     for i, (ms, delay, mae, status) in enumerate(runs):
         _job(root, i, ["+experiment=fig3_4_pd", f"delay.total_ms={ms}", f"delay={delay}", "trials=12"],
              {"status": status, "task": "circle", "controller": "pd", "plant": "baxter", "delay": delay,
-              "seed": 0, "error": None if mae else "Diverged: joint 2 left its bounds", "trials": 12, "trials_completed": 12 if mae else 3, "final_mae": mae,
+              "seed": 0, "error": None if mae else "Diverged: joint 2 left its bounds", "trials": 12,
+              "trials_completed": 12 if mae else 3, "final_mae": mae,
               "rt_factor": 2.5 + i})
     _job(root, 10, ["+experiment=fig3_4_pd", "delay.total_ms=80", "delay=none", "trials=12"], None)  # no summary
     (root / "multirun.yaml").write_text(

@@ -248,7 +248,8 @@ class Study:
         """``cerebx run -m`` overrides: the shared ones, then where the jobs go, then ``extra`` (a launcher)."""
         common = self.jobs[0].common()
         swept = bool(self.jobs[0].sweep_args)
-        out = ["-m", *self.jobs[0].common(sweeps=True), "resume=auto", "recording.progress=off", f"hydra.sweep.dir='{self.sweep_dir}'"]
+        out = ["-m", *self.jobs[0].common(sweeps=True), "resume=auto", "recording.progress=off",
+               f"hydra.sweep.dir='{self.sweep_dir}'"]
         if swept:
             keys = sorted({_key(a) for a in [*common, "resume=", "recording.progress="]})
             out += ["hydra.sweep.subdir=${hydra.job.override_dirname}",
