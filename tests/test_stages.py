@@ -35,6 +35,7 @@ KINDS = {
                       "~controller", "+controller={kind: composite, parts: [{kind: pd, kp: [60.0, 40.0], "
                       "kd: [4.0, 2.5], tau_max_Nm: [30.0, 20.0]}, {kind: pd, kp: [5.0, 5.0], kd: [0.0, 0.0], "
                       "tau_max_Nm: [1.0, 1.0]}]}"],
+        "muscle_rest": ["+experiment=fig4_6b", "trials=1"],
     },
     "stage": {
         "hold": [*DEMO, "robot=[{kind: hold}]"],
@@ -42,6 +43,8 @@ KINDS = {
         "future_past": [*DEMO, "robot=[{kind: future_past}]"],
         "supervisor": [*DEMO, "robot=[{kind: hold}, {kind: supervisor, kp: [20.0, 20.0], kd: [5.0, 5.0], "
                        "bounds: plant}]"],
+        "ekeberg": ["+task=eight", "+experiment=small_snn", "plant=baxter_muscles", "muscle=ekeberg",
+                    "controller.output=agonist_antagonist", "controller.decoder.spikes_full_scale=10"],
     },
 }
 

@@ -45,7 +45,9 @@ class StudySpec(Strict):
     args: list[str] = Field(min_length=1, description="overrides of every job, the experiment preset first")
     sweep: dict[str, list[str | int | float]] = Field(
         default_factory=dict, description="override key -> values; one job per combination")
-    init_from: str | None = Field(None, description="single-run study whose learned state starts each job")
+    init_from: str | None = Field(
+        None, description="study whose learned state starts each job: a single-run study, or one with the same "
+        "sweep (each job then starts from the job of the same sweep values)")
     quick: ProfileSpec = Field(description="the quick profile (< 30 min on 2 cores in all)")
     full: ProfileSpec = Field(description="the full profile (the thesis's trial counts)")
 
@@ -67,8 +69,9 @@ def load_studies(path: Path = STUDIES_FILE) -> dict[str, StudySpec]:
     for name, s in studies.items():
         for prof in PROFILES:
             src = _init_from(s, prof)
-            if src is not None and (src not in studies or studies[src].sweep):
-                raise ConfigError(f"{path}: studies.{name}.init_from: {src!r} is not a single-run study")
+            if src is not None and (src not in studies or studies[src].sweep not in ({}, s.sweep)):
+                raise ConfigError(f"{path}: studies.{name}.init_from: {src!r} is not a single-run study "
+                                  "or one with the same sweep")
     return studies
 
 
@@ -126,6 +129,7 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
         want(n)
     jobs: list[Job] = []
     single: dict[str, Job] = {}
+    by_label: dict[tuple[str, str], Job] = {}
     for n in wanted:
         s = studies[n]
         p: ProfileSpec = getattr(s, profile)
@@ -137,9 +141,10 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
             label = ",".join(a.lstrip("+") for a in sweep_args) or "run"
             job = Job(n, label, [*s.args, *p.args, *sweep_args], p.trials, root / profile / n / label, src)
             if src is not None:
-                job.deps = [single[src]]
+                job.deps = [single[src] if src in single else by_label[src, label]]
             if not keys:
                 single[n] = job
+            by_label[n, label] = job
             jobs.append(job)
     return jobs
 

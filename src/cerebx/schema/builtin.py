@@ -5,6 +5,7 @@ from cerebx import registry
 from cerebx.schema import controller as c
 from cerebx.schema import delay as d
 from cerebx.schema import events as e
+from cerebx.schema import muscles as m
 from cerebx.schema import plant as p
 from cerebx.schema import stages as s
 from cerebx.schema import task as t
@@ -25,12 +26,14 @@ registry.controllers.register(c.PositionController, "cerebx.controllers.position
 registry.controllers.register(c.SNNController, "cerebx.controllers.snn:SNNControllerImpl")
 registry.controllers.register(ANNController, "cerebx.controllers.ann:ANN")
 registry.controllers.register(c.CompositeController, "cerebx.build:build_composite")
+registry.controllers.register(m.MuscleRestController, "cerebx.stages.muscles:build_muscle_rest")
 
 # receivers take (cfg, ctx, signals the link delivers); other stages (cfg, ctx)
 registry.stages.register(s.HoldConfig, "cerebx.stages.receivers:build_hold")
 registry.stages.register(s.MeanFilterConfig, "cerebx.stages.receivers:build_mean")
 registry.stages.register(s.FuturePastFilterConfig, "cerebx.stages.receivers:build_future_past")
 registry.stages.register(s.SupervisorConfig, "cerebx.stages.supervisor:build_supervisor")
+registry.stages.register(m.EkebergConfig, "cerebx.stages.muscles:build_ekeberg")
 
 registry.delays.register(d.NoDelay, "cerebx.loop.delays:no_delay")
 registry.delays.register(d.ConstantDelay, "cerebx.loop.delays:constant_delay")
