@@ -81,19 +81,26 @@ def test_arm_stays_at_rest_with_zero_commands_and_no_gravity(load, tmp_path):
     assert len(q) == 1000 and np.abs(q - Q_REST).max() < 1e-6
 
 
-def _sag_cm(run_dir) -> float:
-    t, z = zip(*[(m["t"], m["ee"][2]) for topic, _, m in read_messages(run_dir) if topic == "/control"])
-    t, z = np.array(t), np.array(z)
-    return 100 * (z[t < 1.0][-1] - z[t >= t[-1] - 1.0].mean())
+def test_payload_sags_less_with_more_cocontraction_and_fig4_6_shows_it(load, tmp_path):
+    from cerebx.report.ch4_muscles import fig4_6, payload_sag_cm
+    from cerebx.report.runs import Run, RunSet
 
-
-def test_payload_sags_less_with_more_cocontraction(load, tmp_path):
-    sag = []
+    runs = RunSet()
     for k in (0, 12):
         cfg = load(["+experiment=fig4_6b", f"muscle.cocontraction={k}"])
         assert run_experiment(cfg, tmp_path / str(k))["status"] == "completed"
-        sag.append(_sag_cm(tmp_path / str(k)))
+        runs.append(Run.load(tmp_path / str(k)))
+    sag = [payload_sag_cm(r) for r in runs]
     assert sag[0] > 2 * sag[1] > 0
+    # by hand from the log: z before the payload (attached at 1 s) minus the mean z of the last second
+    t, z = zip(*[(m["t"], m["ee"][2]) for topic, _, m in read_messages(tmp_path / "0") if topic == "/control"])
+    t, z = np.array(t), np.array(z)
+    assert sag[0] == pytest.approx(100 * (z[t < 1.0][-1] - z[t >= t[-1] - 1.0].mean()))
+    fig = fig4_6(runs, tmp_path / "fig4_6")
+    rows = {row[0]: row[1:] for row in fig.table}
+    assert rows["B: sag Δz with 2 kg at c = x0 (cm)"] == ["9.9", f"{sag[0]:.1f}"]
+    assert rows["B: sag falls monotonically with c"] == ["yes", "yes"]
+    assert fig.notes == ["panel A: no SNN runs of the eight from a learned state with the muscles (study fig4_6a)"]
 
 
 def test_snn_drives_the_muscles_through_two_signals(load, tmp_path):
