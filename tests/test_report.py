@@ -151,3 +151,18 @@ def test_ctrl_c_stops_the_study_runner_and_says_how_to_resume(tmp_path):
     finally:
         signal.signal(signal.SIGINT, previous)
     assert any("interrupted" in line and "run again to resume" in line for line in lines)
+
+
+def test_init_from_a_study_with_the_same_sweep_pairs_jobs_by_sweep_value(tmp_path):
+    jobs = {j.name: j for j in plan("quick", tmp_path, ["fig4_6a"])}
+    for k in (0, 1, 5, 9, 10, 12):
+        job = jobs[f"fig4_6a/muscle.cocontraction={k}"]
+        assert [d.name for d in job.deps] == [f"fig4_6a_learn/muscle.cocontraction={k}"]
+        assert f"init_from='{tmp_path}/quick/fig4_6a_learn/muscle.cocontraction={k}'" in job.overrides()
+    bad = tmp_path / "studies.yaml"
+    bad.write_text("studies:\n  a:\n    args: [+experiment=demo]\n    sweep: {seed: [0, 1]}\n"
+                   "    quick: {trials: 1}\n    full: {trials: 2}\n"
+                   "  b:\n    args: [+experiment=demo]\n    sweep: {seed: [0, 2]}\n    init_from: a\n"
+                   "    quick: {trials: 1}\n    full: {trials: 2}\n")
+    with pytest.raises(ConfigError, match="init_from: 'a' is not a single-run study or one with the same sweep"):
+        load_studies(bad)
