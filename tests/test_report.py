@@ -189,3 +189,29 @@ def test_studies_are_multiruns_of_their_presets(tmp_path):
     excluded = next(o for o in ov if o.startswith("hydra.job.config.override_dirname.exclude_keys="))
     assert "delay.total_ms" not in excluded and "init_from" in excluded and "trials" in excluded
     assert "hydra.sweep.subdir=run" in studies[0].overrides()
+
+
+def test_init_from_a_study_with_the_same_sweep_pairs_jobs_by_sweep_value(tmp_path):
+    from cerebx.report.studies import group
+
+    jobs = plan("quick", tmp_path, ["fig4_6a"])
+    by_name = {j.name: j for j in jobs}
+    for k in (0, 1, 5, 9, 10, 12):
+        job = by_name[f"fig4_6a/muscle.cocontraction={k}"]
+        assert [d.name for d in job.deps] == [f"fig4_6a_learn/muscle.cocontraction={k}"]
+        assert f"init_from='{tmp_path}/quick/fig4_6a_learn/muscle.cocontraction={k}'" in job.overrides()
+    studies = group(jobs)
+    assert [s.name for s in studies][0] == "fig4_6a_learn" and len(studies) == 7  # one multirun per paired job
+    one = studies[3]
+    assert one.name == "fig4_6a/muscle.cocontraction=5" and one.deps == [studies[0]]
+    ov = one.overrides()
+    assert "muscle.cocontraction=5" in ov and "hydra.sweep.subdir='muscle.cocontraction=5'" in ov
+    assert f"init_from='{tmp_path}/quick/fig4_6a_learn/muscle.cocontraction=5'" in ov
+    assert f"hydra.sweep.dir='{tmp_path}/quick/fig4_6a'" in ov
+    bad = tmp_path / "studies.yaml"
+    bad.write_text("studies:\n  a:\n    args: [+experiment=fig3_4_pd]\n"
+                   "    quick: {trials: 1}\n    full: {trials: 2}\n"
+                   "  b:\n    args: [+experiment=fig3_4_pd, 'delay.total_ms=0,40']\n    init_from: a\n"
+                   "    quick: {trials: 1}\n    full: {trials: 2}\n")
+    with pytest.raises(ConfigError, match="init_from: 'a' is not a single-run study or one with the same sweep"):
+        load_studies(bad)

@@ -42,6 +42,7 @@ KINDS = {
         "pid_velocity": ["+experiment=capolei2020_arch1", "trials=1"],
         "capolei_forward": ["+experiment=capolei2020_arch3", "trials=1"],
         "capolei_inverse": ["+experiment=capolei2020_arch2", "trials=1"],
+        "muscle_rest": ["+experiment=fig4_6b", "trials=1"],
     },
     "stage": {
         "hold": [*DEMO, "robot=[{kind: hold}]"],
@@ -49,6 +50,8 @@ KINDS = {
         "future_past": [*DEMO, "robot=[{kind: future_past}]"],
         "supervisor": [*DEMO, "robot=[{kind: hold}, {kind: supervisor, kp: [20.0, 20.0], kd: [5.0, 5.0], "
                        "bounds: plant}]"],
+        "ekeberg": ["+task=eight", "+experiment=small_snn", "plant=baxter_muscles", "muscle=ekeberg",
+                    "controller.output=agonist_antagonist", "controller.decoder.spikes_full_scale=10"],
     },
 }
 

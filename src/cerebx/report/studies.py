@@ -48,7 +48,9 @@ class StudySpec(Strict):
     args: list[str] = Field(min_length=1, description="overrides of every job, the experiment preset first (its "
                             "hydra.sweeper.params make the study a sweep; an arg setting a swept key fixes it, "
                             "or with a sweep value (seed=0,1,2) sweeps those values instead)")
-    init_from: str | None = Field(None, description="single-run study whose learned state starts each job")
+    init_from: str | None = Field(
+        None, description="study whose learned state starts each job: a single-run study, or one with the same "
+        "sweep (each job then starts from the job of the same sweep values)")
     quick: ProfileSpec = Field(description="the quick profile (< 30 min on 2 cores in all)")
     full: ProfileSpec = Field(description="the full profile (the thesis's trial counts)")
 
@@ -70,8 +72,10 @@ def load_studies(path: Path = STUDIES_FILE) -> dict[str, StudySpec]:
     for name, s in studies.items():
         for prof in PROFILES:
             src = _init_from(s, prof)
-            if src is not None and (src not in studies or preset_sweep(studies[src].args) != [[]]):
-                raise ConfigError(f"{path}: studies.{name}.init_from: {src!r} is not a single-run study")
+            if src is not None and (src not in studies or _sweep_of(studies[src], prof) not in (
+                    [[]], _sweep_of(s, prof))):
+                raise ConfigError(f"{path}: studies.{name}.init_from: {src!r} is not a single-run study "
+                                  "or one with the same sweep")
     return studies
 
 
@@ -119,6 +123,10 @@ def _preset_sweep(args: tuple[str, ...]) -> tuple[tuple[str, ...], ...]:
     fixed = {_key(a) for a in [*args, *given]}
     sweep = [f"{k}={v}" for k, v in params.items() if _key(k) not in fixed] + given
     return tuple(tuple(sorted(c)) for c in expand_sweep(sweep)) if sweep else ((),)
+
+
+def _sweep_of(s: StudySpec, profile: str) -> list[list[str]]:
+    return preset_sweep([*s.args, *getattr(s, profile).args])
 
 
 def _init_from(s: StudySpec, profile: str) -> str | None:
@@ -195,6 +203,7 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
         want(n)
     jobs: list[Job] = []
     single: dict[str, Job] = {}
+    by_label: dict[tuple[str, str], Job] = {}
     for n in wanted:
         s = studies[n]
         p: ProfileSpec = getattr(s, profile)
@@ -204,9 +213,10 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
             label = ",".join(sweep_args) or "run"  # as Hydra's override_dirname names the job's folder
             job = Job(n, label, args, p.trials, root / profile / n / label, src, sweep_args=sweep_args)
             if src is not None:
-                job.deps = [single[src]]
+                job.deps = [single[src] if src in single else by_label[src, label]]
             if not sweep_args:
                 single[n] = job
+            by_label[n, label] = job
             jobs.append(job)
     return jobs
 
@@ -250,7 +260,9 @@ class Study:
         swept = bool(self.jobs[0].sweep_args)
         out = ["-m", *self.jobs[0].common(sweeps=True), "resume=auto", "recording.progress=off",
                f"hydra.sweep.dir='{self.sweep_dir}'"]
-        if swept:
+        if swept and self.name == self.jobs[0].name:  # one job of a paired study: its sweep point fixed
+            out += [*self.jobs[0].sweep_args, f"hydra.sweep.subdir='{self.jobs[0].label}'"]
+        elif swept:
             keys = sorted({_key(a) for a in [*common, "resume=", "recording.progress="]})
             out += ["hydra.sweep.subdir=${hydra.job.override_dirname}",
                     f"hydra.job.config.override_dirname.exclude_keys=[{','.join(keys)}]"]
@@ -260,12 +272,19 @@ class Study:
 
 
 def group(jobs: list[Job]) -> list[Study]:
-    """The jobs as studies (in plan order), each depending on the studies its jobs start from."""
+    """The jobs as studies (in plan order), each depending on the studies its jobs start from. A study whose
+    jobs start from the jobs of the same sweep values of another (paired) runs each job as its own multirun
+    of one job, as each has its own ``init_from``."""
     studies: dict[str, Study] = {}
+    of_job: dict[str, Study] = {}
     for j in jobs:
-        studies.setdefault(j.study, Study(j.study, [])).jobs.append(j)
+        paired = bool(j.sweep_args) and any(d.sweep_args for d in j.deps)
+        st = studies.setdefault(j.name if paired else j.study, Study(j.name if paired else j.study, []))
+        st.jobs.append(j)
+        of_job[j.name] = st
     for st in studies.values():
-        st.deps = [studies[d.study] for d in st.jobs[0].deps if d.study in studies]
+        st.deps = list({id(of_job[d.name]): of_job[d.name] for j in st.jobs for d in j.deps
+                        if d.name in of_job}.values())
     return list(studies.values())
 
 

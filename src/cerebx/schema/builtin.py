@@ -6,6 +6,7 @@ from cerebx.schema import capolei as cap
 from cerebx.schema import controller as c
 from cerebx.schema import delay as d
 from cerebx.schema import events as e
+from cerebx.schema import muscles as m
 from cerebx.schema import plant as p
 from cerebx.schema import stages as s
 from cerebx.schema import task as t
@@ -33,12 +34,14 @@ registry.controllers.register(c.CompositeController, "cerebx.build:build_composi
 registry.controllers.register(cap.PIDVelocity, "cerebx.capolei.stages:build_pid")
 registry.controllers.register(cap.CapoleiForward, "cerebx.capolei.stages:build_forward")
 registry.controllers.register(cap.CapoleiInverse, "cerebx.capolei.stages:build_inverse")
+registry.controllers.register(m.MuscleRestController, "cerebx.stages.muscles:build_muscle_rest")
 
 # receivers take (cfg, ctx, signals the link delivers); other stages (cfg, ctx)
 registry.stages.register(s.HoldConfig, "cerebx.stages.receivers:build_hold")
 registry.stages.register(s.MeanFilterConfig, "cerebx.stages.receivers:build_mean")
 registry.stages.register(s.FuturePastFilterConfig, "cerebx.stages.receivers:build_future_past")
 registry.stages.register(s.SupervisorConfig, "cerebx.stages.supervisor:build_supervisor")
+registry.stages.register(m.EkebergConfig, "cerebx.stages.muscles:build_ekeberg")
 
 registry.delays.register(d.NoDelay, "cerebx.loop.delays:no_delay")
 registry.delays.register(d.ConstantDelay, "cerebx.loop.delays:constant_delay")
