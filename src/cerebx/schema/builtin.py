@@ -19,6 +19,7 @@ registry.tasks.register(t.ReachingTask, "cerebx.tasks.cartesian:build_reaching")
 
 registry.plants.register(p.Planar2Config, "cerebx.plants.planar2:Planar2Arm")
 registry.plants.register(p.BaxterConfig, "cerebx.plants.baxter:BaxterArm")
+registry.plants.register(p.UpperLimbConfig, "cerebx.plants.upper_limb:UpperLimb")
 
 registry.controllers.register(c.PDController, "cerebx.controllers.pd:PD")
 registry.controllers.register(c.PositionController, "cerebx.controllers.position:PositionServo")
