@@ -49,3 +49,14 @@ registry.events.register(e.ForcePulse, "cerebx.plants.events:force_pulse")
 # mossy encoders take (cfg, lo, hi); climbing encoders (cfg, n_joints, fibres_per_joint, kpos, kvel, rng)
 registry.encoders.register(c.BoxEncoder, "cerebx.snn.encoders:MossyEncoder")
 registry.encoders.register(c.CFEncoder, "cerebx.snn.encoders:ClimbingEncoder")
+
+# the upper limb's stages (thesis ch. 4): spinal cord or direct muscle commands; torque split for PD baselines
+from cerebx.schema import spinal as sp  # noqa: E402
+
+registry.stages.register(sp.SpinalCordConfig, "cerebx.stages.spinal:SpinalCord")
+registry.stages.register(sp.DirectMusclesConfig, "cerebx.stages.spinal:DirectMuscles")
+registry.stages.register(sp.SplitPairsConfig, "cerebx.stages.spinal:SplitPairs")
+from cerebx.schema import arm_tasks as at  # noqa: E402
+
+registry.tasks.register(at.FlexionExtensionTask, "cerebx.tasks.upper_limb:FlexionExtension")
+registry.tasks.register(at.VerticalCircleTask, "cerebx.tasks.upper_limb:VerticalCircle")
