@@ -23,6 +23,7 @@ from cerebx.stages.base import Stage
 from cerebx.stages.check import check_experiment
 
 DEMO = ["+experiment=demo", "trials=1"]
+UPPER_LIMB = ["+experiment=upper_limb_pd", "+task=vertical_circle_fast", "trials=1"]
 
 # every controller and stage kind, each in an experiment where it belongs (planar arm unless it needs Baxter)
 KINDS = {
@@ -42,6 +43,9 @@ KINDS = {
         "future_past": [*DEMO, "robot=[{kind: future_past}]"],
         "supervisor": [*DEMO, "robot=[{kind: hold}, {kind: supervisor, kp: [20.0, 20.0], kd: [5.0, 5.0], "
                        "bounds: plant}]"],
+        "spinal_cord": [*UPPER_LIMB, "spinal=cord"],
+        "direct_muscles": [*UPPER_LIMB, "spinal=direct"],
+        "split_pairs": [*UPPER_LIMB, "spinal=cord"],
     },
 }
 

@@ -87,7 +87,7 @@ class SpinalCordConfig(_MuscleMap):
 
     @model_validator(mode="after")
     def _antagonists_known(self):
-        bad = [m for m, ants in self.antagonists.items() for a in (m, *ants) if a not in self.muscles]
+        bad = [a for m, ants in self.antagonists.items() for a in (m, *ants) if a not in self.muscles]
         if bad:
             raise ValueError(f"antagonists: unknown muscles {', '.join(sorted(set(bad)))}")
         missing = [m for m in self.muscles if not self.antagonists.get(m)]
@@ -109,7 +109,8 @@ class SplitPairsConfig(StageConfig):
 
     sides: ClassVar[tuple[str, ...]] = ("brain",)
     kind: Literal["split_pairs"] = "split_pairs"
-    full_command_Nm: tuple[PositiveFloat, ...] = Field((10.0, 10.0), description="torque giving a command of 1, per joint")
+    full_command_Nm: tuple[PositiveFloat, ...] = Field(
+        (10.0, 10.0), description="torque giving a command of 1, per joint")
 
     def io(self, n_joints: int) -> StageIO:
         return StageIO(("joint.torque",), (Signal("muscle.ag", n_joints, "", 0.0, 1.0),

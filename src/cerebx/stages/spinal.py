@@ -28,7 +28,7 @@ import numba
 import numpy as np
 
 from cerebx.errors import ConfigError
-from cerebx.schema.spinal import DirectMusclesConfig, SplitPairsConfig, SpinalCordConfig, _MuscleMap
+from cerebx.schema.spinal import DirectMusclesConfig, SpinalCordConfig, SplitPairsConfig, _MuscleMap
 from cerebx.signals import Frame
 from cerebx.stages.base import Stage
 
@@ -78,19 +78,50 @@ def _sigmoid(x: float, k: float, x0: float) -> float:
 
 
 @numba.njit(cache=True)
-def spinal_tick(cmd, ia, ant, mn, ia_in, decay, w_exc, w_inh, k, x0):  # pragma: no cover - numba
-    """One 2 ms step of the Ia INs then the MNs (in place). ``ant`` (n, n): row i averages the Ia INs
-    inhibiting MN i."""
+def ia_rate(length, velocity, prm):  # pragma: no cover - numba
+    """Eq. 4.3 before normalisation; prm = (a, p, b, c, V): velocity clipped to +-V, odd power for shortening."""
+    v = min(max(velocity, -prm[4]), prm[4])
+    sv = prm[0] * abs(v) ** prm[1]
+    return (sv if v >= 0 else -sv) + prm[2] * length + prm[3]
+
+
+@numba.njit(cache=True)
+def cord_tick(ag, at, length, velocity, cmd_map, ant, fifo, head, delay, r_lo, r_hi, ia_prm, neuron_prm,
+              ia, ia_in, mn):  # pragma: no cover - numba
+    """One 2 ms step in place: the Ia afferents of the sample pushed ``delay`` ticks ago (this one stored),
+    then the Ia INs, then the MNs. neuron_prm = (decay, w_exc, w_inh, k, x0). Returns the FIFO's new head."""
     n = mn.shape[0]
+    nj = ag.shape[0]
+    if head < 0:  # first sample: the history before t = 0 is the arm at rest as it is now
+        for s in range(fifo.shape[0]):
+            for i in range(n):
+                fifo[s, 0, i] = length[i]
+                fifo[s, 1, i] = velocity[i]
+        head = 0
+    for i in range(n):
+        if delay > 0:
+            l_del, v_del = fifo[head, 0, i], fifo[head, 1, i]
+            fifo[head, 0, i], fifo[head, 1, i] = length[i], velocity[i]
+        else:
+            l_del, v_del = length[i], velocity[i]
+        r = (ia_rate(l_del, v_del, ia_prm) - r_lo[i]) / (r_hi[i] - r_lo[i])
+        ia[i] = min(max(r, 0.0), 1.0)
+    if delay > 0:
+        head = (head + 1) % delay
+    decay, w_exc, w_inh, k, x0 = neuron_prm[0], neuron_prm[1], neuron_prm[2], neuron_prm[3], neuron_prm[4]
     for i in range(n):
         s = _sigmoid(w_exc * ia[i], k, x0)
         ia_in[i] = s + (ia_in[i] - s) * decay
     for i in range(n):
+        cmd = 0.0
+        for j in range(nj):
+            cmd += cmd_map[i, j] * ag[j] + cmd_map[i, nj + j] * at[j]
         inh = 0.0
         for j in range(n):
             inh += ant[i, j] * ia_in[j]
-        s = _sigmoid(w_exc * (cmd[i] + ia[i]) - w_inh * inh, k, x0)
+        s = _sigmoid(w_exc * (cmd + ia[i]) - w_inh * inh, k, x0)
         mn[i] = s + (mn[i] - s) * decay
+    return head
 
 
 class SpinalCord(Stage):
@@ -108,50 +139,32 @@ class SpinalCord(Stage):
         if not (np.all(np.isfinite(l_lo)) and np.all(np.isfinite(l_hi)) and np.all(l_hi > l_lo)):
             raise ConfigError("spinal_cord: the plant's muscle.length signal must declare each muscle's length range")
         v = cfg.velocity_range_mm_per_s
-        self.r_lo, self.r_hi = self.ia_rate(l_lo, np.full(n, -v)), self.ia_rate(l_hi, np.full(n, v))
+        self.ia_prm = np.array([cfg.ia_velocity_gain, cfg.ia_velocity_exponent, cfg.ia_length_gain, cfg.ia_offset, v])
+        self.r_lo = np.array([ia_rate(x, -v, self.ia_prm) for x in l_lo])
+        self.r_hi = np.array([ia_rate(x, v, self.ia_prm) for x in l_hi])
         self.delay_steps = int(round(cfg.afferent_delay_ms / 1000.0 / CONTROL_DT_S))
-        self.decay = math.exp(-CONTROL_DT_S / (cfg.tau_m_ms / 1000.0))
+        decay = math.exp(-CONTROL_DT_S / (cfg.tau_m_ms / 1000.0))
+        self.neuron_prm = np.array([decay, cfg.w_exc, cfg.w_inh, cfg.sigmoid_slope, cfg.sigmoid_centre])
         self.mn, self.ia_in, self.ia = np.zeros(n), np.zeros(n), np.zeros(n)
         self._fifo = np.zeros((max(self.delay_steps, 1), 2, n))
         self._head = -1  # -1: empty (the first sample fills it)
 
-    def ia_rate(self, length_mm: np.ndarray, velocity_mm_per_s: np.ndarray) -> np.ndarray:
-        """Eq. 4.3 before normalisation (velocity clipped to the range, odd power for shortening)."""
-        c = self.cfg
-        v = np.clip(velocity_mm_per_s, -c.velocity_range_mm_per_s, c.velocity_range_mm_per_s)
-        return (c.ia_velocity_gain * np.sign(v) * np.abs(v) ** c.ia_velocity_exponent
-                + c.ia_length_gain * length_mm + c.ia_offset)
-
     def afferent(self, length_mm: np.ndarray, velocity_mm_per_s: np.ndarray) -> np.ndarray:
-        """Normalised Ia rate in [0, 1] for a (delayed) length and velocity."""
-        r = self.ia_rate(length_mm, velocity_mm_per_s)
+        """Normalised Ia rate in [0, 1] for a length and velocity (no delay)."""
+        r = np.array([ia_rate(x, v, self.ia_prm) for x, v in zip(length_mm, velocity_mm_per_s)])
         return np.clip((r - self.r_lo) / (self.r_hi - self.r_lo), 0.0, 1.0)
 
     def reset(self, rng: np.random.Generator) -> None:
         self.mn[:] = 0.0
         self.ia_in[:] = 0.0
+        self.ia[:] = 0.0
         self._head = -1
 
-    def _delayed(self, length: np.ndarray, velocity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The sample pushed ``delay_steps`` ticks ago; stores this one."""
-        if self.delay_steps == 0:
-            return length, velocity
-        fifo = self._fifo
-        if self._head < 0:
-            fifo[:, 0], fifo[:, 1] = length, velocity
-            self._head = 0
-        out = fifo[self._head].copy()
-        fifo[self._head, 0], fifo[self._head, 1] = length, velocity
-        self._head = (self._head + 1) % self.delay_steps
-        return out[0], out[1]
-
     def step(self, frame: Frame) -> None:
-        s, c = frame.signals, self.cfg
-        cmd = self.cmd @ np.concatenate([s["muscle.ag"], s["muscle.at"]])
-        length, velocity = self._delayed(s["muscle.length"], s["muscle.velocity"])
-        self.ia = self.afferent(length, velocity)
-        spinal_tick(cmd, self.ia, self.ant, self.mn, self.ia_in, self.decay, c.w_exc, c.w_inh, c.sigmoid_slope,
-                    c.sigmoid_centre)
+        s = frame.signals
+        self._head = cord_tick(s["muscle.ag"], s["muscle.at"], s["muscle.length"], s["muscle.velocity"], self.cmd,
+                               self.ant, self._fifo, self._head, self.delay_steps, self.r_lo, self.r_hi, self.ia_prm,
+                               self.neuron_prm, self.ia, self.ia_in, self.mn)
         self.emit(frame, "muscle.activation", self.mn.copy())
 
     def record(self) -> dict[str, Any]:
