@@ -185,3 +185,57 @@ def test_stamped_efferent_sends_what_hold_applies_later(pipeline):
         held, sent = out["hold"][k + D], out["stamp"][k]
         assert sent.stamp_s == pytest.approx(held.stamp_s)
         np.testing.assert_array_equal(sent.tau, held.tau)
+
+
+# ---- agonist/antagonist output for a muscle stage (thesis §4.6.2) ----
+
+def test_dcn_decoder_sides_count_each_side_over_full_scale():
+    dec = DCNDecoder((0.75, 1.1), 2, 100)
+    # step 0: joint 0 4 ag + 2 at, joint 1 3 at; step 1: joint 1 one ag (index 100), joint 0 nothing
+    idx = np.array([0, 1, 2, 49, 50, 99, 150, 151, 160, 100])
+    step = np.array([0, 0, 0, 0, 0, 0, 0, 0, 0, 1])
+    m = dec.sides(idx, step, 3, 100.0)
+    np.testing.assert_allclose(m, [[0.04, 0.0, 0.02, 0.03], [0.0, 0.01, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0]])
+
+
+def test_agonist_antagonist_output_is_the_torque_split_by_side():
+    """Same network, same inputs: alpha x full scale x (M_ag - M_at) is the torque of Eq. 3.5, and each M
+    stays in [0, 1]."""
+    full = 20.0  # 5 DCN per side in the test network x at most 2 spikes per 2 ms step x 2 (headroom)
+    torque = make_ctrl(pathway_delay_ms=10.0)
+    muscles = make_ctrl(pathway_delay_ms=10.0, output="agonist_antagonist",
+                        decoder={"alpha_Nm_per_spike": (0.75, 1.1, 0.375, 0.63, 0.078, 0.078),
+                                 "spikes_full_scale": full})
+    torque.reset(np.random.default_rng(0))
+    muscles.reset(np.random.default_rng(0))
+    tau = drive(torque, 150)
+    ag, at = [], []
+    for k in range(150):
+        t = k * 0.002
+        q = np.sin(np.pi * t) * 0.3 * np.ones(6)
+        qd = np.cos(np.pi * t) * 0.3 * np.ones(6)
+        msg = muscles.step(ControlInput(k, t, q, qd, SensorMsg(t, q - 0.02, qd)))
+        ag.append(msg.values["muscle.ag"])
+        at.append(msg.values["muscle.at"])
+    ag, at = np.array(ag), np.array(at)
+    assert ((ag >= 0) & (ag <= 1) & (at >= 0) & (at <= 1)).all()
+    assert ag.max() > 0 and at.max() > 0
+    alpha = np.array(muscles.cfg.decoder.alpha_Nm_per_spike)
+    np.testing.assert_allclose(alpha * full * (ag - at), tau, atol=1e-9)
+
+
+def test_max_spikes_per_step_follows_the_refractory_period():
+    from cerebx.schema.controller import max_spikes_per_step
+
+    dcn = thesis_network().populations["dcn"].neuron  # t_ref 1 ms at 0.5 ms steps: fires at most every 1.5 ms
+    assert max_spikes_per_step(dcn, 0.5) == 2
+    assert max_spikes_per_step(dcn.model_copy(update={"t_ref_ms": 0.0}), 0.5) == 4
+    assert max_spikes_per_step(dcn.model_copy(update={"t_ref_ms": 2.0}), 0.5) == 1
+    assert max_spikes_per_step(thesis_network().populations["mf"].neuron, 0.5) == 1
+
+
+def test_agonist_antagonist_io_declares_the_two_muscle_signals():
+    io = SNNController(output="agonist_antagonist").io(6)
+    assert [(s.name, s.size, s.low, s.high) for s in io.writes] == [("muscle.ag", 6, 0.0, 1.0),
+                                                                    ("muscle.at", 6, 0.0, 1.0)]
+    assert [s.name for s in SNNController().io(6).writes] == ["joint.torque"]

@@ -36,6 +36,15 @@ class TorqueMsg:
 
 
 @dataclass(frozen=True)
+class CommandMsg:
+    """Controller-to-robot message of named signals other than the joint torque (e.g. the muscle
+    commands ``muscle.ag``/``muscle.at``), meant to be applied at ``stamp_s``."""
+
+    stamp_s: float
+    values: dict[str, np.ndarray]
+
+
+@dataclass(frozen=True)
 class ControlInput:
     """What a controller sees at one control step.
 
@@ -62,8 +71,8 @@ class Controller(ABC):
         """Prepare for a run (called once, before the first step)."""
 
     @abstractmethod
-    def step(self, inp: ControlInput) -> TorqueMsg:
-        """One 2 ms control step."""
+    def step(self, inp: ControlInput) -> TorqueMsg | CommandMsg:
+        """One 2 ms control step: a joint torque, or the named signals the controller's schema declares."""
 
     def end_trial(self, trial: int) -> dict[str, float]:
         """Called after each trial; may return scalars to record (e.g. weight summaries)."""

@@ -11,6 +11,10 @@ Pipelining: because the network's output is not needed until k steps after its i
 the network can run ahead on a second thread, one chunk of k steps at a time, while the loop
 steps the plant and records (``pipeline: true``). The network sees the same inputs in the same
 order, so the results are identical to the synchronous order; only the wall time changes.
+
+Output (``output``): a joint torque (Eq. 3.5), or for a muscle stage the agonist and antagonist
+sides apart as ``muscle.ag``/``muscle.at`` = spikes of the side in the step / ``spikes_full_scale``
+(thesis §4.6.2). The teaching signal is the joint error either way.
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from cerebx import registry
-from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
+from cerebx.controllers.base import CommandMsg, ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
 from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
@@ -79,6 +83,8 @@ class SNNControllerImpl(Controller):
         self._rng_seed = ctx.rng("controller.snn.cf")
         self.cf = registry.encoders.build(cfg.cf, nj, n_cf // nj, cfg.error.kpos, cfg.error.kvel, self._rng_seed)
         self.decoder = DCNDecoder(cfg.decoder.alpha_Nm_per_spike, nj, n_dcn // nj)
+        self.muscles = cfg.output == "agonist_antagonist"
+        self.width = 2 * nj if self.muscles else nj  # values per step in the output FIFO ([ag, at] or tau)
         self.recorder = None
         self.record = {name: self.net.index(name) for name in cfg.record_spikes}
         self.fingerprint = self.net.fingerprint
@@ -93,8 +99,8 @@ class SNNControllerImpl(Controller):
         self._join()
         k = self.k_delay
         self._pending: deque[np.ndarray] = deque([np.zeros(0, np.int32)] * k)  # inputs not yet simulated
-        # torques not yet emitted (held back by the efferent delay unless they are stamped instead)
-        self._ready: deque[np.ndarray] = deque([np.zeros(self.n_ctrl)] * (k if self.hold else 0))
+        # outputs not yet emitted (held back by the efferent delay unless they are stamped instead)
+        self._ready: deque[np.ndarray] = deque([np.zeros(self.width)] * (k if self.hold else 0))
         self._net_step = 0  # network steps simulated so far (step m is stamped m * 2 ms)
         self._des: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._dcn_spikes = 0
@@ -103,8 +109,9 @@ class SNNControllerImpl(Controller):
 
     # ------------------------------------------------------------------ network execution
     def _simulate(self, inputs: list[np.ndarray], first_step: int) -> list[tuple]:
-        """Run the network over ``inputs`` (one GIL-free call); per step: (time, torque, DCN spike
-        count, recorded spikes). Decoding is done for the whole chunk at once."""
+        """Run the network over ``inputs`` (one GIL-free call); per step: (time, output, DCN spike
+        count, recorded spikes), the output a torque or [M_ag, M_at]. Decoding is done for the whole
+        chunk at once."""
         idx, off = self.net.step_many(inputs)
         n, nj = len(inputs), self.n_ctrl
         step_of = np.repeat(np.arange(n), np.diff(off))
@@ -112,8 +119,11 @@ class SNNControllerImpl(Controller):
         sel = (idx >= lo) & (idx < hi)
         dcn, st = idx[sel] - lo, step_of[sel]
         dec = self.decoder
-        net = np.bincount(st * nj + dcn // dec.per_joint, weights=dec.sign[dcn], minlength=n * nj)
-        taus = dec.alpha * net.reshape(n, nj)
+        if self.muscles:
+            taus = dec.sides(dcn, st, n, self.cfg.decoder.spikes_full_scale)
+        else:
+            net = np.bincount(st * nj + dcn // dec.per_joint, weights=dec.sign[dcn], minlength=n * nj)
+            taus = dec.alpha * net.reshape(n, nj)
         counts = np.bincount(st, minlength=n)
         out = []
         for i in range(n):
@@ -206,9 +216,14 @@ class SNNControllerImpl(Controller):
         self._pending.append(spikes_in)
         self._advance()
         self._steps += 1
-        tau = np.zeros(self.n_joints)
-        tau[: self.n_ctrl] = self._ready.popleft()
         stamp = inp.t_s if self.hold else inp.t_s + self.k_delay * STEP_S
+        out = self._ready.popleft()
+        if self.muscles:
+            ag, at = np.zeros(self.n_joints), np.zeros(self.n_joints)
+            ag[: self.n_ctrl], at[: self.n_ctrl] = out[: self.n_ctrl], out[self.n_ctrl:]
+            return CommandMsg(stamp, {"muscle.ag": ag, "muscle.at": at})
+        tau = np.zeros(self.n_joints)
+        tau[: self.n_ctrl] = out
         return TorqueMsg(stamp, tau)
 
     # ------------------------------------------------------------------ reporting
@@ -252,7 +267,7 @@ class SNNControllerImpl(Controller):
         path = Path(path)
         arrays = {f"net_{k}": v for k, v in self.net.state_arrays().items()}
         arrays["cf_burst_left"] = self.cf.burst_left
-        arrays["out_fifo"] = np.array(list(self._ready)).reshape(len(self._ready), self.n_ctrl)
+        arrays["out_fifo"] = np.array(list(self._ready)).reshape(len(self._ready), self.width)
         meta = {"version": STATE_VERSION, "fingerprint": self.fingerprint, "config": self.config_hash,
                 "network": self.net_cfg.name, "rng": self.cf.rng.bit_generator.state}
         arrays["in_fifo"] = np.array(json.dumps([a.tolist() for a in self._pending]))
@@ -274,6 +289,8 @@ class SNNControllerImpl(Controller):
         self.cf.rng.bit_generator.state = meta["rng"]
         fifo = json.loads(str(data["in_fifo"]))
         self._join()
-        if len(fifo) + len(data["out_fifo"]) == self.k_delay * (2 if self.hold else 1):  # resume exactly
+        out_fifo = data["out_fifo"]
+        exact = len(fifo) + len(out_fifo) == self.k_delay * (2 if self.hold else 1)
+        if exact and out_fifo.shape[1:] == (self.width,):  # resume exactly (same delay and output kind)
             self._pending = deque(np.asarray(a, dtype=np.int32) for a in fifo)
-            self._ready = deque(np.asarray(r, dtype=float) for r in data["out_fifo"])
+            self._ready = deque(np.asarray(r, dtype=float) for r in out_fifo)

@@ -4,6 +4,7 @@ are stages (``schema/stages.py``)."""
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
@@ -11,7 +12,7 @@ from pydantic import Field, model_validator
 
 from cerebx.registry import Plugin
 from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
-from cerebx.signals import StageIO, torque_controller_io
+from cerebx.signals import Signal, StageIO, torque_controller_io
 
 
 class ControllerConfig(Strict):
@@ -161,9 +162,16 @@ class ErrorGains(Strict):
 
 
 class DCNDecoderConfig(Strict):
-    """Torque = alpha_j (agonist - antagonist DCN spikes per 2 ms) (Eq. 2.16-2.17, 3.5)."""
+    """Torque = alpha_j (agonist - antagonist DCN spikes per 2 ms) (Eq. 2.16-2.17, 3.5); with the
+    controller's ``output: agonist_antagonist`` the two sides are kept apart instead (thesis §4.6.2):
+    M = spikes of the side in the 2 ms step / ``spikes_full_scale``."""
 
     alpha_Nm_per_spike: tuple[PositiveFloat, ...] = (0.75, 1.1, 0.375, 0.63, 0.078, 0.078)
+    spikes_full_scale: PositiveFloat = Field(
+        100.0, description="agonist_antagonist output: DCN spikes of one side of one joint in one 2 ms step "
+        "that give M = 1; must be at least the most that side can fire (cells x spikes per cell per step "
+        "allowed by the refractory period: 50 x 2 in the thesis networks), so M stays in [0, 1]. "
+        "Unused for torque output")
 
 
 class SNNController(ControllerConfig):
@@ -171,6 +179,10 @@ class SNNController(ControllerConfig):
     from the top-level ``network`` group."""
 
     kind: Literal["snn"] = "snn"
+    output: Literal["torque", "agonist_antagonist"] = Field(
+        "torque", description="'torque': joint.torque = alpha (agonist - antagonist DCN spikes) (Eq. 3.5); "
+        "'agonist_antagonist': the two sides as muscle.ag and muscle.at, each spikes / "
+        "decoder.spikes_full_scale in [0, 1], no subtraction (thesis §4.6.2), for a muscle stage")
     mf: Plugin("encoder") = Field(BoxEncoder(), description="mossy-fibre encoder (registered kind, role mossy)")
     cf: Plugin("encoder") = Field(CFEncoder(), description="climbing-fibre encoder (registered kind, role climbing)")
     error: ErrorGains = ErrorGains()
@@ -206,6 +218,11 @@ class SNNController(ControllerConfig):
     def n_joints(self) -> int:
         return len(self.decoder.alpha_Nm_per_spike)
 
+    def io(self, n_joints: int) -> StageIO:
+        if self.output == "torque":
+            return torque_controller_io(n_joints)
+        return StageIO(("ref.q", "ref.qd"), muscle_command_signals(n_joints))
+
     def cross_check(self, exp: Any) -> list[str]:
         """The encoders and decoder must match the population sizes they drive and read."""
         out = []
@@ -222,7 +239,29 @@ class SNNController(ControllerConfig):
             if p is not None and p.size % (2 * n_joints):
                 out.append(f"network.populations.{name}.size: {p.size} is not an agonist/antagonist pair per joint "
                            f"({n_joints} joints)")
+        dcn = pops.get(io.output)
+        if self.output == "agonist_antagonist" and dcn is not None and not dcn.size % (2 * n_joints):
+            most = dcn.size // (2 * n_joints) * max_spikes_per_step(dcn.neuron, exp.network.dt_ms)
+            if self.decoder.spikes_full_scale < most:
+                out.append(f"controller.decoder.spikes_full_scale: {self.decoder.spikes_full_scale:g} spikes, but one "
+                           f"side of a joint of {io.output!r} can fire {most} in a 2 ms step (M would exceed 1)")
         return out
+
+
+def muscle_command_signals(n_joints: int) -> tuple[Signal, Signal]:
+    """The agonist and antagonist commands of an antagonist muscle pair per joint, each in [0, 1]."""
+    return (Signal("muscle.ag", n_joints, "1", 0.0, 1.0), Signal("muscle.at", n_joints, "1", 0.0, 1.0))
+
+
+def max_spikes_per_step(neuron: Any, network_dt_ms: float, step_ms: float = 2.0) -> int:
+    """The most spikes one neuron can fire in a control step: it may fire at the end of any integration
+    step h, then is held for round(t_ref / h) steps (as the kernels count it); an input fibre fires at
+    most once per step."""
+    if getattr(neuron, "kind", None) != "lif_cond":
+        return 1
+    h = neuron.integration.dt_ms or network_dt_ms
+    steps = int(round(step_ms / h))
+    return math.ceil(steps / (round(neuron.t_ref_ms / h) + 1))
 
 
 class CompositeController(ControllerConfig):

@@ -1,5 +1,7 @@
 """Spike-to-torque decoder (thesis Eq. 2.16-2.17 / 3.4-3.5, facts §4): per joint,
-tau_j = alpha_j (agonist - antagonist DCN spikes in the 2 ms bin), no offset, no memory."""
+tau_j = alpha_j (agonist - antagonist DCN spikes in the 2 ms bin), no offset, no memory.
+For a muscle stage the two sides are kept apart (thesis §4.6.2): M_ag,j and M_at,j = the side's
+spikes in the bin / full scale, each in [0, 1] when the full scale is the most the side can fire."""
 
 from __future__ import annotations
 
@@ -14,6 +16,14 @@ class DCNDecoder:
         self.n_joints, self.per_joint = n_joints, per_joint
         sign = np.concatenate([np.ones(per_joint // 2), -np.ones(per_joint // 2)])
         self.sign = np.tile(sign, n_joints)
+
+    def sides(self, local_idx: np.ndarray, step_of: np.ndarray, n_steps: int, full_scale: float) -> np.ndarray:
+        """(n_steps, 2 n_joints): per step [M_ag of each joint, M_at of each joint] from the local DCN
+        indices that spiked and the step each spike belongs to (repeats count)."""
+        nj, half = self.n_joints, self.per_joint // 2
+        counts = np.bincount(step_of * 2 * nj + local_idx // half, minlength=n_steps * 2 * nj)
+        m = counts[: n_steps * 2 * nj].reshape(n_steps, nj, 2) / full_scale
+        return m.transpose(0, 2, 1).reshape(n_steps, 2 * nj)
 
     def torque(self, local_idx: np.ndarray) -> np.ndarray:
         """Torque (N m) from the local DCN indices that spiked in this bin (repeats count)."""

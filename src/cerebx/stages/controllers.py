@@ -2,7 +2,9 @@
 
 A joint-torque :class:`~cerebx.controllers.base.Controller` (PD, position servo, SNN, ANN) runs
 behind :class:`TorqueControllerStage`: it reads the task's desired state and the newest sensor
-message that has arrived, and writes ``joint.torque`` stamped with its application time. A
+message that has arrived, and writes ``joint.torque`` stamped with its application time (or, when
+it returns a :class:`~cerebx.controllers.base.CommandMsg`, the signals named there: the SNN's
+``muscle.ag``/``muscle.at``). A
 :class:`Composite` runs several parts in order on the same tick; outputs with the same name add up
 (feedback + feed-forward corrective torque), and each part keeps its own learned state.
 """
@@ -14,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.controllers.base import ControlInput, Controller, SensorMsg
+from cerebx.controllers.base import CommandMsg, ControlInput, Controller, SensorMsg
 from cerebx.signals import Frame, Signal, torque_controller_io
 from cerebx.stages.base import Stage
 
@@ -41,7 +43,11 @@ class TorqueControllerStage(Stage):
         sig = frame.signals
         cmd = self.controller.step(ControlInput(frame.tick, frame.t_s, sig["ref.q"], sig["ref.qd"], self._sensor))
         frame.stamp_s = cmd.stamp_s
-        self.emit(frame, "joint.torque", cmd.tau)
+        if isinstance(cmd, CommandMsg):
+            for name, value in cmd.values.items():
+                self.emit(frame, name, value)
+        else:
+            self.emit(frame, "joint.torque", cmd.tau)
 
     def end_trial(self, trial: int) -> dict[str, float]:
         return self.controller.end_trial(trial)
