@@ -129,7 +129,8 @@ class UpperLimbConfig(PlantSchema):
     kind: Literal["upper_limb"] = "upper_limb"
     physics_dt_ms: PhysicsStepMs = 0.5
     joint_damping_Nms_per_rad: NonNegFloat = Field(
-        0.05, description="viscous joint damping (the MyoConverter Arm26 value; Arm26 itself has none)")
+        0.5, description="viscous joint damping (constructed: Arm26 has none, the MyoConverter conversion 0.05; "
+        "0.5 damps the 30 ms-delayed stretch-reflex loop)")
     activation_time_constants_s: tuple[PositiveFloat, PositiveFloat] = Field(
         (0.01, 0.04), description="t_act, t_deact of the activation dynamics (Eq. 4.5; Arm26's Thelen values)")
     gravity: bool = Field(True, description="gravity acts in the arm's plane")

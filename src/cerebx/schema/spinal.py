@@ -79,9 +79,11 @@ class SpinalCordConfig(_MuscleMap):
     ia_length_gain: NonNegFloat = Field(2.0, description="b in Eq. 4.3 (per mm)")
     ia_offset: float = Field(10.0, description="c in Eq. 4.3")
     velocity_range_mm_per_s: PositiveFloat = Field(
-        100.0, description="constructed: velocities are clipped to +-this; the rate is normalised between its "
-        "value at (shortest length, -range) and at (longest length, +range); lengths from the plant's muscle.length "
-        "bounds")
+        5000.0, description="constructed: velocities are clipped to +-this (mm/s) and the rate's peak is taken here")
+    normalise: Literal["peak", "range"] = Field(
+        "peak", description="constructed: 'peak' divides the rate by its peak (longest length, +velocity range); "
+        "'range' maps [rate at (shortest length, -range), rate at (longest length, +range)] onto [0, 1]; "
+        "lengths from the plant's muscle.length bounds")
     antagonists: dict[str, tuple[str, ...]] = Field(
         default_factory=lambda: dict(ANTAGONISTS), description="whose Ia INs inhibit each muscle's MN (mean)")
 

@@ -10,8 +10,11 @@ lasted that long, the first sample (the arm at rest before t = 0). Its rate is n
     r_norm = clip((r - r_lo) / (r_hi - r_lo), 0, 1),   r_lo = r(l_min, -V),  r_hi = r(l_max, +V),
 
 with [l_min, l_max] each muscle's length range over the joint range (the plant's ``muscle.length`` bounds)
-and V = ``velocity_range_mm_per_s`` (constructed). Shortening (v < 0) lowers the rate (odd extension of
-v^0.6; the thesis gives the law only for lengthening); a muscle at rest in mid-range fires at about 0.5.
+and V = ``velocity_range_mm_per_s``; by default (``normalise: peak``) r_lo = 0, i.e. the rate over its peak.
+Both are constructed (the thesis only says "normalised to [0, 1]"): the default keeps the 30 ms-delayed
+reflex loop of this strong arm from turning into clonus (with 'range' and V = 100 mm/s the resting arm
+oscillates at ~3 Hz; v^0.6 has an infinite slope at v = 0, so some small limit cycle always remains).
+Shortening (v < 0) lowers the rate (odd extension of v^0.6; the thesis gives the law only for lengthening).
 The MN rates are the muscle excitations: the plant's MuJoCo muscles integrate the activation dynamics
 (Eq. 4.4-4.5) once.
 
@@ -140,7 +143,7 @@ class SpinalCord(Stage):
             raise ConfigError("spinal_cord: the plant's muscle.length signal must declare each muscle's length range")
         v = cfg.velocity_range_mm_per_s
         self.ia_prm = np.array([cfg.ia_velocity_gain, cfg.ia_velocity_exponent, cfg.ia_length_gain, cfg.ia_offset, v])
-        self.r_lo = np.array([ia_rate(x, -v, self.ia_prm) for x in l_lo])
+        self.r_lo = np.array([ia_rate(x, -v, self.ia_prm) for x in l_lo]) if cfg.normalise == "range" else np.zeros(n)
         self.r_hi = np.array([ia_rate(x, v, self.ia_prm) for x in l_hi])
         self.delay_steps = int(round(cfg.afferent_delay_ms / 1000.0 / CONTROL_DT_S))
         decay = math.exp(-CONTROL_DT_S / (cfg.tau_m_ms / 1000.0))

@@ -15,6 +15,8 @@ from cerebx.tasks.base import Task, TrialReference
 ELBOW_M = np.array([0.0061, -0.2904])
 HAND_M = np.array([-0.0011, -0.23559])
 RANGE_RAD = (np.array([-0.8, 0.0]), np.array([1.3, 2.26892803]))
+# world position of the shoulder centre, moved into the plane the hand point moves in (world y = -0.252 m)
+SHOULDER_WORLD_M = np.array([-0.017545, -0.252, 0.793])
 
 
 def min_jerk(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -101,6 +103,6 @@ class VerticalCircle(_UpperLimbTask):
         xyd = r * phid[:, None] * np.stack([-np.sin(phi), np.cos(phi)], 1)
         q = inverse_kinematics(xy, np.array([0.4, 1.2]))
         qd = np.array([np.linalg.solve(jacobian(qi), v) for qi, v in zip(q, xyd)])
-        # the path in the arm's plane, as (forward, lateral 0, up) from the shoulder
-        xyz = np.stack([xy[:, 0], np.zeros(n), xy[:, 1]], 1)
+        # the hand's path in the world frame (x forward, z up; the arm's plane is y = const)
+        xyz = SHOULDER_WORLD_M + np.stack([xy[:, 0], np.zeros(n), xy[:, 1]], 1)
         self._finish(q, qd, "vertical_circle", xyz)
