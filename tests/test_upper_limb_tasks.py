@@ -14,7 +14,7 @@ from cerebx.tasks.upper_limb import SHOULDER_WORLD_M, FlexionExtension, Vertical
 def _bell(speed: np.ndarray) -> None:
     """One smooth peak: zero at both ends, rising to a single maximum in the middle, then falling."""
     k = int(np.argmax(speed))
-    assert speed[0] < 1e-9 and speed[-1] < 0.01 * speed[k]
+    assert speed[0] < 1e-4 * speed[k] and speed[-1] < 0.01 * speed[k]
     assert 0.4 < k / len(speed) < 0.6
     assert np.all(np.diff(speed[: k + 1]) >= -1e-12) and np.all(np.diff(speed[k:]) <= 1e-12)
 
