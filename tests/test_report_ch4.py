@@ -31,10 +31,14 @@ def test_fig4_5_selects_runs_and_measures(tmp_path):
             ev = [{"at_s": 5.25, "action": {"kind": "force_pulse", "force_N": [20 * np.cos(a), 0.0, 20 * np.sin(a)]}}]
             mae = [0, 0, 0.05, 0.05 + 0.01 * scale]  # 2 warm-up, nominal, perturbed
             runs.append(_run(tmp_path, f"p{spinal}{k}", "vertical_circle", 1.5, spinal, mae, [0.1] * 4, ev, warmup=2))
+        ev0 = [{"at_s": 5.25, "action": {"kind": "force_pulse", "force_N": [0.0, 0.0, 0.0]}}]
+        runs.append(_run(tmp_path, f"z{spinal}", "vertical_circle", 1.5, spinal, [0, 0, 0.05, 0.045], [0.1] * 4, ev0,
+                         warmup=2))
     learn, pert = learning_runs(RunSet(runs)), perturbation_runs(RunSet(runs))
     assert set(learn) == {(t, s) for t in ("flexion_extension", "circle_slow", "circle_fast")
                           for s in ("spinal_cord", "direct_muscles")}
-    assert sorted(a for s, a in pert if s == "spinal_cord") == [0, 45, 90, 135, 180, 225, 270, 315]
+    assert sorted(a for s, a in pert if s == "spinal_cord" and a is not None) == [0, 45, 90, 135, 180, 225, 270, 315]
+    assert ("spinal_cord", None) in pert  # the zero-force reference
     # first trial at or below 0.1 rad: 0.3 e^(-k/10) + 0.03 <= 0.1  ->  k = 15 (trial 16)
     assert trials_to(learn[("circle_fast", "spinal_cord")]) == 16
     out = fig4_5(RunSet(runs), tmp_path / "fig4_5")
@@ -42,5 +46,5 @@ def test_fig4_5_selects_runs_and_measures(tmp_path):
     rows = {r[0]: r for r in out.table}
     assert rows["position MAE (rad), fast circle, with SC"][1] == "0.020 ± 0.003"
     assert rows["trials to 0.1 rad, slow circle, with SC"][2] == "16"
-    assert rows["MAE deviation under 20 N pulses, with SC (rad; mean over directions)"][2] == "0.010"
-    assert rows["MAE deviation under 20 N pulses, without SC (rad; mean over directions)"][2] == "0.015"
+    assert rows["MAE deviation under 20 N pulses, with SC (rad; mean over directions)"][2] == "0.015"
+    assert rows["MAE deviation under 20 N pulses, without SC (rad; mean over directions)"][2] == "0.020"

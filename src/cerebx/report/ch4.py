@@ -48,15 +48,17 @@ def learning_runs(runs: RunSet) -> dict[tuple[str, str], Run]:
     return rs.by(lambda r: (task_key(r), r.get("spinal.kind")))
 
 
-def perturbation_runs(runs: RunSet) -> dict[tuple[str, float], Run]:
-    """Per (spinal kind, direction in deg): the run with one force pulse on the hand during the fast circle."""
+def perturbation_runs(runs: RunSet) -> dict[tuple[str, float | None], Run]:
+    """Per (spinal kind, direction in deg): the run with one force pulse on the hand during the fast circle;
+    direction None: the same run with a zero force (the unperturbed reference)."""
     def ok(r: Run) -> bool:
         return (_upper_limb(r) and task_key(r) == "circle_fast" and len(r.events) == 1
                 and r.events[0].get("action", {}).get("kind") == "force_pulse" and r.mae.size >= 2)
     out = {}
     for r in runs.where(ok):
-        fx, _, fz = r.events[0]["action"]["force_N"]
-        out[(r.get("spinal.kind"), round(math.degrees(math.atan2(fz, fx)) % 360.0, 1))] = r
+        fx, fy, fz = r.events[0]["action"]["force_N"]
+        zero = fx == fy == fz == 0.0
+        out[(r.get("spinal.kind"), None if zero else round(math.degrees(math.atan2(fz, fx)) % 360.0, 1))] = r
     return out
 
 
@@ -71,10 +73,12 @@ def trials_to(run: Run, threshold: float = CONVERGED_RAD) -> int | None:
     return int(hit[0]) + 1 if hit.size else None
 
 
-def deviation(run: Run) -> float:
-    """Position MAE of the perturbed trial minus that of the nominal trial before it (rad)."""
+def deviation(run: Run, reference: Run | None) -> float:
+    """Position MAE of the perturbed trial minus that of the same trial without the pulse (the zero-force run:
+    the simulation is deterministic, so the difference is the pulse's alone), or without a reference, minus
+    the nominal trial before it (rad)."""
     m = run.mae
-    return float(m[-1] - m[-2])
+    return float(m[-1] - (reference.mae[-1] if reference is not None else m[-2]))
 
 
 @figure("fig4_5", "Fig. 4.5 — upper limb with and without the spinal cord",
@@ -105,6 +109,10 @@ def fig4_5(runs: RunSet, stem: Path) -> Figure:
     for s, (spinal, (label, colour)) in enumerate(SPINAL.items()):
         n = [trials_to(learn[(t, spinal)]) if (t, spinal) in learn else None for t in TASKS]
         ax.bar(x + (s - 0.5) * 0.38, [np.nan if v is None else v for v in n], 0.38, color=colour, label=label)
+        for i, v in enumerate(n):
+            if v is None and (TASKS[i], spinal) in learn:
+                ax.text(x[i] + (s - 0.5) * 0.38, 0.02, "not reached", rotation=90, ha="center", va="bottom",
+                        fontsize=7, color=colour, transform=ax.get_xaxis_transform())
         for i, t in enumerate(TASKS):
             run = learn.get((t, spinal))
             got = "–" if run is None else (str(n[i]) if n[i] is not None else f"not reached in {run.n_measured}")
@@ -114,9 +122,10 @@ def fig4_5(runs: RunSet, stem: Path) -> Figure:
     ax.legend(fontsize=8)
     panel_letter(ax, "B")
     ax = axes[3]
-    angles = sorted({a for _, a in pert})
+    angles = sorted({a for _, a in pert if a is not None})
     for spinal, (label, colour) in SPINAL.items():
-        dev = [deviation(pert[(spinal, a)]) if (spinal, a) in pert else np.nan for a in angles]
+        ref = pert.get((spinal, None))
+        dev = [deviation(pert[(spinal, a)], ref) if (spinal, a) in pert else np.nan for a in angles]
         ax.plot(angles, dev, "o-", color=colour, label=label)
         if angles:
             table.append([f"MAE deviation under 20 N pulses, {label} (rad; mean over directions)",
@@ -132,7 +141,8 @@ def fig4_5(runs: RunSet, stem: Path) -> Figure:
     notes = [f"A: mean ± std over the last {int(FINAL_FRACTION * 100)} % of trials of one run per task and "
              "condition (the thesis's std is over its runs); task paths constructed (thesis Fig. 4.4 shows them "
              "only as a figure).",
-             "D: perturbed trial's position MAE minus the nominal trial's, learned state, plasticity off."]
+             "D: perturbed trial's position MAE minus the same trial's in the zero-force run (learned state, "
+             "plasticity off)."]
     if not pert:
         notes.append("D: no perturbation runs (studies fig4_5_perturb_*)")
     missing = [f"{TASK_LABELS[t]} {SPINAL[s][0]}" for t in TASKS for s in SPINAL if (t, s) not in learn]
