@@ -118,6 +118,10 @@ def fig4_5(runs: RunSet, stem: Path) -> Figure:
             got = "–" if run is None else (str(n[i]) if n[i] is not None else f"not reached in {run.n_measured}")
             table.append([f"trials to {CONVERGED_RAD} rad, {TASK_LABELS[t]}, {label}", "fewer with SC (figure)", got])
     ax.set_xticks(x, [TASK_LABELS[t] for t in TASKS], fontsize=8)
+    ax.set_xlim(-0.6, len(TASKS) - 0.4)
+    ax.set_ylim(bottom=0)
+    if not ax.patches or all(not np.isfinite(p.get_height()) for p in ax.patches):
+        ax.set_ylim(0, max((r.n_measured for r in learn.values()), default=1))
     ax.set_ylabel(f"trials to position MAE ≤ {CONVERGED_RAD} rad")
     ax.legend(fontsize=8)
     panel_letter(ax, "B")
