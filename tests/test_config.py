@@ -15,9 +15,14 @@ def _options(group: str) -> list[str]:
     return sorted(p.stem for p in (CONF / group).glob("*.yaml"))
 
 
+UPPER_LIMB_TASKS = ("flexion_extension", "vertical_circle_slow", "vertical_circle_fast")
+
+
 def _plant_for(task: str) -> list[str]:
     if task == "luque_eight":
         return ["plant=lwr3", "controller=luque2011"]
+    if task in UPPER_LIMB_TASKS:
+        return ["+experiment=upper_limb_pd"]
     return ["plant=planar2", "controller=pd_planar2"] if task == "joint_sine" else []
 
 
@@ -30,7 +35,10 @@ def test_every_task_validates(load, task):
 @pytest.mark.parametrize("network", _options("network"))
 def test_every_network_validates(load, network):
     extra = ["+experiment=small_snn"] if network.startswith("small") else []
-    cfg = load(["+task=circle", *extra, f"network={network}"])
+    task = "+task=circle"
+    if network == "upper_limb":
+        extra, task = ["+experiment=upper_limb"], "+task=vertical_circle_slow"
+    cfg = load([task, *extra, f"network={network}"])
     assert cfg.network.n_neurons > 0
 
 
@@ -42,6 +50,8 @@ def test_every_option_validates(load, group):
             extra = ["+task=joint_sine", "plant=planar2", "controller=pd_planar2"]
         elif option in ("lwr3", "luque2011"):
             extra = ["+task=luque_eight", "plant=lwr3", "controller=luque2011"]
+        elif option == "upper_limb":
+            extra = ["+task=vertical_circle_slow", "+experiment=upper_limb_pd"]
         else:
             extra = ["+task=circle"]
         load([*extra, f"{group}={option}"])
@@ -55,7 +65,8 @@ def test_every_experiment_validates(load, experiment):
         load([f"+experiment={experiment}"])
     except ConfigError as err:  # presets that leave the task open validate with one
         assert any("no task chosen" in p for p in err.problems), err.problems
-        load([f"+experiment={experiment}", "+task=circle"])
+        task = "vertical_circle_slow" if "upper_limb" in experiment else "circle"
+        load([f"+experiment={experiment}", f"+task={task}"])
 
 
 def test_thesis_tables_are_encoded(load):

@@ -23,6 +23,7 @@ from cerebx.stages.base import Stage
 from cerebx.stages.check import check_experiment
 
 DEMO = ["+experiment=demo", "trials=1"]
+UPPER_LIMB = ["+experiment=upper_limb_pd", "+task=vertical_circle_fast", "trials=1"]
 
 # every controller and stage kind, each in an experiment where it belongs (planar arm unless it needs Baxter)
 KINDS = {
@@ -52,6 +53,9 @@ KINDS = {
                        "bounds: plant}]"],
         "ekeberg": ["+task=eight", "+experiment=small_snn", "plant=baxter_muscles", "muscle=ekeberg",
                     "controller.output=agonist_antagonist", "controller.decoder.spikes_full_scale=10"],
+        "spinal_cord": [*UPPER_LIMB, "spinal=cord"],
+        "direct_muscles": [*UPPER_LIMB, "spinal=direct"],
+        "split_pairs": [*UPPER_LIMB, "spinal=cord"],
     },
 }
 

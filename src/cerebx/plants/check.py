@@ -1,4 +1,6 @@
-"""Contract checker for plants, run over every registered plant kind (like Gymnasium's ``check_env``)."""
+"""Contract checker for plants, run over every registered plant kind (like Gymnasium's ``check_env``).
+A joint-torque plant is driven through ``apply``; a plant commanded with other signals (muscle
+excitations) through ``actuate`` with values within the bounds its command signals declare."""
 
 from __future__ import annotations
 
@@ -43,14 +45,46 @@ def _torques(plant: Plant, seed: int, steps: int) -> np.ndarray:
     return rng.uniform(-0.2, 0.2, (steps, plant.n_joints)) * probe
 
 
-def _rollout(plant: Plant, taus: np.ndarray, seed: int, events: Sequence[PlantEvent] = ()) -> np.ndarray:
+def _torque_plant(plant: Plant) -> bool:
+    return "joint.torque" in plant.command_signals()
+
+
+def _commands(plant: Plant, seed: int, steps: int) -> list[dict[str, np.ndarray]]:
+    """Random commands: torques in a modest band around zero, other command signals uniform within
+    their declared bounds (e.g. muscle excitations in [0, 1])."""
+    if _torque_plant(plant):
+        return [{"joint.torque": tau} for tau in _torques(plant, seed, steps)]
+    rng = np.random.default_rng(seed)
+    out: list[dict[str, np.ndarray]] = [{} for _ in range(steps)]
+    for name, sig in plant.command_signals().items():
+        lo, hi = sig.bounds()
+        _require(bool(np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))),
+                 f"command signal {name} must declare finite bounds")
+        for row, v in zip(out, rng.uniform(lo, hi, (steps, sig.size))):
+            row[name] = v
+    return out
+
+
+def _check_commands(plant: Plant) -> None:
+    """A plant commanded with other signals than joint torques clips each to its declared bounds."""
+    for name, sig in plant.command_signals().items():
+        lo, hi = sig.bounds()
+        for probe, want in ((hi + 1e9, hi), (lo - 1e9, lo), (0.5 * (lo + hi), 0.5 * (lo + hi))):
+            got = plant.actuate({name: probe})
+            _require(got.shape == (sig.size,) and bool(np.all(np.isfinite(got))),
+                     f"actuate() must return finite {sig} values")
+            _require(np.allclose(got, want), f"actuate() must clip {name} to its bounds and pass values within them")
+
+
+def _rollout(plant: Plant, commands: Sequence[dict[str, np.ndarray]], seed: int,
+             events: Sequence[PlantEvent] = ()) -> np.ndarray:
     plant.reset(_start(plant), np.random.default_rng(seed))
     for ev in events:
         plant.handle_event(ev)
     rows = []
-    for tau in taus:
+    for command in commands:
         q, qd = plant.sensors()
-        plant.apply(tau)
+        plant.actuate(command)
         plant.step()
         rows.append(np.concatenate([q, qd]))
     q, qd = plant.true_state()
@@ -79,17 +113,26 @@ def check_plant(plant_factory: Callable[[], Plant], steps: int = ROLLOUT_STEPS) 
     tq, _ = plant.true_state()
     _require(np.allclose(tq, q0), "reset(q0) must put the plant at q0")
 
-    big = plant.apply(np.full(n, 1e9))
-    _require(
-        big.shape == (n,) and bool(np.all(np.isfinite(big))), "apply() must return finite (n_joints,) torques"
-    )
-    _require(bool(np.all(big < 1e9)) and bool(np.all(big > 0)), "apply() must saturate large torques")
-    _require(np.allclose(plant.apply(-np.full(n, 1e9)), -big), "saturation must be symmetric")
-    _require(np.allclose(plant.apply(0.5 * big), 0.5 * big), "apply() must pass torques within the limits")
+    sensed = plant.sense()
+    declared = plant.sensor_signals()
+    _require(set(sensed) == set(declared), f"sense() returns {sorted(sensed)}, sensor_signals() {sorted(declared)}")
+    for name, sig in declared.items():
+        _require(np.shape(sensed[name]) == (sig.size,), f"sense(): {name} must have {sig.size} values")
 
-    taus = _torques(plant, 1, steps)
-    base = _rollout(plant, taus, 7)
-    _require(bool(np.all(np.isfinite(base))), "rollout with random torques produced non-finite states")
+    if _torque_plant(plant):
+        big = plant.apply(np.full(n, 1e9))
+        _require(
+            big.shape == (n,) and bool(np.all(np.isfinite(big))), "apply() must return finite (n_joints,) torques"
+        )
+        _require(bool(np.all(big < 1e9)) and bool(np.all(big > 0)), "apply() must saturate large torques")
+        _require(np.allclose(plant.apply(-np.full(n, 1e9)), -big), "saturation must be symmetric")
+        _require(np.allclose(plant.apply(0.5 * big), 0.5 * big), "apply() must pass torques within the limits")
+    else:
+        _check_commands(plant)
+
+    commands = _commands(plant, 1, steps)
+    base = _rollout(plant, commands, 7)
+    _require(bool(np.all(np.isfinite(base))), "rollout with random commands produced non-finite states")
     _require(abs(plant.time_s - steps * plant.control_dt_s) < 1e-9, "step() must advance control_dt_s")
     _require(plant.is_diverged() is None, f"plant diverged in a short rollout: {plant.is_diverged()}")
     ee = plant.end_effector()
@@ -98,13 +141,13 @@ def check_plant(plant_factory: Callable[[], Plant], steps: int = ROLLOUT_STEPS) 
         "end_effector() must be None or a finite 3-vector",
     )
 
-    again = _rollout(plant_factory(), taus, 7)
+    again = _rollout(plant_factory(), commands, 7)
     _require(np.array_equal(base, again), "same seed must give an identical trajectory")
 
     supported = set()
     for kind, params in _EVENTS.items():
         try:
-            traj = _rollout(plant, taus, 7, [PlantEvent(0.0, kind, dict(params))])
+            traj = _rollout(plant, commands, 7, [PlantEvent(0.0, kind, dict(params))])
         except ValueError:
             continue
         supported.add(kind)
@@ -114,7 +157,7 @@ def check_plant(plant_factory: Callable[[], Plant], steps: int = ROLLOUT_STEPS) 
             continue
         done = [PlantEvent(0.0, needs, dict(_EVENTS[needs])), PlantEvent(0.0, kind, dict(params))]
         try:
-            traj = _rollout(plant, taus, 7, done)
+            traj = _rollout(plant, commands, 7, done)
         except ValueError:
             continue
         _require(np.allclose(traj, base, atol=1e-6), f"event {kind!r} must undo {needs!r}")

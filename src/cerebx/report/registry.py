@@ -56,7 +56,7 @@ def figure(name: str, title: str, studies: tuple[str, ...]) -> Callable:
 
 def all_figures() -> dict[str, FigureSpec]:
     """Every registered figure, in thesis order (importing the modules registers them)."""
-    from cerebx.report import capolei, ch2, ch3, ch4_muscles, luque2011  # noqa: F401
+    from cerebx.report import capolei, ch2, ch3, ch4, ch4_muscles, luque2011  # noqa: F401
 
     def order(name: str) -> tuple:
         parts = name.replace("fig", "").replace("table", "").split("_")

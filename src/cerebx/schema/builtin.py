@@ -25,6 +25,7 @@ registry.plants.register(p.Planar2Config, "cerebx.plants.planar2:Planar2Arm")
 registry.plants.register(p.BaxterConfig, "cerebx.plants.baxter:BaxterArm")
 registry.plants.register(p.LWR3Config, "cerebx.plants.lwr3:LWR3Arm")
 registry.plants.register(p.ICubWristConfig, "cerebx.plants.icub_wrist:ICubWrist")
+registry.plants.register(p.UpperLimbConfig, "cerebx.plants.upper_limb:UpperLimb")
 
 registry.controllers.register(c.PDController, "cerebx.controllers.pd:PD")
 registry.controllers.register(c.PositionController, "cerebx.controllers.position:PositionServo")
@@ -67,3 +68,14 @@ from cerebx.schema import luque as lq  # noqa: E402
 
 registry.controllers.register(lq.CrudeInverseDynamics, "cerebx.controllers.inverse_dynamics:CrudeInverseDynamicsStage")
 registry.controllers.register(lq.Luque2011Cerebellum, "cerebx.controllers.luque2011:Luque2011Stage")
+
+# the upper limb's stages (thesis ch. 4): spinal cord or direct muscle commands; torque split for PD baselines
+from cerebx.schema import spinal as sp  # noqa: E402
+
+registry.stages.register(sp.SpinalCordConfig, "cerebx.stages.spinal:SpinalCord")
+registry.stages.register(sp.DirectMusclesConfig, "cerebx.stages.spinal:DirectMuscles")
+registry.stages.register(sp.SplitPairsConfig, "cerebx.stages.spinal:SplitPairs")
+from cerebx.schema import arm_tasks as at  # noqa: E402
+
+registry.tasks.register(at.FlexionExtensionTask, "cerebx.tasks.upper_limb:FlexionExtension")
+registry.tasks.register(at.VerticalCircleTask, "cerebx.tasks.upper_limb:VerticalCircle")

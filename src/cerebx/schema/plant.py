@@ -171,3 +171,39 @@ class ICubWristConfig(PlantSchema):
     @property
     def n_joints(self) -> int:
         return 3
+
+
+MUSCLES_UPPER_LIMB = ("deltoid", "biceps_long", "biceps_short", "brachialis", "triceps_long", "triceps_lateral",
+                      "triceps_medial")
+"""The upper limb's muscles in command/sensor order (thesis Fig. 4.1)."""
+
+
+class UpperLimbConfig(PlantSchema):
+    """Human arm, shoulder and elbow flexion-extension in a vertical plane, 7 Hill-type muscles on
+    spatial tendons (OpenSim Arm26, Holzbaur et al. 2005, + MoBL-ARMS anterior deltoid; thesis §4.3.1).
+    Commanded with the muscles' neural excitations; MuJoCo integrates the activation dynamics (Eq. 4.4-4.5)."""
+
+    kind: Literal["upper_limb"] = "upper_limb"
+    physics_dt_ms: PhysicsStepMs = 0.5
+    joint_damping_Nms_per_rad: NonNegFloat = Field(
+        0.5, description="viscous joint damping (constructed: Arm26 has none, the MyoConverter conversion 0.05; "
+        "0.5 damps the 30 ms-delayed stretch-reflex loop)")
+    activation_time_constants_s: tuple[PositiveFloat, PositiveFloat] = Field(
+        (0.01, 0.04), description="t_act, t_deact of the activation dynamics (Eq. 4.5; Arm26's Thelen values)")
+    gravity: bool = Field(True, description="gravity acts in the arm's plane")
+
+    @property
+    def n_joints(self) -> int:
+        return 2
+
+    def sensor_signals(self) -> dict:
+        from cerebx.signals import Signal
+
+        n = len(MUSCLES_UPPER_LIMB)
+        return {**super().sensor_signals(), "muscle.length": Signal("muscle.length", n, "mm"),
+                "muscle.velocity": Signal("muscle.velocity", n, "mm/s")}
+
+    def command_signals(self) -> dict:
+        from cerebx.signals import Signal
+
+        return {"muscle.activation": Signal("muscle.activation", len(MUSCLES_UPPER_LIMB), "", 0.0, 1.0)}

@@ -60,12 +60,15 @@ def _run(stage: Stage, available: dict[str, Signal], ticks: int, seed: int, sens
     return outs
 
 
-def _available(ctx: Any, side: str) -> dict[str, Signal]:
+def _available(ctx: Any, side: str, earlier: tuple[Signal, ...] = ()) -> dict[str, Signal]:
+    """What a stage may read: the plant's sensors, the task's reference (brain side) or what crossed the
+    link (robot side), and what the stages before it on its side wrote."""
     available = dict(ctx.plant.sensor_signals())
     if side == "brain":
         available.update(reference_signals(ctx.cfg))
     else:
         available.update({s.name: s for s in ctx.sent})
+    available.update({s.name: s for s in earlier})
     return available
 
 
@@ -78,11 +81,12 @@ def check_receiver(stage: Receiver) -> None:
         _require(bool(np.all(np.isfinite(out[s.name]))), f"{stage.name}: receive() gave non-finite {s.name}")
 
 
-def check_stage(ctx: Any, stage: Stage, twin: Stage, side: str, ticks: int = 60) -> None:
+def check_stage(ctx: Any, stage: Stage, twin: Stage, side: str, ticks: int = 60,
+                earlier: tuple[Signal, ...] = ()) -> None:
     """Step ``stage`` and ``twin`` (the same stage built again from the same config) over the same
     random valid input: declared outputs written, finite, of their size, and identical between the
-    two; a saved state loads."""
-    available = _available(ctx, side)
+    two; a saved state loads. ``earlier``: signals written by the stages before it on its side."""
+    available = _available(ctx, side, earlier)
     for name in stage.reads:
         _require(name in available, f"{stage.name}: reads {name}, which the {side} side of this experiment lacks")
     sensors = list(ctx.plant.sensor_signals())
@@ -102,8 +106,12 @@ def check_experiment(build: Callable[[], Any], ticks: int = 60) -> None:
     """Check the controller and every stage of an experiment; ``build`` builds it afresh
     (e.g. ``lambda: build_components(cfg)``) and is called twice."""
     ctx, twin = build(), build()
+    earlier: tuple[Signal, ...] = ()
     for st, tw in zip(ctx.brain, twin.brain):
-        check_stage(ctx, st, tw, "brain", ticks)
+        check_stage(ctx, st, tw, "brain", ticks, earlier)
+        earlier += tuple(st.writes)
     check_receiver(ctx.receiver)
+    earlier = ()
     for st, tw in zip(ctx.robot, twin.robot):
-        check_stage(ctx, st, tw, "robot", ticks)
+        check_stage(ctx, st, tw, "robot", ticks, earlier)
+        earlier += tuple(st.writes)
