@@ -237,6 +237,10 @@ def test_dcn_decoder_sides_count_each_side_over_full_scale():
     step = np.array([0, 0, 0, 0, 0, 0, 0, 0, 0, 1])
     m = dec.sides(idx, step, 3, 100.0)
     np.testing.assert_allclose(m, [[0.04, 0.0, 0.02, 0.03], [0.0, 0.01, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0]])
+    # one full scale per joint, and the cap at 1
+    m = dec.sides(idx, step, 2, (2.0, 4.0), saturate=True)
+    np.testing.assert_allclose(m, [[1.0, 0.0, 1.0, 0.75], [0.0, 0.25, 0.0, 0.0]])
+    np.testing.assert_allclose(dec.sides(idx, step, 2, (2.0, 4.0))[0], [2.0, 0.0, 1.0, 0.75])
 
 
 def test_agonist_antagonist_output_is_the_torque_split_by_side():

@@ -130,7 +130,7 @@ class SNNControllerImpl(Controller):
         dcn, st = idx[sel] - lo, step_of[sel]
         dec = self.decoder
         if self.muscles:
-            taus = dec.sides(dcn, st, n, self.cfg.decoder.spikes_full_scale)
+            taus = dec.sides(dcn, st, n, self.cfg.decoder.full_scale(nj), self.cfg.decoder.saturate)
         else:
             net = np.bincount(st * nj + dcn // dec.per_joint, weights=dec.sign[dcn], minlength=n * nj)
             taus = dec.alpha * net.reshape(n, nj)

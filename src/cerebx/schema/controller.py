@@ -164,14 +164,21 @@ class ErrorGains(Strict):
 class DCNDecoderConfig(Strict):
     """Torque = alpha_j (agonist - antagonist DCN spikes per 2 ms) (Eq. 2.16-2.17, 3.5); with the
     controller's ``output: agonist_antagonist`` the two sides are kept apart instead (thesis §4.6.2):
-    M = spikes of the side in the 2 ms step / ``spikes_full_scale``."""
+    M = spikes of the side in the 2 ms step / ``spikes_full_scale`` (capped at 1 with ``saturate``)."""
 
     alpha_Nm_per_spike: tuple[PositiveFloat, ...] = (0.75, 1.1, 0.375, 0.63, 0.078, 0.078)
-    spikes_full_scale: PositiveFloat = Field(
+    spikes_full_scale: PositiveFloat | tuple[PositiveFloat, ...] = Field(
         100.0, description="agonist_antagonist output: DCN spikes of one side of one joint in one 2 ms step "
-        "that give M = 1; must be at least the most that side can fire (cells x spikes per cell per step "
-        "allowed by the refractory period: 50 x 2 in the thesis networks), so M stays in [0, 1]. "
-        "Unused for torque output")
+        "that give M = 1 (one value, or one per joint); without saturate it must be at least the most that "
+        "side can fire (cells x spikes per cell per step allowed by the refractory period: 50 x 2 in the "
+        "thesis networks), so M stays in [0, 1]. Unused for torque output")
+    saturate: bool = Field(
+        False, description="agonist_antagonist output: M = min(1, spikes / full scale), the saturation of "
+        "the cerebellar output the thesis names (§4.7); allows a full scale below the most a side can fire")
+
+    def full_scale(self, n_joints: int) -> tuple[float, ...]:
+        fs = self.spikes_full_scale
+        return tuple(fs) if isinstance(fs, tuple) else (float(fs),) * n_joints
 
 
 class SNNController(ControllerConfig):
@@ -246,9 +253,12 @@ class SNNController(ControllerConfig):
         dcn = pops.get(io.output)
         if self.output == "agonist_antagonist" and dcn is not None and not dcn.size % (2 * n_joints):
             most = dcn.size // (2 * n_joints) * max_spikes_per_step(dcn.neuron, exp.network.dt_ms)
-            if self.decoder.spikes_full_scale < most:
-                out.append(f"controller.decoder.spikes_full_scale: {self.decoder.spikes_full_scale:g} spikes, but one "
-                           f"side of a joint of {io.output!r} can fire {most} in a 2 ms step (M would exceed 1)")
+            fs = self.decoder.spikes_full_scale
+            low = min(self.decoder.full_scale(n_joints))
+            if (not isinstance(fs, tuple) or len(fs) == n_joints) and not self.decoder.saturate and low < most:
+                out.append(f"controller.decoder.spikes_full_scale: {low:g} "
+                           f"spikes, but one side of a joint of {io.output!r} can fire {most} in a 2 ms step (M "
+                           "would exceed 1, unless controller.decoder.saturate caps it)")
         return out
 
 
