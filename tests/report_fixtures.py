@@ -13,7 +13,7 @@ def shrink(job: Job) -> Job:
     """A few trials; the spiking network reduced as in the small_snn preset."""
     from cerebx.config import load
 
-    exp, _ = load(job.args)
+    exp, _ = load([*job.args, *job.sweep_args])
     job.trials = exp.warmup_trials + (3 if "reaching" in job.study else 4 if job.study == "fig2_10_adaptation" else 2)
     if exp.controller.kind == "snn" and exp.network.name != "upper_limb":  # the 2-joint network is small enough
         small = {"multikernel": "small_multikernel", "thesis_ch2": "small_ch2"}.get(exp.network.name, "small")

@@ -21,6 +21,8 @@ UPPER_LIMB_TASKS = ("flexion_extension", "vertical_circle_slow", "vertical_circl
 def _plant_for(task: str) -> list[str]:
     if task == "luque_eight":
         return ["plant=lwr3", "controller=luque2011"]
+    if task == "wrist_oscillation":
+        return ["plant=icub_wrist", "controller=capolei_arch4", "network=small"]
     if task in UPPER_LIMB_TASKS:
         return ["+experiment=upper_limb_pd"]
     return ["plant=planar2", "controller=pd_planar2"] if task == "joint_sine" else []
@@ -50,6 +52,10 @@ def test_every_option_validates(load, group):
             extra = ["+task=joint_sine", "plant=planar2", "controller=pd_planar2"]
         elif option in ("lwr3", "luque2011"):
             extra = ["+task=luque_eight", "plant=lwr3", "controller=luque2011"]
+        elif option == "muscle_rest":
+            extra = ["+task=circle", "plant=baxter_muscles", "muscle=ekeberg"]
+        elif option == "icub_wrist" or option.startswith("capolei_"):
+            extra = ["+task=wrist_oscillation", "plant=icub_wrist", "controller=capolei_arch4", "network=small"]
         elif option == "upper_limb":
             extra = ["+task=vertical_circle_slow", "+experiment=upper_limb_pd"]
         else:

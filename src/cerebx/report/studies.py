@@ -149,6 +149,7 @@ class Job:
         return f"{self.study}/{self.label}"
 
     sweep_args: list[str] = field(default_factory=list)  # this job's point of its preset's sweep
+    sweeps: list[str] = field(default_factory=list)  # the study's args that sweep several values (seed=0,1,2)
 
     def overrides(self) -> list[str]:
         return [*self.common(), *self.sweep_args]
@@ -156,7 +157,7 @@ class Job:
     def common(self, sweeps: bool = False) -> list[str]:
         """The overrides every job of the study shares (``sweeps``: with the args that sweep several values,
         as the study's ``cerebx run -m`` gives them)."""
-        out = [a for a in self.args if sweeps or not is_sweep(a)] + [f"trials={self.trials}"]
+        out = [*self.args, *(self.sweeps if sweeps else []), f"trials={self.trials}"]
         if self.after is not None:
             out.append(f"init_from='{self.deps[0].run_dir}'")
         return out
@@ -209,9 +210,11 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
         p: ProfileSpec = getattr(s, profile)
         args = [*s.args, *p.args]
         src = _init_from(s, profile)
+        fixed, sweeps = [a for a in args if not is_sweep(a)], [a for a in args if is_sweep(a)]
         for sweep_args in preset_sweep(args):
             label = ",".join(sweep_args) or "run"  # as Hydra's override_dirname names the job's folder
-            job = Job(n, label, args, p.trials, root / profile / n / label, src, sweep_args=sweep_args)
+            job = Job(n, label, fixed, p.trials, root / profile / n / label, src, sweep_args=sweep_args,
+                      sweeps=sweeps)
             if src is not None:
                 job.deps = [single[src] if src in single else by_label[src, label]]
             if not sweep_args:
