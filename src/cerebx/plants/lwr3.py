@@ -23,7 +23,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from cerebx.plants.base import Plant
+from cerebx.plants.mujoco_arm import MujocoArm
 from cerebx.schema.plant import LWR3Config
 
 MJCF = Path(__file__).with_name("lwr3.xml")
@@ -50,19 +50,12 @@ def set_object(model: mujoco.MjModel, mass_kg: float) -> None:
     model.body_inertia[b] = 0.4 * mass_kg * OBJECT_RADIUS_M**2
 
 
-class LWR3Arm(Plant):
+class LWR3Arm(MujocoArm):
     joint_names = ("a1", "a2", "a4")
     control_dt_s = 0.002
 
     def __init__(self, cfg: LWR3Config, ctx=None):
-        self.cfg = cfg
-        self.model = lwr3_model(cfg)
-        self.data = mujoco.MjData(self.model)
-        self.physics_dt_s = cfg.physics_dt_ms / 1000.0
-        self._limit = np.asarray(cfg.torque_limit_Nm, float)
-        self._site = self.model.site("end_effector").id
-        self._rng = np.random.default_rng(0)
-        self._n = self.substeps
+        self._attach(cfg, lwr3_model(cfg))
 
     def nominal_model(self) -> mujoco.MjModel:
         """A copy of the arm's model without any object (what a crude inverse dynamics model knows)."""
@@ -70,41 +63,7 @@ class LWR3Arm(Plant):
 
     def reset(self, q0: np.ndarray, rng: np.random.Generator) -> None:
         set_object(self.model, self.cfg.object_mass_kg)
-        mujoco.mj_resetData(self.model, self.data)
-        self.data.qpos[:] = q0
-        mujoco.mj_forward(self.model, self.data)
-        self._rng = rng
-
-    def sensors(self) -> tuple[np.ndarray, np.ndarray]:
-        q, qd = self.data.qpos.copy(), self.data.qvel.copy()
-        if self.cfg.sensor_noise_rad > 0:
-            q += self._rng.normal(0.0, self.cfg.sensor_noise_rad, q.shape)
-        return q, qd
-
-    def true_state(self) -> tuple[np.ndarray, np.ndarray]:
-        return self.data.qpos.copy(), self.data.qvel.copy()
-
-    def apply(self, tau: np.ndarray) -> np.ndarray:
-        applied = np.minimum(np.maximum(tau, -self._limit), self._limit)
-        self.data.ctrl[:] = applied
-        return applied
-
-    def step(self) -> None:
-        mujoco.mj_step(self.model, self.data, nstep=self._n)
-
-    @property
-    def time_s(self) -> float:
-        return float(self.data.time)
-
-    def joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
-        r = self.model.jnt_range
-        return r[:, 0].copy(), r[:, 1].copy()
-
-    def torque_limits(self) -> np.ndarray:
-        return self._limit.copy()
-
-    def end_effector(self) -> np.ndarray:
-        return self.data.site_xpos[self._site].copy()
+        super().reset(q0, rng)
 
     def object_mass_kg(self) -> float:
         return float(self.model.body_mass[self.model.body("object").id])

@@ -8,9 +8,8 @@ upper arm horizontally along +x; gravity acts along -z when enabled.
 from __future__ import annotations
 
 import mujoco
-import numpy as np
 
-from cerebx.plants.base import Plant
+from cerebx.plants.mujoco_arm import MujocoArm
 from cerebx.schema.plant import Planar2Config
 
 
@@ -43,50 +42,9 @@ def planar2_mjcf(cfg: Planar2Config) -> str:
 </mujoco>"""
 
 
-class Planar2Arm(Plant):
+class Planar2Arm(MujocoArm):
     joint_names = ("shoulder", "elbow")
     control_dt_s = 0.002
 
     def __init__(self, cfg: Planar2Config, ctx=None):
-        self.cfg = cfg
-        self.model = mujoco.MjModel.from_xml_string(planar2_mjcf(cfg))
-        self.data = mujoco.MjData(self.model)
-        self.physics_dt_s = cfg.physics_dt_ms / 1000.0
-        self._limit = np.asarray(cfg.torque_limit_Nm, float)
-        self._site = self.model.site("end_effector").id
-        self._rng = np.random.default_rng(0)
-        self._n = self.substeps
-
-    def reset(self, q0: np.ndarray, rng: np.random.Generator) -> None:
-        mujoco.mj_resetData(self.model, self.data)
-        self.data.qpos[:] = q0
-        mujoco.mj_forward(self.model, self.data)
-        self._rng = rng
-
-    def sensors(self) -> tuple[np.ndarray, np.ndarray]:
-        q, qd = self.data.qpos.copy(), self.data.qvel.copy()
-        if self.cfg.sensor_noise_rad > 0:
-            q += self._rng.normal(0.0, self.cfg.sensor_noise_rad, q.shape)
-        return q, qd
-
-    def true_state(self) -> tuple[np.ndarray, np.ndarray]:
-        return self.data.qpos.copy(), self.data.qvel.copy()
-
-    def apply(self, tau: np.ndarray) -> np.ndarray:
-        applied = np.minimum(np.maximum(tau, -self._limit), self._limit)
-        self.data.ctrl[:] = applied
-        return applied
-
-    def step(self) -> None:
-        mujoco.mj_step(self.model, self.data, nstep=self._n)
-
-    @property
-    def time_s(self) -> float:
-        return float(self.data.time)
-
-    def joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
-        r = self.model.jnt_range
-        return r[:, 0].copy(), r[:, 1].copy()
-
-    def end_effector(self) -> np.ndarray:
-        return self.data.site_xpos[self._site].copy()
+        self._attach(cfg, mujoco.MjModel.from_xml_string(planar2_mjcf(cfg)))

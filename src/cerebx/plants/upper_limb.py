@@ -24,7 +24,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from cerebx.plants.base import Plant
+from cerebx.plants.mujoco_arm import MujocoArm
 from cerebx.schema.plant import MUSCLES_UPPER_LIMB, UpperLimbConfig
 from cerebx.signals import Signal
 
@@ -60,39 +60,30 @@ def moment_arms(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     return out
 
 
-class UpperLimb(Plant):
+class UpperLimb(MujocoArm):
     joint_names = ("shoulder", "elbow")
     muscle_names = MUSCLES_UPPER_LIMB
     control_dt_s = 0.002
 
     def __init__(self, cfg: UpperLimbConfig, ctx=None):
-        self.cfg = cfg
-        self.physics_dt_s = cfg.physics_dt_ms / 1000.0
         model = mujoco.MjModel.from_xml_path(str(MJCF))
         names = tuple(model.actuator(i).name for i in range(model.nu))
         if names != MUSCLES_UPPER_LIMB:
             raise ValueError(f"{MJCF.name}: muscles {names} differ from {MUSCLES_UPPER_LIMB}")
-        model.opt.timestep = self.physics_dt_s
+        model.opt.timestep = cfg.physics_dt_ms / 1000.0
         model.opt.gravity[:] = (0.0, 0.0, -9.80665 if cfg.gravity else 0.0)
         model.dof_damping[:] = cfg.joint_damping_Nms_per_rad
         model.actuator_dynprm[:, 0:2] = cfg.activation_time_constants_s
-        self.model, self.data = model, mujoco.MjData(model)
+        self._attach(cfg, model, site="hand")
         self.length_range_m = set_muscle_parameters(model, self.data)
-        self._hand = model.site("hand").id
         self._forearm = model.body("r_ulna_radius_hand").id
-        self._n = self.substeps
         self._pulse_end_s = -1.0
         self._pulse = np.zeros(3)
 
     # ---- plant contract -------------------------------------------------------------------
     def reset(self, q0: np.ndarray, rng: np.random.Generator) -> None:
-        mujoco.mj_resetData(self.model, self.data)
-        self.data.qpos[:] = q0
-        mujoco.mj_forward(self.model, self.data)
+        super().reset(q0, rng)
         self._pulse_end_s = -1.0
-
-    def sensors(self) -> tuple[np.ndarray, np.ndarray]:
-        return self.data.qpos.copy(), self.data.qvel.copy()
 
     def apply(self, excitation: np.ndarray) -> np.ndarray:
         """Set the 7 muscle excitations (clipped to [0, 1]) as MuJoCo's controls; returns them."""
@@ -111,17 +102,6 @@ class UpperLimb(Plant):
         if self._pulse_end_s >= 0 and self.data.time >= self._pulse_end_s - 1e-9:
             self.data.xfrc_applied[self._forearm] = 0.0
             self._pulse_end_s = -1.0
-
-    @property
-    def time_s(self) -> float:
-        return float(self.data.time)
-
-    def joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
-        r = self.model.jnt_range
-        return r[:, 0].copy(), r[:, 1].copy()
-
-    def end_effector(self) -> np.ndarray:
-        return self.hand()
 
     # ---- signals --------------------------------------------------------------------------
     def sensor_signals(self) -> dict[str, Signal]:
@@ -145,7 +125,7 @@ class UpperLimb(Plant):
     # ---- extras ---------------------------------------------------------------------------
     def hand(self) -> np.ndarray:
         """World position (m) of the hand point (Arm26's radius-styloid marker, at the wrist)."""
-        return self.data.site_xpos[self._hand].copy()
+        return self.data.site_xpos[self._site].copy()
 
     def activation(self) -> np.ndarray:
         """MuJoCo's muscle activation state (Eq. 4.4-4.5 integrated by MuJoCo)."""
@@ -161,6 +141,6 @@ class UpperLimb(Plant):
 
     def _set_pulse_wrench(self) -> None:
         d = self.data
-        arm = d.site_xpos[self._hand] - d.xipos[self._forearm]  # xfrc_applied acts at the body's centre of mass
+        arm = d.site_xpos[self._site] - d.xipos[self._forearm]  # xfrc_applied acts at the body's centre of mass
         d.xfrc_applied[self._forearm, :3] = self._pulse
         d.xfrc_applied[self._forearm, 3:] = np.cross(arm, self._pulse)

@@ -299,7 +299,15 @@ def subprocess_runner(job: Job) -> int:
     job.run_dir.mkdir(parents=True, exist_ok=True)
     cmd = [sys.executable, "-m", "cerebx", "run", *job.overrides(), f"hydra.run.dir='{job.run_dir}'",
            "recording.progress=off"]
-    with open(job.run_dir / "job.log", "w") as log:
+    return _run_logged(cmd, job.run_dir / "job.log", "w")
+
+
+_children: set[subprocess.Popen] = set()  # the `cerebx run` processes under way
+
+
+def _run_logged(cmd: list[str], log_path: Path, mode: str) -> int:
+    """Run ``cmd`` with its output (after the command line itself) in ``log_path``; its exit code."""
+    with open(log_path, mode) as log:
         log.write(" ".join(cmd) + "\n")
         log.flush()
         proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT)
@@ -310,9 +318,6 @@ def subprocess_runner(job: Job) -> int:
             _children.discard(proc)
 
 
-_children: set[subprocess.Popen] = set()  # the `cerebx run` processes under way
-
-
 def study_runner(extra: list[str] = ()) -> Runner:
     """Runs a :class:`Study` as one ``cerebx run -m`` child (``extra``: e.g. the launcher); its output goes
     to ``<study>/study.log``."""
@@ -320,15 +325,7 @@ def study_runner(extra: list[str] = ()) -> Runner:
     def run(study: Study) -> int:
         study.sweep_dir.mkdir(parents=True, exist_ok=True)
         cmd = [sys.executable, "-m", "cerebx", "run", *study.overrides(list(extra))]
-        with open(study.sweep_dir / "study.log", "a") as log:
-            log.write(" ".join(cmd) + "\n")
-            log.flush()
-            proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT)
-            _children.add(proc)
-            try:
-                return proc.wait()
-            finally:
-                _children.discard(proc)
+        return _run_logged(cmd, study.sweep_dir / "study.log", "a")
 
     return run
 
