@@ -400,6 +400,7 @@ def test_numba_cache_defaults_to_the_checkout(monkeypatch):
     from cerebx.cli import _default_numba_cache
 
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.delenv("CEREBX_CACHE", raising=False)
     _default_numba_cache()
     root = Path(__file__).resolve().parents[1]
     assert os.environ["NUMBA_CACHE_DIR"] == str(root / ".cache" / "numba")

@@ -223,13 +223,12 @@ def _completion(argv: list[str]) -> int:
 
 
 def _default_numba_cache() -> None:
-    """Compiled numba kernels go where ``make`` puts them (``.cache/numba`` of a source checkout, else
-    ``~/.cache/cerebx/numba``), never into ``src/.../__pycache__``, also when ``cerebx`` is run directly."""
-    if "NUMBA_CACHE_DIR" in os.environ:
-        return
-    checkout = Path(__file__).resolve().parents[2]
-    root = checkout / ".cache" if (checkout / "pyproject.toml").is_file() else Path.home() / ".cache" / "cerebx"
-    os.environ["NUMBA_CACHE_DIR"] = str(root / "numba")
+    """Compiled numba kernels go to one cache folder (``cerebx.jobenv.numba_cache_dir``), never into
+    ``src/.../__pycache__``, also when ``cerebx`` is run directly."""
+    from cerebx.jobenv import numba_cache_dir
+
+    if "NUMBA_CACHE_DIR" not in os.environ:
+        os.environ["NUMBA_CACHE_DIR"] = str(numba_cache_dir())
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -6,7 +6,8 @@ sets variables (``LD_PRELOAD``, ``PYTHONPATH``) for every process a run starts, 
 unpickles a file. All of these are refused in command-line overrides, in cerebx's own presets and in
 every YAML file of a ``--config-dir``/``--config-path`` tree, one ``where: problem`` line each.
 Launchers and sweepers are chosen by the name of an installed Hydra plugin (``hydra/launcher=joblib``),
-which brings its own fixed target; a name that no installed plugin registers is refused.
+which brings its own fixed target, or of a cerebx preset for one (``conf/hydra/launcher/slurm.yaml``: it
+sets values of an installed plugin and is checked like every shipped preset); any other name is refused.
 """
 
 from __future__ import annotations
@@ -33,13 +34,15 @@ CONF_ROOT = Path(__file__).resolve().parent / "conf"
 
 @functools.cache
 def installed_plugins(group: str) -> tuple[str, ...]:
-    """Options of ``hydra/<group>`` registered by installed Hydra plugins (e.g. basic, joblib)."""
+    """Options of ``hydra/<group>``: those registered by installed Hydra plugins (e.g. basic, joblib) and
+    cerebx's own presets for them (``conf/hydra/<group>/*.yaml``, e.g. slurm)."""
     from hydra.core.config_store import ConfigStore
     from hydra.core.plugins import Plugins
 
     Plugins.instance()  # registers the installed plugins' configs
     repo = ConfigStore.instance().repo.get("hydra", {}).get(group, {})
-    return tuple(sorted(name.removesuffix(".yaml") for name in repo))
+    shipped = (p.stem for p in (CONF_ROOT / "hydra" / group).glob("*.yaml"))
+    return tuple(sorted({*(name.removesuffix(".yaml") for name in repo), *shipped}))
 
 
 def _why_code(path: str) -> str | None:

@@ -4,8 +4,9 @@ A job started by a launcher (joblib, submitit on SLURM) does not inherit the Mak
 ``cerebx run`` sets them itself before numba is first imported. An environment variable that is already
 set wins; otherwise:
 
-- ``NUMBA_CACHE_DIR`` = ``$CEREBX_CACHE/numba`` (``~/.cache/cerebx/numba``): one writable cache per user,
-  shared by the jobs of a sweep on one machine (or one shared home on a cluster);
+- ``NUMBA_CACHE_DIR`` = ``$CEREBX_CACHE/numba``; without ``CEREBX_CACHE``, ``.cache/numba`` of the source
+  checkout cerebx runs from (where ``make`` puts it), else ``~/.cache/cerebx/numba``: one writable cache
+  shared by the jobs of a sweep on one machine (or one shared home on a cluster), never ``src/…/__pycache__``;
 - ``NUMBA_NUM_THREADS`` = the CPUs given to this job: ``SLURM_CPUS_PER_TASK`` inside a SLURM job, else
   the CPUs this process may run on.
 """
@@ -32,8 +33,12 @@ def job_cpus(environ: dict[str, str] | None = None) -> int:
 
 def numba_cache_dir(environ: dict[str, str] | None = None) -> Path:
     env = os.environ if environ is None else environ
-    root = Path(env.get("CEREBX_CACHE", Path.home() / ".cache" / "cerebx"))
-    return root / "numba"
+    if env.get("CEREBX_CACHE"):
+        return Path(env["CEREBX_CACHE"]) / "numba"
+    checkout = Path(__file__).resolve().parents[2]
+    if (checkout / "pyproject.toml").is_file():
+        return checkout / ".cache" / "numba"
+    return Path.home() / ".cache" / "cerebx" / "numba"
 
 
 def configure(environ: dict[str, str] | None = None) -> dict[str, str]:
