@@ -122,9 +122,10 @@ BAD = {
                                                   "cocontraction_base 6",
     "muscle.gamma=[3.0,3.0]": "muscle: rows need one value per joint each, got alpha_Nm 6, beta_Nm_per_rad 6, "
                               "gamma 2, delta_Nms_per_rad 6, rest_pose_rad 6, cocontraction_base 6",
-    "controller.decoder.spikes_full_scale=99": "controller.decoder.spikes_full_scale: 99 spikes, but one side of "
-                                               "a joint of 'dcn' can fire 100 in a 2 ms step (M would exceed 1, "
-                                               "unless controller.decoder.saturate caps it)",
+    # the preset caps M (saturate); without the cap a full scale below the DCN limit is refused
+    "controller.decoder.saturate=false controller.decoder.spikes_full_scale=99":
+        "controller.decoder.spikes_full_scale: 99 spikes, but one side of a joint of 'dcn' can fire 100 in a 2 ms "
+        "step (M would exceed 1, unless controller.decoder.saturate caps it)",
     "controller.decoder.spikes_full_scale=[40.0,40.0]":
         "controller.decoder.spikes_full_scale: 2 values given but the plant has 6 joints",
 }
@@ -132,7 +133,7 @@ BAD = {
 
 @pytest.mark.parametrize("override", BAD)
 def test_bad_values_refused_with_one_line(override, capsys):
-    code = main(["validate", "+experiment=fig4_6a_learn", override])
+    code = main(["validate", "+experiment=fig4_6a_learn", *override.split()])
     lines = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and lines == [BAD[override]]
 
