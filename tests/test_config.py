@@ -23,6 +23,8 @@ def _plant_for(task: str) -> list[str]:
         return ["plant=lwr3", "controller=luque2011"]
     if task in UPPER_LIMB_TASKS:
         return ["+experiment=upper_limb_pd"]
+    if task == "wrist_oscillation":
+        return ["plant=icub_wrist", "controller=capolei_arch1"]
     return ["plant=planar2", "controller=pd_planar2"] if task == "joint_sine" else []
 
 
@@ -52,6 +54,10 @@ def test_every_option_validates(load, group):
             extra = ["+task=luque_eight", "plant=lwr3", "controller=luque2011"]
         elif option == "upper_limb":
             extra = ["+task=vertical_circle_slow", "+experiment=upper_limb_pd"]
+        elif option.startswith("capolei") or option == "icub_wrist":
+            extra = ["+task=wrist_oscillation", "plant=icub_wrist", "controller=capolei_arch1"]
+        elif option == "muscle_rest":
+            extra = ["+experiment=fig4_6b"]
         else:
             extra = ["+task=circle"]
         load([*extra, f"{group}={option}"])
