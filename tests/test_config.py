@@ -25,8 +25,6 @@ def _plant_for(task: str) -> list[str]:
         return ["plant=icub_wrist", "controller=capolei_arch4", "network=small"]
     if task in UPPER_LIMB_TASKS:
         return ["+experiment=upper_limb_pd"]
-    if task == "wrist_oscillation":
-        return ["plant=icub_wrist", "controller=capolei_arch1"]
     return ["plant=planar2", "controller=pd_planar2"] if task == "joint_sine" else []
 
 
@@ -60,10 +58,6 @@ def test_every_option_validates(load, group):
             extra = ["+task=wrist_oscillation", "plant=icub_wrist", "controller=capolei_arch4", "network=small"]
         elif option == "upper_limb":
             extra = ["+task=vertical_circle_slow", "+experiment=upper_limb_pd"]
-        elif option.startswith("capolei") or option == "icub_wrist":
-            extra = ["+task=wrist_oscillation", "plant=icub_wrist", "controller=capolei_arch1"]
-        elif option == "muscle_rest":
-            extra = ["+experiment=fig4_6b"]
         else:
             extra = ["+task=circle"]
         load([*extra, f"{group}={option}"])
