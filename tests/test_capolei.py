@@ -114,6 +114,34 @@ def test_forward_module_learns_and_corrects_on_schedule():
     assert run_trial().any()
 
 
+def test_module_and_pid_states_round_trip_and_refuse_each_other(tmp_path):
+    from cerebx.errors import StateMismatchError
+
+    a = ForwardModuleStage(CapoleiForward(learn_from_trial=0), CTX)
+    a.reset(np.random.default_rng(0))
+    for tick in range(0, 100, 10):
+        sig = {"ref.q": np.full(3, 0.2), "ref.qd": np.full(3, 0.1), "joint.q": np.zeros(3), "joint.qd": np.zeros(3)}
+        a.step(Frame(tick, tick * 0.002, sig))
+    a.save_state(tmp_path / "fwd.npz")
+    b = ForwardModuleStage(CapoleiForward(), CTX)
+    b.load_state(tmp_path / "fwd.npz")
+    for name, value in a.circuit.state().items():
+        np.testing.assert_array_equal(b.circuit.state()[name], value)
+    pid = PIDVelocityStage(PIDVelocity(), CTX)
+    pid.integral[:] = [0.1, 0.2, 0.3]
+    pid.save_state(tmp_path / "pid.npz")
+    other = PIDVelocityStage(PIDVelocity(), CTX)
+    other.load_state(tmp_path / "pid.npz")
+    np.testing.assert_array_equal(other.integral, [0.1, 0.2, 0.3])
+    with pytest.raises(StateMismatchError, match="not a capolei_forward state"):
+        b.load_state(tmp_path / "pid.npz")
+    with pytest.raises(StateMismatchError, match="not a pid_velocity state"):
+        other.load_state(tmp_path / "fwd.npz")
+    (tmp_path / "bad.npz").write_bytes(b"PK\x03\x04 truncated")
+    with pytest.raises(StateMismatchError, match="not a readable cerebx"):
+        b.load_state(tmp_path / "bad.npz")
+
+
 def test_architecture_iv_beats_the_pid_alone(load, tmp_path):
     """Gravity makes the PID leave a pitch offset; the cerebellar modules remove most of it."""
     base = ["trials=14", "recording.joint_states=false"]

@@ -15,6 +15,8 @@ from typing import Any
 import numpy as np
 
 from cerebx.capolei.circuit import ModularCerebellarCircuit
+from cerebx.controllers.state import load_state_npz, save_state_npz
+from cerebx.errors import StateMismatchError
 from cerebx.schema.capolei import QD_CORRECTION, VELOCITY_ERROR, CapoleiForward, CapoleiInverse, PIDVelocity
 from cerebx.signals import Frame
 from cerebx.stages.base import Stage
@@ -53,12 +55,14 @@ class PIDVelocityStage(Stage):
         self.emit(frame, VELOCITY_ERROR, self.e.copy())
 
     def save_state(self, path: Path) -> bool:
-        np.savez(path, integral=self.integral)
+        save_state_npz(path, {"kind": self.cfg.kind}, integral=self.integral)
         return True
 
     def load_state(self, path: Path) -> None:
-        with np.load(path) as z:
-            self.integral = z["integral"].copy()
+        data, meta = load_state_npz(path, self.cfg.kind)
+        if meta.get("kind") != self.cfg.kind or data["integral"].shape != self.integral.shape:
+            raise StateMismatchError(f"{path}: not a {self.cfg.kind} state of {len(self.integral)} joints")
+        self.integral = data["integral"].copy()
 
     def describe(self) -> dict[str, Any]:
         return {"kp": list(self.cfg.kp), "ki": list(self.cfg.ki), "kd": list(self.cfg.kd), "rate_hz": self.cfg.rate_hz}
@@ -105,12 +109,17 @@ class _ModuleStage(Stage):
         return self.circuit.summary()
 
     def save_state(self, path: Path) -> bool:
-        np.savez(path, trial=self.trial, **self.circuit.state())
+        save_state_npz(path, {"kind": self.cfg.kind}, trial=np.array(self.trial), **self.circuit.state())
         return True
 
     def load_state(self, path: Path) -> None:
-        with np.load(path) as z:
-            self.circuit.load(dict(z))
+        data, meta = load_state_npz(path, self.cfg.kind)
+        if meta.get("kind") != self.cfg.kind:
+            raise StateMismatchError(f"{path}: not a {self.cfg.kind} state (saved by {meta.get('kind')!r})")
+        try:
+            self.circuit.load({name: data[name] for name in data.files})
+        except (KeyError, ValueError) as err:
+            raise StateMismatchError(f"{path}: {err}") from None
 
     def describe(self) -> dict[str, Any]:
         return {"rate_hz": self.cfg.rate_hz, "learn_from_trial": self.cfg.learn_from_trial,

@@ -91,6 +91,7 @@ class SNNControllerImpl(Controller):
         self.decoder = DCNDecoder(cfg.decoder.alpha_Nm_per_spike, nj, n_dcn // nj)
         self.muscles = cfg.output == "agonist_antagonist"
         self.width = 2 * nj if self.muscles else nj  # values per step in the output FIFO ([ag, at] or tau)
+        self.full_scale = np.asarray(cfg.decoder.full_scale(nj), float)  # M = 1 (agonist_antagonist output)
         self.recorder = None
         self.record = {name: self.net.index(name) for name in cfg.record_spikes}
         self.fingerprint = self.net.fingerprint
@@ -130,7 +131,7 @@ class SNNControllerImpl(Controller):
         dcn, st = idx[sel] - lo, step_of[sel]
         dec = self.decoder
         if self.muscles:
-            taus = dec.sides(dcn, st, n, self.cfg.decoder.full_scale(nj), self.cfg.decoder.saturate)
+            taus = dec.sides(dcn, st, n, self.full_scale, self.cfg.decoder.saturate)
         else:
             net = np.bincount(st * nj + dcn // dec.per_joint, weights=dec.sign[dcn], minlength=n * nj)
             taus = dec.alpha * net.reshape(n, nj)

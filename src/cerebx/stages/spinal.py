@@ -31,11 +31,12 @@ import numba
 import numpy as np
 
 from cerebx.errors import ConfigError
+from cerebx.schema.base import CONTROL_DT_MS
 from cerebx.schema.spinal import DirectMusclesConfig, SpinalCordConfig, SplitPairsConfig, _MuscleMap
 from cerebx.signals import Frame
 from cerebx.stages.base import Stage
 
-CONTROL_DT_S = 0.002
+CONTROL_DT_S = CONTROL_DT_MS / 1000.0
 
 
 def command_matrix(cfg: _MuscleMap, n_joints: int) -> np.ndarray:
