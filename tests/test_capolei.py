@@ -142,6 +142,15 @@ def test_module_and_pid_states_round_trip_and_refuse_each_other(tmp_path):
         b.load_state(tmp_path / "bad.npz")
 
 
+def test_a_part_state_of_another_kind_is_refused_at_validation(load, tmp_path, capsys):
+    from cerebx.cli import main
+
+    assert run_experiment(load(["+experiment=capolei2020_arch4", "trials=1"]), tmp_path / "iv")["status"] == "completed"
+    assert main(["validate", "+experiment=capolei2020_arch1", f"init_from={tmp_path / 'iv'}"]) == 2
+    assert capsys.readouterr().err.strip().endswith(
+        "controller_state.part0.npz was saved by a 'capolei_forward' controller (controller.parts.0 is 'pid_velocity')")
+
+
 def test_architecture_iv_beats_the_pid_alone(load, tmp_path):
     """Gravity makes the PID leave a pitch offset; the cerebellar modules remove most of it."""
     base = ["trials=14", "recording.joint_states=false"]

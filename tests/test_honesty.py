@@ -418,3 +418,21 @@ def test_the_setup_line_names_the_chosen_presets(load, tmp_path, capsys):
     (tmp_path / "summary.json").write_text(json.dumps(s))
     assert main(["inspect", str(tmp_path)]) == 0
     assert "controller=pd_planar2 plant=planar2 delay=gamma45 " in capsys.readouterr().out
+
+
+def test_a_summary_key_with_control_characters_is_still_one_line():
+    """Found by the long fuzz run: a presets key holding \\x1e split the error over two lines."""
+    from cerebx.errors import CerebxError
+    from cerebx.recording.summary import validate_summary
+
+    bad = {"status": "completed", "task": "circle", "controller": "pd", "plant": "baxter", "delay": "none",
+           "seed": 0, "trials": 1, "presets": {"a\x1eb\nc": 1}}
+    with pytest.raises(CerebxError) as err:
+        validate_summary(bad, "run/summary.json")
+    assert str(err.value).splitlines() == ["run/summary.json: presets.a\\x1eb\\nc: Input should be a valid string"]
+
+
+def test_a_robot_list_that_is_not_a_list_with_a_delay_is_one_line(capsys):
+    """Found by the long fuzz run: the delay-robust default indexed `robot=1` and crashed."""
+    assert main(["validate", "+task=circle", "+biodelay=d100", "robot=1"]) == 2
+    assert _one_line(capsys) == "robot: Input should be a valid list"

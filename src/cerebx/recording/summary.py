@@ -98,7 +98,8 @@ def validate_summary(data: Any, where: Path | str) -> dict[str, Any]:
         s = RunSummary.model_validate(data).model_dump()
     except ValidationError as err:
         e = err.errors()[0]
-        loc = ".".join(str(p) for p in e["loc"]) or "<root>"
+        # a key from the file may hold line breaks or control characters: shown escaped, on one line
+        loc = ".".join(str(p) if str(p).isprintable() else repr(str(p))[1:-1] for p in e["loc"]) or "<root>"
         more = f" (+{err.error_count() - 1} more)" if err.error_count() > 1 else ""
         raise CerebxError(f"{where}: {loc}: {e['msg']}{more}") from None
     if is_killed(s):

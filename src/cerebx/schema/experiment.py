@@ -61,6 +61,7 @@ def tuple_union(types: tuple[type, ...]) -> Any:
 
 
 BODY_SLOTS = ("spinal", "muscle")
+"""Named robot-side stage slots, in the order they run between the receiver and the ``robot`` list."""
 
 # The receiver of the delay-robust SNN (conf/controller/snn_delays.yaml, facts §7): the mean of the
 # nearest future and past stamped torques (Eq. 3.6), decaying by 0.998 per step when starved.
@@ -79,11 +80,10 @@ def delay_robust_default(data: Any) -> Any:
         return data
     delayed = isinstance(delay, dict) and delay.get("kind", "none") != "none"
     out = {**data, "controller": {**ctrl, "efferent": "stamp" if delayed else "hold"}}
-    robot = list(data.get("robot") or [])
-    if delayed and robot and isinstance(robot[0], dict) and robot[0].get("kind") == "mean":
+    robot = data.get("robot")  # not a list: left for the schema to refuse
+    if delayed and isinstance(robot, list) and robot and isinstance(robot[0], dict) and robot[0].get("kind") == "mean":
         out["robot"] = [dict(DELAYED_SNN_RECEIVER), *robot[1:]]
     return out
-"""Named robot-side stage slots, in the order they run between the receiver and the ``robot`` list."""
 
 
 class _ExperimentBase(Strict):

@@ -54,6 +54,8 @@ def _mismatch(meta: dict[str, Any], part: Any, exp: Any) -> str | None:
                     f"{exp.network.name!r} has fingerprint {want}: sizes or connections differ")
     elif part.kind == "ann" and meta.get("kind") != "ann":
         return "is not an ANN state (saved by another controller)"
+    elif meta.get("kind") not in (None, part.kind):
+        return f"was saved by a {meta['kind']!r} controller"
     return None
 
 
