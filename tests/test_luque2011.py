@@ -218,3 +218,14 @@ def test_short_closed_loop_learns(load):
     loop.start()
     mae = [sum(loop.run_trial(i).mae_per_joint) for i in range(60)]
     assert np.mean(mae[-10:]) < 0.6 * mae[0]
+
+
+def test_stage_kernel_peaks_at_teaching_delay_plus_arm_lag(load):
+    from cerebx.build import build_components
+
+    for extra, peak in (([], 170.0), (["controller.parts.1.plasticity.arm_lag_ms=0"], 100.0),
+                        (["controller.parts.1.plasticity.kernel_peak_ms=50", "controller.parts.1.plasticity.arm_lag_ms=20"],
+                         70.0)):
+        stage = build_components(load(["+experiment=luque2011_eight", *extra])).brain[0].parts[1]
+        assert stage.describe()["kernel_peak_ms"] == peak
+        assert np.argmax(stage.kern) * stage.cfg.substep_ms == pytest.approx(peak, abs=0.25)

@@ -215,3 +215,21 @@ def test_init_from_a_study_with_the_same_sweep_pairs_jobs_by_sweep_value(tmp_pat
                    "    quick: {trials: 1}\n    full: {trials: 2}\n")
     with pytest.raises(ConfigError, match="init_from: 'a' is not a single-run study or one with the same sweep"):
         load_studies(bad)
+
+
+def test_plant_realism_takes_the_study_runs_not_chapter_3_runs_on_the_same_plant(tmp_path):
+    from cerebx.report.ch3 import realism_cells
+    from cerebx.report.runs import Run, RunSet
+
+    def run(name, preset, peaks, trials, mae):
+        kern = {f"pf_pc{i}": {"plasticity": {"kind": "kernel_stdp", "kernel_peak_ms": p}} for i, p in enumerate(peaks)}
+        cfg = {"delay": {"total_ms": 0.0}, "init_from": "learned", "events": [], "network": {"projections": kern}}
+        summary = {"task": "circle", "controller": "snn", "delay": "constant", "status": "completed",
+                   "trials_completed": trials, "mae_per_trial": [mae] * trials, "sim_seconds": 2.0 * trials,
+                   "presets": {"plant": "baxter", "controller": preset}}
+        return Run(tmp_path / name, summary, cfg)
+
+    study = run("realism", "snn", [150.0], 12, 0.022)
+    runs = RunSet([study, run("fig3_4", "snn_delays", [150.0], 102, 0.019),
+                   run("multikernel", "snn", [100.0, 150.0, 200.0], 102, 0.033)])
+    assert realism_cells(runs) == {("baxter", "snn", 0.0): study}

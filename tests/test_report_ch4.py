@@ -6,12 +6,15 @@ from pathlib import Path
 
 import numpy as np
 
-from cerebx.report.ch4 import fig4_5, learning_runs, perturbation_runs, trials_to
+from cerebx.config import compose
+from cerebx.report.ch4 import PATHWAY_MS, fig4_5, learning_runs, perturbation_runs, trials_to
 from cerebx.report.runs import Run, RunSet
 
 
-def _run(tmp: Path, name: str, task: str, period: float, spinal: str, mae, vel, events=(), warmup=0) -> Run:
-    cfg = {"plant": {"kind": "upper_limb"}, "controller": {"kind": "snn"}, "spinal": {"kind": spinal},
+def _run(tmp: Path, name: str, task: str, period: float, spinal: str, mae, vel, events=(), warmup=0,
+         pathway=PATHWAY_MS) -> Run:
+    cfg = {"plant": {"kind": "upper_limb"}, "controller": {"kind": "snn", "pathway_delay_ms": pathway},
+           "spinal": {"kind": spinal},
            "task": {"kind": task, "period_s": period}, "events": list(events), "init_from": None,
            "warmup_trials": warmup}
     summary = {"task": task, "controller": "snn", "status": "completed", "trials_completed": len(mae),
@@ -48,3 +51,29 @@ def test_fig4_5_selects_runs_and_measures(tmp_path):
     assert rows["trials to 0.1 rad, slow circle, with SC"][2] == "16"
     assert rows["MAE deviation under 20 N pulses, with SC (rad; mean over directions)"][2] == "0.015"
     assert rows["MAE deviation under 20 N pulses, without SC (rad; mean over directions)"][2] == "0.020"
+
+
+def test_other_pathways_are_sensitivity_rows_not_panels(tmp_path):
+    """Runs with chapter 2's 2 x 50 ms pathway (study fig4_5_learn_d50) never replace the preset's runs in the
+    panels; they are listed in the table as sensitivity rows."""
+    decay = 0.3 * np.exp(-np.arange(50) / 10.0) + 0.03
+    runs = RunSet()
+    for spinal in ("spinal_cord", "direct_muscles"):
+        runs.append(_run(tmp_path, f"a{spinal}", "vertical_circle", 1.5, spinal, decay, decay * 3))
+        # longer, so the "longest run" rule would pick it if the pathway were not checked
+        runs.append(_run(tmp_path, f"b{spinal}", "vertical_circle", 1.5, spinal, np.full(80, 0.07), np.full(80, 0.8),
+                         pathway=50.0))
+    learn = learning_runs(runs)
+    assert learn[("circle_fast", "spinal_cord")].n_measured == 50
+    out = fig4_5(runs, tmp_path / "fig4_5")
+    rows = {r[0]: r for r in out.table}
+    assert rows["position MAE (rad), fast circle, with SC"][2] == "0.033 ± 0.000"  # last 5 of 0.3 e^(-k/10) + 0.03
+    assert rows["sensitivity, pathway 2 × 50 ms: position MAE (rad), fast circle, with SC"][2] == "0.070 ± 0.000"
+    assert rows["sensitivity, pathway 2 × 50 ms: trials to 0.1 rad, fast circle, with / without SC"][2] == "1 / 1"
+
+
+def test_preset_pathway_is_the_reports():
+    cfg = compose(["+experiment=upper_limb", "+task=vertical_circle_fast"])
+    assert cfg.controller.pathway_delay_ms == PATHWAY_MS
+    plast = cfg.network.projections.pf_pc.plasticity
+    assert (plast.kernel_peak_ms, plast.kernel_onset_ms) == (2 * PATHWAY_MS + 50, 2 * PATHWAY_MS + 20)

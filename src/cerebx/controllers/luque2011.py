@@ -51,7 +51,7 @@ class Luque2011Stage(Stage):
         self.sigma = cfg.inputs.sigma_spacing * (hi - lo) / (n_per - 1)
         self.enc = np.stack([self.centres, np.repeat(0.5 / self.sigma**2, n_per)])
         dt_ms = cfg.substep_ms
-        self.kern = k.kernel_table(cfg.plasticity.kernel_peak_ms, dt_ms)
+        self.kern = k.kernel_table(self.kernel_peak_ms, dt_ms)
         self.p_pc, self.p_dcn = lif_params(cfg.pc, dt_ms), lif_params(cfg.dcn, dt_ms)
         pl, t = cfg.plasticity, cfg.teaching
         self.pars = np.array([round(STEP_MS / dt_ms), dt_ms, math.exp(-dt_ms / cfg.inputs.tau_ms),
@@ -134,4 +134,9 @@ class Luque2011Stage(Stage):
 
     def describe(self) -> dict[str, Any]:
         return {"input_cells": self.n_in, "io": N_IO, "pc": N_PC, "dcn": N_DCN,
-                "kernel_peak_ms": self.cfg.plasticity.kernel_peak_ms}
+                "kernel_peak_ms": self.kernel_peak_ms}
+
+    @property
+    def kernel_peak_ms(self) -> float:
+        """Where the LTD kernel peaks: the teaching delay plus the arm's own lag."""
+        return self.cfg.plasticity.kernel_peak_ms + self.cfg.plasticity.arm_lag_ms

@@ -759,12 +759,15 @@ def _plant_preset(run: Run) -> str:
 
 
 def realism_cells(runs: RunSet) -> dict[tuple[str, str, float], Run]:
-    """(plant preset, controller, round trip ms) -> the run of the plant realism study."""
+    """(plant preset, controller, round trip ms) -> the run of the plant realism study: PD with the ``pd``
+    preset, the SNN with the default ``snn`` preset and one kernel (not the chapter 3 studies' ``snn_delays``
+    or multikernel runs on the same plant and delays, which have more trials and would win ``best``)."""
     study = runs.where(lambda r: r.trials > 0 and r.delay == "constant" and _plant_preset(r) in REALISM_PLANTS
                        and r.delay_total_ms in REALISM_DELAYS_MS and r.task == "circle" and not r.events)
     out = {}
     for ctrl, sel in (("pd", study.where(controller="pd", controller_preset="pd")),
-                      ("snn", study.where(lambda r: r.learned_from is not None, controller="snn"))):
+                      ("snn", study.where(lambda r: r.learned_from is not None and len(r.kernel_peaks_ms) == 1,
+                                          controller="snn", controller_preset="snn"))):
         for r in sel:
             key = (_plant_preset(r), ctrl, r.delay_total_ms)
             if key not in out or RunSet([r, out[key]]).best() is r:

@@ -27,6 +27,9 @@ THESIS_POS = {"spinal_cord": ("0.038 ± 0.003", "0.027 ± 0.002", "0.020 ± 0.00
 THESIS_VEL = {"spinal_cord": ("0.24 ± 0.017", "0.09 ± 0.008", "0.104 ± 0.014"),
               "direct_muscles": ("0.29 ± 0.034", "0.193 ± 0.035", "0.173 ± 0.022")}
 CONVERGED_RAD = 0.1  # Fig. 4.5 B threshold
+# the upper_limb preset's pathway delay each way (constructed, see conf/experiment/upper_limb.yaml): the
+# panels show these runs; runs with another pathway (study fig4_5_learn_d50) go to the table as sensitivity
+PATHWAY_MS = 20.0
 FINAL_FRACTION = 0.1  # "after learning": the last 10 % of the trials
 
 
@@ -42,17 +45,29 @@ def _upper_limb(run: Run) -> bool:
     return run.get("plant.kind") == "upper_limb" and run.controller == "snn" and run.trials > 0
 
 
-def learning_runs(runs: RunSet) -> dict[tuple[str, str], Run]:
-    """The longest from-scratch run per (task, spinal kind), without perturbations."""
-    rs = runs.where(lambda r: _upper_limb(r) and not r.events and r.learned_from is None)
+def pathway_ms(run: Run) -> float:
+    return float(run.get("controller.pathway_delay_ms", 50.0))
+
+
+def learning_runs(runs: RunSet, pathway: float | None = PATHWAY_MS) -> dict[tuple[str, str], Run]:
+    """The longest from-scratch run per (task, spinal kind), without perturbations, with this pathway delay
+    each way (None: any)."""
+    rs = runs.where(lambda r: (_upper_limb(r) and not r.events and r.learned_from is None
+                               and (pathway is None or pathway_ms(r) == pathway)))
     return rs.by(lambda r: (task_key(r), r.get("spinal.kind")))
+
+
+def other_pathways(runs: RunSet) -> list[float]:
+    """Pathway delays of from-scratch upper-limb runs other than the preset's, ascending."""
+    return sorted({pathway_ms(r) for r in runs.where(lambda r: _upper_limb(r) and not r.events
+                                                      and r.learned_from is None)} - {PATHWAY_MS})
 
 
 def perturbation_runs(runs: RunSet) -> dict[tuple[str, float | None], Run]:
     """Per (spinal kind, direction in deg): the run with one force pulse on the hand during the fast circle;
     direction None: the same run with a zero force (the unperturbed reference)."""
     def ok(r: Run) -> bool:
-        return (_upper_limb(r) and task_key(r) == "circle_fast" and len(r.events) == 1
+        return (_upper_limb(r) and task_key(r) == "circle_fast" and len(r.events) == 1 and pathway_ms(r) == PATHWAY_MS
                 and r.events[0].get("action", {}).get("kind") == "force_pulse" and r.mae.size >= 2)
     out = {}
     for r in runs.where(ok):
@@ -83,11 +98,11 @@ def deviation(run: Run, reference: Run | None) -> float:
 
 @figure("fig4_5", "Fig. 4.5 — upper limb with and without the spinal cord",
         ("fig4_5_learn", "fig4_5_learn_fast_cord", "fig4_5_learn_fast_direct", "fig4_5_perturb_cord",
-         "fig4_5_perturb_direct"))
+         "fig4_5_perturb_direct", "fig4_5_learn_d50"))
 def fig4_5(runs: RunSet, stem: Path) -> Figure:
     learn, pert = learning_runs(runs), perturbation_runs(runs)
     if not learn:
-        raise MissingRuns("no upper-limb SNN learning runs (studies fig4_5_learn*)")
+        raise MissingRuns(f"no upper-limb SNN learning runs with the {PATHWAY_MS:g} ms pathway (studies fig4_5_learn*)")
     fig, axes = plt.subplots(1, 4, figsize=(17, 4.2))
     x = np.arange(len(TASKS))
     table = [["quantity", "paper", "cerebx"]]
@@ -140,9 +155,25 @@ def fig4_5(runs: RunSet, stem: Path) -> Figure:
         ax.set_xticks(angles)
         ax.legend(fontsize=8)
     panel_letter(ax, "D")
+    for other in other_pathways(runs):
+        alt = learning_runs(runs, other)
+        for what, key in (("position MAE (rad)", "mae_per_trial"), ("velocity MAE (rad/s)", "vel_mae_per_trial")):
+            for t in TASKS:
+                for spinal, (label, _) in SPINAL.items():
+                    if (t, spinal) in alt:
+                        table.append([f"sensitivity, pathway 2 × {other:g} ms: {what}, {TASK_LABELS[t]}, {label}",
+                                      "–", mean_std(final(alt[(t, spinal)], key))])
+        for t in TASKS:
+            n = [trials_to(alt[(t, s)]) if (t, s) in alt else None for s in SPINAL]
+            if any((t, s) in alt for s in SPINAL):
+                table.append([f"sensitivity, pathway 2 × {other:g} ms: trials to {CONVERGED_RAD} rad, "
+                              f"{TASK_LABELS[t]}, with / without SC", "–",
+                              " / ".join("–" if v is None else str(v) for v in n)])
     fig.tight_layout()
     png = save(fig, stem)
-    notes = [f"A: mean ± std over the last {int(FINAL_FRACTION * 100)} % of trials of one run per task and "
+    notes = [f"Pathway delay {PATHWAY_MS:g} ms each way (constructed: the thesis gives none for ch. 4; with "
+             "chapter 2's 2 × 50 ms the learned loop oscillates, see the sensitivity rows).",
+             f"A: mean ± std over the last {int(FINAL_FRACTION * 100)} % of trials of one run per task and "
              "condition (the thesis's std is over its runs); task paths constructed (thesis Fig. 4.4 shows them "
              "only as a figure).",
              "D: perturbed trial's position MAE minus the same trial's in the zero-force run (learned state, "

@@ -67,13 +67,20 @@ class InputLayer(Strict):
 
 class LTDLTP(Strict):
     """PF-PC plasticity (Eq. 5-6): an IO spike depresses each PF-PC synapse by ``ltd_nS`` x the sum of
-    k(t_IO - t_PF) over the PF's earlier spikes, k(s) = e^-x sin(x)^20, x = s atan(20) / peak (so k peaks at
-    ``kernel_peak_ms``; normalised to 1 there); every PF spike potentiates its synapses by ``ltp_nS``."""
+    k(t_IO - t_PF) over the PF's earlier spikes, k(s) = e^-x sin(x)^20, x = s atan(20) / peak (normalised to 1
+    at its peak, ``kernel_peak_ms + arm_lag_ms``); every PF spike potentiates its synapses by ``ltp_nS``.
+
+    ``kernel_peak_ms`` is the paper's setting, the teaching delay of the link; ``arm_lag_ms`` adds the plant's own
+    response time, which the paper's kernel does not name: an IO spike reports an error that torques of
+    link delay + arm lag ago caused. Set ``arm_lag_ms: 0`` for the paper's kernel as written."""
 
     enabled: bool = True
     ltd_nS: NonNegFloat = Field(0.075, description="paper's balanced LTD (Fig. 8); unit taken as nS")
     ltp_nS: NonNegFloat = Field(0.01, description="paper: below 0.015 for LTD 0.075 (Fig. 8)")
     kernel_peak_ms: PositiveFloat = Field(100.0, description="paper: 100 ms, the loop's teaching delay")
+    arm_lag_ms: NonNegFloat = Field(
+        70.0, description="constructed: the lwr3 arm's own lag, added to the kernel's peak (README, Luque 2011)"
+    )
     weight_max_nS: PositiveFloat = Field(30.0, description="upper weight bound (constructed: twice the start)")
 
 
