@@ -105,10 +105,16 @@ def test_study_runner_reuses_finished_runs_and_skips_dependents_of_failures(tmp_
     ran: list[str] = []
 
     def fake(job: Job) -> int:
+        from cerebx.config import load
+        from cerebx.recording.recorder import Recorder
+
         ran.append(job.name)
         if job.study == "learn_circle_ch3":
             return 1
         job.run_dir.mkdir(parents=True, exist_ok=True)
+        rec = Recorder(job.run_dir / "run.mcap")  # a run records the configuration it was made from
+        rec.metadata("config", {"json": json.dumps(load(job.overrides())[1])})
+        rec.close()
         (job.run_dir / "summary.json").write_text(json.dumps({
             "status": "completed", "task": "circle", "controller": "pd", "plant": "baxter", "delay": "none",
             "seed": 0, "trials": job.trials, "trials_completed": job.trials, "final_mae": 0.1, "wall_seconds": 1}))
@@ -122,6 +128,11 @@ def test_study_runner_reuses_finished_runs_and_skips_dependents_of_failures(tmp_
     ran.clear()
     execute(plan("quick", tmp_path, ["fig3_4_pd"]), runner=fake, log=lambda line: None)
     assert ran == []  # every fig3_4_pd run is complete: reused
+    # a preset value changed since a run was made: that run is not reused
+    jobs = plan("quick", tmp_path, ["fig3_4_pd"])
+    jobs[0].args = [*jobs[0].args, "seed=7"]
+    execute(jobs, runner=fake, log=lambda line: None)
+    assert ran == [jobs[0].name]
 
 
 def test_a_profile_can_sweep_fewer_values(tmp_path):

@@ -144,8 +144,48 @@ def test_resume_auto_reuses_continues_or_restarts(tmp_path, load):
     resume.save(loop, tmp_path, wall_seconds=0.5)
     exp, run_dir, reused = resume.continued(cfg, plain, tmp_path)
     assert exp.resume == str(tmp_path) and plain["resume"] == str(tmp_path) and reused is None
-    # completed with enough trials: reused, nothing runs
-    (tmp_path / "summary.json").write_text(json.dumps({"status": "completed", "trials_completed": 6}))
-    assert resume.continued(cfg, {}, tmp_path)[2]["trials_completed"] == 6
     # completed with fewer trials than asked: continue from its checkpoint
+    (tmp_path / "summary.json").write_text(json.dumps({"status": "completed", "trials_completed": 6}))
     assert resume.continued(load([*RUN, "trials=8", "resume=auto"]), {}, tmp_path)[0].resume == str(tmp_path)
+
+
+def test_resume_auto_reuses_only_a_run_of_todays_config_after_its_source(tmp_path, load):
+    """A completed run is reused only when the presets still compose to its recorded configuration (the
+    trial count aside) and the run it started from has not been written since (else it runs again)."""
+    from cerebx.config import load as compose
+    from cerebx.loop.runner import run_experiment
+    from cerebx.recording.summary import read_summary
+
+    source, run = tmp_path / "source", tmp_path / "run"
+    exp, plain = compose([*RUN, "trials=2"])
+    run_experiment(exp, source, plain)
+    named = {**plain, "init_from": str(source)}  # recorded as if it had started from `source`
+    run_experiment(exp, run, named)
+    done = read_summary(run)
+    assert resume.stale(run, named, done) is None
+    assert resume.stale(run, {**named, "trials": 9, "recording": {}}, done) is None  # longer: continued()'s call
+    assert resume.continued(load([*RUN, "trials=2", "resume=auto"]), dict(named), run)[2] is not None
+    # a preset value changed since: run again
+    _, other = compose([*RUN, "trials=2", "seed=1"])
+    assert resume.stale(run, {**other, "init_from": str(source)}, done).startswith("the configuration changed: seed")
+    exp2, fresh = resume.continued(load([*RUN, "trials=2", "resume=auto", "seed=1"]),
+                                   {**other, "init_from": str(source)}, run)[::2]
+    assert fresh is None
+    # an option added later with the old behaviour's value does not count; another value does
+    key = next(iter(resume.ADDED_WITHOUT_EFFECT)).split(".")
+    older = tmp_path / "older"
+    without = json.loads(json.dumps(named))
+    without[key[0]][key[1]].pop(key[2], None) if len(key) == 3 else without[key[0]].pop(key[1], None)
+    run_experiment(exp, older, without)
+    same, changed = json.loads(json.dumps(without)), json.loads(json.dumps(without))
+    node_same, node_changed = same, changed
+    for part in key[:-1]:
+        node_same, node_changed = node_same.setdefault(part, {}), node_changed.setdefault(part, {})
+    node_same[key[-1]] = resume.ADDED_WITHOUT_EFFECT[".".join(key)]
+    node_changed[key[-1]] = "something else"
+    assert resume.stale(older, same, read_summary(older)) is None
+    assert resume.stale(older, changed, read_summary(older)) is not None
+    # the run it started from was written again after it started: run again
+    later = float(done["started_at"]) + 60.0
+    os.utime(source / "summary.json", (later, later))
+    assert "was written after it started" in resume.stale(run, named, done)

@@ -8,6 +8,7 @@ import itertools
 import math
 import os
 import re
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -58,6 +59,9 @@ def _hydra_lines(err: Exception) -> list[str]:
     return [f"overrides: {first}"]
 
 
+_COMPOSING = threading.RLock()  # Hydra's global state and the lazily built schema: one thread at a time
+
+
 def compose(overrides: list[str]) -> DictConfig:
     """Compose ``conf/config.yaml`` with command-line style overrides (no output folders)."""
     return compose_with_choices(overrides)[0]
@@ -77,11 +81,12 @@ def compose_with_choices(overrides: list[str]) -> tuple[DictConfig, dict[str, st
     problems = check_args(overrides)
     if problems:
         raise ConfigError(problems)
-    GlobalHydra.instance().clear()
     try:
-        with initialize_config_module(config_module="cerebx.conf", version_base="1.3"):
-            cfg = hydra_compose(config_name="config", overrides=[o for o in overrides if not _is_hydra(o)],
-                                return_hydra_config=True)
+        with _COMPOSING:
+            GlobalHydra.instance().clear()
+            with initialize_config_module(config_module="cerebx.conf", version_base="1.3"):
+                cfg = hydra_compose(config_name="config", overrides=[o for o in overrides if not _is_hydra(o)],
+                                    return_hydra_config=True)
     except (HydraException, OmegaConfBaseException, ValueError) as err:
         raise ConfigError(_hydra_lines(err)) from None
     choices = user_choices(cfg.hydra.runtime.choices)
@@ -102,11 +107,12 @@ def _is_hydra(override: str) -> bool:
 
 def load(overrides: list[str]) -> tuple[Any, dict[str, Any]]:
     """Compose and validate; returns (validated experiment, plain resolved dict)."""
-    plain = to_plain(compose(overrides))
-    try:
-        return validate(plain), plain
-    except ConfigError as err:
-        raise ConfigError(_with_hints(err.problems, plain)) from None
+    with _COMPOSING:  # the report composes jobs in threads
+        plain = to_plain(compose(overrides))
+        try:
+            return validate(plain), plain
+        except ConfigError as err:
+            raise ConfigError(_with_hints(err.problems, plain)) from None
 
 
 def _with_hints(problems: list[str], plain: dict[str, Any]) -> list[str]:

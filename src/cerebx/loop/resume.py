@@ -155,12 +155,12 @@ def expand_args(args: list[str]) -> list[str]:
     return [*kept, *rest, f"resume={run_dir}", f"hydra.run.dir={run_dir}", "hydra.output_subdir=.hydra.resumed"]
 
 
-def _check_same(old: Any, new: Any, where: str = "") -> None:
+def _check_same(old: Any, new: Any, where: str = "", whose: str = "the resumed run's") -> None:
     if isinstance(old, dict) and isinstance(new, dict):
         for k in sorted(set(old) | set(new)):
-            _check_same(old.get(k), new.get(k), f"{where}.{k}" if where else k)
+            _check_same(old.get(k), new.get(k), f"{where}.{k}" if where else k, whose)
     elif old != new:
-        raise ConfigError(f"{where or 'config'}: {new!r} differs from the resumed run's {old!r}")
+        raise ConfigError(f"{where or 'config'}: {new!r} differs from {whose} {old!r}")
 
 
 def finish(run_dir: Path) -> None:
@@ -188,7 +188,10 @@ def continued(exp: Any, plain: dict, output_dir: Path) -> tuple[Any, Path, dict 
     if exp.resume == AUTO:
         done = _completed(output_dir)
         if done is not None and (done.get("trials_completed") or 0) >= exp.trials:
-            return exp, output_dir, done
+            why = stale(output_dir, plain, done)
+            if why is None:
+                return exp, output_dir, done
+            log.warning("not reusing %s: %s; running it again", output_dir, why)
         target = str(output_dir) if (output_dir / CHECKPOINT).exists() else None
         if target is not None:
             try:
@@ -207,6 +210,50 @@ def continued(exp: Any, plain: dict, output_dir: Path) -> tuple[Any, Path, dict 
         return exp, output_dir, None
     check(exp, Path(exp.resume))
     return exp, Path(exp.resume), None
+
+
+_NOT_COMPARED = ("resume", "trials", "recording")  # what a reused run may differ in (as same_config)
+# Options added since runs were first recorded, with the value that does what runs without them did
+# (CHANGELOG: their recorded data did not change). A config that lacks one counts as having that value.
+ADDED_WITHOUT_EFFECT: dict[str, Any] = {"controller.output": "torque", "controller.decoder.spikes_full_scale": 100.0}
+
+
+def _with_added(config: dict) -> dict:
+    out = json.loads(json.dumps(config))
+    for dotted, value in ADDED_WITHOUT_EFFECT.items():
+        *parents, last = dotted.split(".")
+        node = out
+        for part in parents:
+            node = node.get(part) if isinstance(node, dict) else None
+        if isinstance(node, dict) and last not in node:
+            node[last] = value
+    return out
+
+
+def stale(run_dir: Path, plain: dict, summary: dict) -> str | None:
+    """Why the completed run in ``run_dir`` cannot stand for the run ``plain`` asks for now, or None: its
+    recorded configuration must equal ``plain`` (but for the trial count, logging and resumption), and
+    the run it started from (``init_from``) must not have been written since it started."""
+    from cerebx.recording.reader import read_metadata
+
+    try:
+        old = json.loads(read_metadata(run_dir)["config"]["json"])
+    except (CerebxError, KeyError, OSError, ValueError):
+        return "its recorded configuration cannot be read"
+    try:
+        _check_same(*({k: v for k, v in _with_added(d).items() if k not in _NOT_COMPARED} for d in (old, plain)),
+                    whose="its")
+    except ConfigError as err:
+        return f"the configuration changed: {err}"
+    source = plain.get("init_from")
+    if source:
+        try:
+            written = (Path(source) / "summary.json").stat().st_mtime
+        except OSError:
+            return None  # validation reports a missing init_from run
+        if written > float(summary.get("started_at") or 0.0):
+            return f"the run it starts from ({source}) was written after it started"
+    return None
 
 
 def _completed(run_dir: Path) -> dict | None:

@@ -4,8 +4,9 @@ A study is an experiment preset run as a Hydra multirun (``cerebx run -m``): onc
 the preset declares (``hydra.sweeper.params``; the only place a sweep is defined), through whatever
 launcher the report is given (``-o hydra/launcher=slurm``, ``joblib`` …). Each job lands in
 ``runs/report/<profile>/<study>/<job>`` (``run``, or the swept overrides, e.g. ``delay.total_ms=20``).
-Jobs run with ``resume=auto``: a job whose folder holds a completed summary with enough trials is
-reused, one that left a checkpoint continues from it, anything else runs again. Studies run ``jobs``
+Jobs run with ``resume=auto``: a job whose folder holds a completed summary with enough trials, made
+from the configuration its presets compose to now and after the run it starts from, is reused, one that
+left a checkpoint continues from it, anything else runs again. Studies run ``jobs``
 at a time, each after the study whose learned state it starts from.
 """
 
@@ -174,13 +175,28 @@ class Job:
         return f"final MAE {mae if mae is None else round(mae, 4)} rad, {s.get('wall_seconds', 0):.0f} s"
 
     def done(self) -> bool:
+        """A completed run with enough trials, made from this job's configuration as the presets give it
+        now and after the run it starts from (else ``resume=auto`` runs it again: a preset changed since)."""
+        from cerebx.loop.resume import stale
         from cerebx.recording.summary import read_summary
 
         try:
             s = read_summary(self.run_dir)
         except CerebxError:
             return False
-        return s.get("status") == "completed" and (s.get("trials_completed") or 0) >= self.trials
+        if s.get("status") != "completed" or (s.get("trials_completed") or 0) < self.trials:
+            return False
+        return self._plain is not None and stale(self.run_dir, self._plain, s) is None
+
+    @functools.cached_property
+    def _plain(self) -> dict | None:
+        """This job's composed configuration (None when it does not compose: the run will say why)."""
+        from cerebx.config import load
+
+        try:
+            return load(self.overrides())[1]
+        except CerebxError:
+            return None
 
 
 def plan(profile: str, root: Path, names: list[str] | None = None,
