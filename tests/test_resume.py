@@ -3,6 +3,7 @@ one never interrupted, and its log reads as one run across its MCAP segments."""
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import signal
@@ -168,23 +169,24 @@ def test_resume_auto_reuses_only_a_run_of_todays_config_after_its_source(tmp_pat
     # a preset value changed since: run again
     _, other = compose([*RUN, "trials=2", "seed=1"])
     assert resume.stale(run, {**other, "init_from": str(source)}, done).startswith("the configuration changed: seed")
-    exp2, fresh = resume.continued(load([*RUN, "trials=2", "resume=auto", "seed=1"]),
-                                   {**other, "init_from": str(source)}, run)[::2]
-    assert fresh is None
+    assert resume.continued(load([*RUN, "trials=2", "resume=auto", "seed=1"]),
+                            {**other, "init_from": str(source)}, run)[2] is None
     # an option added later with the old behaviour's value does not count; another value does
-    key = next(iter(resume.ADDED_WITHOUT_EFFECT)).split(".")
+    dotted, old_value = next(iter(resume.ADDED_WITHOUT_EFFECT.items()))
+    *parents, last = dotted.split(".")
+
+    def with_option(value):  # `named` with the option set to value (None: without it)
+        out = json.loads(json.dumps(named))
+        node = functools.reduce(lambda d, k: d.setdefault(k, {}), parents, out)
+        node.pop(last, None)
+        if value is not None:
+            node[last] = value
+        return out
+
     older = tmp_path / "older"
-    without = json.loads(json.dumps(named))
-    without[key[0]][key[1]].pop(key[2], None) if len(key) == 3 else without[key[0]].pop(key[1], None)
-    run_experiment(exp, older, without)
-    same, changed = json.loads(json.dumps(without)), json.loads(json.dumps(without))
-    node_same, node_changed = same, changed
-    for part in key[:-1]:
-        node_same, node_changed = node_same.setdefault(part, {}), node_changed.setdefault(part, {})
-    node_same[key[-1]] = resume.ADDED_WITHOUT_EFFECT[".".join(key)]
-    node_changed[key[-1]] = "something else"
-    assert resume.stale(older, same, read_summary(older)) is None
-    assert resume.stale(older, changed, read_summary(older)) is not None
+    run_experiment(exp, older, with_option(None))
+    assert resume.stale(older, with_option(old_value), read_summary(older)) is None
+    assert resume.stale(older, with_option("something else"), read_summary(older)) is not None
     # the run it started from was written again after it started: run again
     later = float(done["started_at"]) + 60.0
     os.utime(source / "summary.json", (later, later))

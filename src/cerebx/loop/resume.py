@@ -41,10 +41,13 @@ _LOOP_FIELDS = ("tick", "trials_done", "metrics", "_sensed", "_task_rng", "_even
 _RECORDER = "recorder"  # persistent id of the run's recorder inside the pickle
 
 
+NOT_SHARED = frozenset({"resume", "trials", "recording"})  # what a continued or reused run may differ in
+
+
 def same_config(cfg: Any) -> dict:
     """The part of a config a continuation must share with the run it continues (not the trial count,
     how it is logged, or where it resumes from)."""
-    return cfg.model_dump(mode="json", exclude={"resume", "trials", "recording"})
+    return cfg.model_dump(mode="json", exclude=set(NOT_SHARED))
 
 
 class _Pickler(cloudpickle.Pickler):
@@ -212,7 +215,6 @@ def continued(exp: Any, plain: dict, output_dir: Path) -> tuple[Any, Path, dict 
     return exp, Path(exp.resume), None
 
 
-_NOT_COMPARED = ("resume", "trials", "recording")  # what a reused run may differ in (as same_config)
 # Options added since runs were first recorded, with the value that does what runs without them did
 # (CHANGELOG: their recorded data did not change). A config that lacks one counts as having that value.
 ADDED_WITHOUT_EFFECT: dict[str, Any] = {"controller.output": "torque", "controller.decoder.spikes_full_scale": 100.0}
@@ -241,7 +243,7 @@ def stale(run_dir: Path, plain: dict, summary: dict) -> str | None:
     except (CerebxError, KeyError, OSError, ValueError):
         return "its recorded configuration cannot be read"
     try:
-        _check_same(*({k: v for k, v in _with_added(d).items() if k not in _NOT_COMPARED} for d in (old, plain)),
+        _check_same(*({k: v for k, v in _with_added(d).items() if k not in NOT_SHARED} for d in (old, plain)),
                     whose="its")
     except ConfigError as err:
         return f"the configuration changed: {err}"

@@ -17,6 +17,7 @@ import numpy as np  # noqa: E402
 
 from cerebx.report.registry import Figure, MissingRuns, figure, fmt, mean_std, panel_letter, save  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
+from cerebx.schema.controller import SNNController  # noqa: E402
 
 TASKS = ("flexion_extension", "circle_slow", "circle_fast")
 TASK_LABELS = {"flexion_extension": "flexion–extension", "circle_slow": "slow circle", "circle_fast": "fast circle"}
@@ -26,6 +27,8 @@ THESIS_POS = {"spinal_cord": ("0.038 ± 0.003", "0.027 ± 0.002", "0.020 ± 0.00
               "direct_muscles": ("0.039 ± 0.006", "0.027 ± 0.007", "0.024 ± 0.009")}
 THESIS_VEL = {"spinal_cord": ("0.24 ± 0.017", "0.09 ± 0.008", "0.104 ± 0.014"),
               "direct_muscles": ("0.29 ± 0.034", "0.193 ± 0.035", "0.173 ± 0.022")}
+MEASURES = (("position MAE (rad)", "mae_per_trial", THESIS_POS),
+            ("velocity MAE (rad/s)", "vel_mae_per_trial", THESIS_VEL))
 CONVERGED_RAD = 0.1  # Fig. 4.5 B threshold
 # the upper_limb preset's pathway delay each way (constructed, see conf/experiment/upper_limb.yaml): the
 # panels show these runs; runs with another pathway (study fig4_5_learn_d50) go to the table as sensitivity
@@ -46,7 +49,7 @@ def _upper_limb(run: Run) -> bool:
 
 
 def pathway_ms(run: Run) -> float:
-    return float(run.get("controller.pathway_delay_ms", 50.0))
+    return float(run.get("controller.pathway_delay_ms", SNNController.model_fields["pathway_delay_ms"].default))
 
 
 def learning_runs(runs: RunSet, pathway: float | None = PATHWAY_MS) -> dict[tuple[str, str], Run]:
@@ -61,6 +64,22 @@ def other_pathways(runs: RunSet) -> list[float]:
     """Pathway delays of from-scratch upper-limb runs other than the preset's, ascending."""
     return sorted({pathway_ms(r) for r in runs.where(lambda r: _upper_limb(r) and not r.events
                                                       and r.learned_from is None)} - {PATHWAY_MS})
+
+
+def sensitivity_rows(runs: RunSet) -> list[list[str]]:
+    """Table rows of the runs with another pathway delay: final position and velocity MAE, trials to 0.1 rad."""
+    rows = []
+    for other in other_pathways(runs):
+        alt, name = learning_runs(runs, other), f"sensitivity, pathway 2 × {other:g} ms"
+        for what, key, _ in MEASURES:
+            rows += [[f"{name}: {what}, {TASK_LABELS[t]}, {label}", "–", mean_std(final(alt[(t, spinal)], key))]
+                     for t in TASKS for spinal, (label, _) in SPINAL.items() if (t, spinal) in alt]
+        for t in TASKS:
+            if any((t, s) in alt for s in SPINAL):
+                n = [trials_to(alt[(t, s)]) if (t, s) in alt else None for s in SPINAL]
+                rows.append([f"{name}: trials to {CONVERGED_RAD} rad, {TASK_LABELS[t]}, with / without SC", "–",
+                             " / ".join("–" if v is None else str(v) for v in n)])
+    return rows
 
 
 def perturbation_runs(runs: RunSet) -> dict[tuple[str, float | None], Run]:
@@ -106,8 +125,7 @@ def fig4_5(runs: RunSet, stem: Path) -> Figure:
     fig, axes = plt.subplots(1, 4, figsize=(17, 4.2))
     x = np.arange(len(TASKS))
     table = [["quantity", "paper", "cerebx"]]
-    for k, (what, key, thesis) in enumerate((("position MAE (rad)", "mae_per_trial", THESIS_POS),
-                                             ("velocity MAE (rad/s)", "vel_mae_per_trial", THESIS_VEL))):
+    for k, (what, key, thesis) in enumerate(MEASURES):
         ax = axes[k]
         for s, (spinal, (label, colour)) in enumerate(SPINAL.items()):
             vals = [final(learn[(t, spinal)], key) if (t, spinal) in learn else np.array([]) for t in TASKS]
@@ -155,20 +173,7 @@ def fig4_5(runs: RunSet, stem: Path) -> Figure:
         ax.set_xticks(angles)
         ax.legend(fontsize=8)
     panel_letter(ax, "D")
-    for other in other_pathways(runs):
-        alt = learning_runs(runs, other)
-        for what, key in (("position MAE (rad)", "mae_per_trial"), ("velocity MAE (rad/s)", "vel_mae_per_trial")):
-            for t in TASKS:
-                for spinal, (label, _) in SPINAL.items():
-                    if (t, spinal) in alt:
-                        table.append([f"sensitivity, pathway 2 × {other:g} ms: {what}, {TASK_LABELS[t]}, {label}",
-                                      "–", mean_std(final(alt[(t, spinal)], key))])
-        for t in TASKS:
-            n = [trials_to(alt[(t, s)]) if (t, s) in alt else None for s in SPINAL]
-            if any((t, s) in alt for s in SPINAL):
-                table.append([f"sensitivity, pathway 2 × {other:g} ms: trials to {CONVERGED_RAD} rad, "
-                              f"{TASK_LABELS[t]}, with / without SC", "–",
-                              " / ".join("–" if v is None else str(v) for v in n)])
+    table += sensitivity_rows(runs)
     fig.tight_layout()
     png = save(fig, stem)
     notes = [f"Pathway delay {PATHWAY_MS:g} ms each way (constructed: the thesis gives none for ch. 4; with "

@@ -35,12 +35,18 @@ def _luque(runs: RunSet) -> RunSet:
     return runs.where(lambda r: r.task == "luque_eight" and _cer(r, "kind") == "luque2011_cerebellum")
 
 
+DEFAULT = Luque2011Cerebellum().plasticity
+
+
+def _default_arm_lag(r: Run) -> bool:
+    """The schema's arm lag (runs made before it existed, or with another, are left out)."""
+    return _cer(r, "plasticity.arm_lag_ms") == DEFAULT.arm_lag_ms
+
+
 def _default_plasticity(r: Run) -> bool:
-    """LTD and LTP at the preset's balanced values (the runs of Fig. 9-12, not the Fig. 8 grid), and the
-    preset's arm lag (runs made before it existed, or with another, are left out)."""
-    default = Luque2011Cerebellum().plasticity
-    return (_cer(r, "plasticity.ltd_nS") == default.ltd_nS and _cer(r, "plasticity.ltp_nS") == default.ltp_nS
-            and _cer(r, "plasticity.arm_lag_ms") == default.arm_lag_ms)
+    """LTD, LTP and arm lag at the preset's values (the runs of Fig. 9-12, not the Fig. 8 grid)."""
+    return (_cer(r, "plasticity.ltd_nS") == DEFAULT.ltd_nS and _cer(r, "plasticity.ltp_nS") == DEFAULT.ltp_nS
+            and _default_arm_lag(r))
 
 
 def _mae_sum(r: Run) -> np.ndarray:
@@ -64,8 +70,7 @@ def _finish(fig, stem: Path, axes: list) -> Path:
 
 def _default_1kg(r: Run) -> bool:
     return (r.get("plant.object_mass_kg") == 1.0 and r.delay_total_ms == 100.0
-            and _cer(r, "plasticity.kernel_peak_ms") == 100.0
-            and _cer(r, "plasticity.arm_lag_ms") == Luque2011Cerebellum().plasticity.arm_lag_ms)
+            and _cer(r, "plasticity.kernel_peak_ms") == 100.0 and _default_arm_lag(r))
 
 
 # ---- Fig. 8 ----------------------------------------------------------------------------------------------------
@@ -145,9 +150,8 @@ def fig9(runs: RunSet, stem: Path) -> Figure:
     finals = [float(r.split()[0]) for _, _, r in rows]
     table = [HEADER, ["final error across delays", "nearly constant", f"{min(finals):.3f} - {max(finals):.3f} rad"],
              *rows]
-    lag = Luque2011Cerebellum().plasticity.arm_lag_ms
     return Figure([png], "MAE per trial and final error for round-trip delays with the LTD kernel peak at the "
-                  f"delay + the arm's own lag ({lag:g} ms, constructed; 1 kg object). Paper: the delay hardly "
+                  f"delay + the arm's own lag ({DEFAULT.arm_lag_ms:g} ms, constructed; 1 kg object). Paper: the delay hardly "
                   "changes the final error.", table)
 
 
@@ -161,9 +165,8 @@ def fig10(runs: RunSet, stem: Path) -> Figure:
     png, rows = _curves_and_final(by_dev, stem, "kernel peak - delay (ms)", lambda d: f"mismatch {d:+g} ms")
     table = [HEADER, ["mismatch 50-70 ms", "still learns, final error constant", "see rows"],
              ["mismatch > 70 ms", "unstable", "see rows"], *rows]
-    lag = Luque2011Cerebellum().plasticity.arm_lag_ms
     return Figure([png], "Kernel peak moved away from the 100 ms teaching delay (1 kg object; the kernel peaks at "
-                  f"the setting + the arm's own lag, {lag:g} ms, constructed). Paper: 50-70 ms of mismatch still "
+                  f"the setting + the arm's own lag, {DEFAULT.arm_lag_ms:g} ms, constructed). Paper: 50-70 ms of mismatch still "
                   "learn; beyond about 70 ms learning becomes unstable.", table)
 
 
