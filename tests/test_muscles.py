@@ -145,6 +145,15 @@ def test_table_for_another_arm_refused_with_one_line_per_row(capsys):
     assert code == 2 and lines == [f"muscle.{r}: 2 values given but the plant has 6 joints" for r in rows]
 
 
+def test_fig4_6a_learns_from_the_chapter_2_eight_error_gains(load):
+    """The thesis's own gains (its chapter 2 eight, the [B] launch; also the lab's muscle eight), not
+    chapter 3's: with w1's kpos 1.5 the IO fired too little for the DCN to hold w1 at x9."""
+    error = load(["+experiment=fig4_6a_learn"]).controller.error
+    assert error == load(["+experiment=learn_eight"]).controller.error
+    assert (error.kpos[5], error.kvel[5]) == (3.0, 0.5)
+    assert load(["+experiment=fig4_6a"]).controller.error == error
+
+
 def test_muscles_without_muscle_commands_refused(capsys):
     code = main(["validate", "+experiment=fig4_6a_learn", "controller.output=torque"])
     lines = capsys.readouterr().err.strip().splitlines()

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import csv
 import json
+import os
+import socket
 from pathlib import Path
 
 from cerebx.cli import main
@@ -75,3 +77,21 @@ def test_multirun_prints_the_summary_when_it_ends(in_tmp, capsys):
     out = capsys.readouterr().out
     assert "| job | seed | status | trials | final_mae_rad | rt_factor |" in out
     assert (in_tmp / "sweep" / "sweep_summary.md").exists()
+
+
+def test_a_job_still_running_in_another_process_is_not_a_failure(tmp_path):
+    """Two multiruns into one folder (the report's paired jobs) see each other's jobs: a live one is
+    ``running``, not failed; one whose process is gone reads as ``killed`` and is."""
+    base = {"task": "eight", "controller": "snn", "plant": "baxter", "delay": "none", "seed": 0, "error": None,
+            "trials": 10, "host": socket.gethostname()}
+    _job(tmp_path, 0, ["muscle.cocontraction=0"], {**base, "status": "completed", "trials_completed": 10,
+                                                   "final_mae": 0.02, "rt_factor": 4.0})
+    _job(tmp_path, 1, ["muscle.cocontraction=1"], {**base, "status": "running", "trials_completed": 3,
+                                                   "pid": os.getpid()})
+    s = summarize(tmp_path)
+    assert [r.status for r in s.rows] == ["completed", "running"] and s.exit_code() == 0
+    assert s.outcome().endswith("1 of 2 jobs completed, 1 still running in another process")
+    dead = json.loads((tmp_path / "1" / "summary.json").read_text()) | {"pid": 2**22 + 1}
+    (tmp_path / "1" / "summary.json").write_text(json.dumps(dead))
+    s = summarize(tmp_path)
+    assert [r.status for r in s.rows] == ["completed", "killed"] and s.exit_code() == 1

@@ -62,6 +62,8 @@ def fig4_6(runs: RunSet, stem: Path) -> Figure:
     learned = muscles.where(lambda r: r.controller == "snn" and r.task == "eight" and r.learned_from is not None
                             and not r.events and r.n_measured > 0).by(_k)
     rest = muscles.where(lambda r: r.controller == "muscle_rest" and bool(r.events)).by(_k)
+    learning = muscles.where(lambda r: r.controller == "snn" and r.task == "eight" and r.learned_from is None)
+    learn_trials = sorted({r.trials for r in learning.by(_k).values()})
     if not learned and not rest:
         raise MissingRuns("no Ekeberg-muscle runs of the eight from a learned state or with a payload at rest "
                           "(studies fig4_6a, fig4_6b)")
@@ -118,8 +120,12 @@ def fig4_6(runs: RunSet, stem: Path) -> Figure:
                       "yes" if all(a > b for a, b in zip(vals, vals[1:])) else "no"])
     caption = ("Fig. 4.6. (A) Position MAE of the cerebellar SNN driving one Ekeberg muscle pair per joint "
                "(Eq. 4.6, Table 4.1) on the eight-like trajectory, each cocontraction profile learnt from scratch "
-               "and then evaluated from its learned state. (B) Vertical sag of the end-effector when a 2 kg payload "
-               "is attached at the resting pose with no active muscle component (M_ag = M_at = 0), measured "
+               "and then evaluated from its learned state"
+               + (f" (learning: {', '.join(map(str, learn_trials))} trials per profile, constructed: the thesis "
+                  "gives no count)" if learn_trials else "")
+               + ". Borrowed: the error gains are the thesis's chapter 2 eight's; M's full scale (DCN spikes "
+               "per 2 ms step) is the lab's later muscle code's. (B) Vertical sag of the end-effector when a 2 kg "
+               "payload is attached at the resting pose with no active muscle component (M_ag = M_at = 0), measured "
                f"against the last {SETTLED_S:g} s of the run. The arm's own weight is compensated (plant "
                "baxter_muscles, constructed); the payload is not.")
     return Figure([png], caption, table, notes)

@@ -419,10 +419,10 @@ class _Scheduler:
             rc, why = fut.result(), f"see {j.run_dir / logname}"
         except Exception as err:  # a runner that raises is a failed job, not a failed report
             rc, why = 1, f"{type(err).__name__}: {err}"
-        if rc == 0 and j.done():
+        if j.done():  # judged by its own runs: a multirun's exit code also counts other jobs in its folder
             self.finished.add(j.name)
             self.log(f"[{self._clock()}] done  {j.name}: {j.describe()} ({len(self.finished) - self.reused}/"
-                     f"{len(self.todo)})")
+                     f"{len(self.todo)})" + (f", though it exited with {rc} ({why})" if rc else ""))
         else:
             self.failed[j.name] = f"{j.name}: failed (exit code {rc}, {why})"
             self.log(self.failed[j.name])

@@ -5,7 +5,8 @@ keys whose value differs between jobs, from each job's ``.hydra/overrides.yaml``
 trials done, final MAE (rad), real-time factor and, for a job that did not complete, its one-line
 reason, from ``summary.json`` (read with the schema that writes it). A job refused before its run
 started (``error.txt``), or whose summary is unreadable, is ``failed``; one that left nothing is
-``missing``. Written beside the job folders as ``sweep_summary.csv`` and ``sweep_summary.md``, with
+``missing``; one whose process is still alive (another multirun into the same folder) is ``running``
+and not counted as failed. Written beside the job folders as ``sweep_summary.csv`` and ``sweep_summary.md``, with
 ``sweep_summary.png``: final MAE against each swept numeric parameter.
 """
 
@@ -39,7 +40,9 @@ class JobRow:
 
     @property
     def failed(self) -> bool:
-        return self.status not in OK_STATUSES
+        """Not a result, and not a run still going in another process (``running`` after reading means its
+        process is alive: a dead one reads as ``killed``), e.g. a sibling multirun writing to the same folder."""
+        return self.status not in (*OK_STATUSES, "running")
 
 
 def _overrides(job_dir: Path) -> dict[str, str]:
@@ -138,7 +141,9 @@ class SweepSummary:
 
     def outcome(self) -> str:
         n = len(self.rows)
-        line = f"sweep {self.sweep_dir}: {n - self.failed} of {n} jobs completed"
+        running = sum(r.status == "running" for r in self.rows)
+        line = f"sweep {self.sweep_dir}: {n - self.failed - running} of {n} jobs completed"
+        line += f", {running} still running in another process" if running else ""
         return line + (f", {self.failed} failed (exit code {self.exit_code()})" if self.failed else "")
 
     def markdown(self) -> str:
