@@ -223,9 +223,9 @@ def test_short_closed_loop_learns(load):
 def test_stage_kernel_peaks_at_teaching_delay_plus_arm_lag(load):
     from cerebx.build import build_components
 
-    for extra, peak in (([], 170.0), (["controller.parts.1.plasticity.arm_lag_ms=0"], 100.0),
-                        (["controller.parts.1.plasticity.kernel_peak_ms=50", "controller.parts.1.plasticity.arm_lag_ms=20"],
-                         70.0)):
+    plasticity = "controller.parts.1.plasticity"
+    for extra, peak in (([], 170.0), ([f"{plasticity}.arm_lag_ms=0"], 100.0),
+                        ([f"{plasticity}.kernel_peak_ms=50", f"{plasticity}.arm_lag_ms=20"], 70.0)):
         stage = build_components(load(["+experiment=luque2011_eight", *extra])).brain[0].parts[1]
         assert stage.describe()["kernel_peak_ms"] == peak
         assert np.argmax(stage.kern) * stage.cfg.substep_ms == pytest.approx(peak, abs=0.25)

@@ -55,15 +55,28 @@ def payload_sag_cm(r: Run) -> float | None:
     return float(100.0 * (before[-1] - settled.mean()))
 
 
+BORROWED = {"controller.error.kpos": "error gains kpos", "controller.error.kvel": "kvel",
+            "controller.decoder.spikes_full_scale": "M's full scale (DCN spikes per 2 ms step)"}
+
+
+def _borrowed(runs: list[Run]) -> str:
+    """The values the thesis does not give for chapter 4, as the evaluated runs have them (their sources:
+    conf/experiment/fig4_6a_learn.yaml)."""
+    shown = []
+    for key, label in BORROWED.items():
+        values = {str(r.get(key)) for r in runs}
+        shown.append(f"{label} {values.pop() if len(values) == 1 else 'differing between runs'}")
+    return f"Borrowed (see the preset fig4_6a_learn): {', '.join(shown)}. " if runs else ""
+
+
 @figure("fig4_6", "Baxter with Ekeberg muscles: MAE and payload sag per cocontraction",
         studies=("fig4_6a", "fig4_6b"))
 def fig4_6(runs: RunSet, stem: Path) -> Figure:
     muscles = runs.where(lambda r: r.completed and _table_4_1(r))
-    learned = muscles.where(lambda r: r.controller == "snn" and r.task == "eight" and r.learned_from is not None
-                            and not r.events and r.n_measured > 0).by(_k)
+    eight = muscles.where(lambda r: r.controller == "snn" and r.task == "eight")
+    learned = eight.where(lambda r: r.learned_from is not None and not r.events and r.n_measured > 0).by(_k)
+    learn_trials = sorted({r.trials for r in eight.where(lambda r: r.learned_from is None).by(_k).values()})
     rest = muscles.where(lambda r: r.controller == "muscle_rest" and bool(r.events)).by(_k)
-    learning = muscles.where(lambda r: r.controller == "snn" and r.task == "eight" and r.learned_from is None)
-    learn_trials = sorted({r.trials for r in learning.by(_k).values()})
     if not learned and not rest:
         raise MissingRuns("no Ekeberg-muscle runs of the eight from a learned state or with a payload at rest "
                           "(studies fig4_6a, fig4_6b)")
@@ -123,8 +136,7 @@ def fig4_6(runs: RunSet, stem: Path) -> Figure:
                "and then evaluated from its learned state"
                + (f" (learning: {', '.join(map(str, learn_trials))} trials per profile, constructed: the thesis "
                   "gives no count)" if learn_trials else "")
-               + ". Borrowed: the error gains are the thesis's chapter 2 eight's; M's full scale (DCN spikes "
-               "per 2 ms step) is the lab's later muscle code's. (B) Vertical sag of the end-effector when a 2 kg "
+               + ". " + _borrowed(list(learned.values())) + "(B) Vertical sag of the end-effector when a 2 kg "
                "payload is attached at the resting pose with no active muscle component (M_ag = M_at = 0), measured "
                f"against the last {SETTLED_S:g} s of the run. The arm's own weight is compensated (plant "
                "baxter_muscles, constructed); the payload is not.")

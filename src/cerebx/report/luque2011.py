@@ -151,8 +151,8 @@ def fig9(runs: RunSet, stem: Path) -> Figure:
     table = [HEADER, ["final error across delays", "nearly constant", f"{min(finals):.3f} - {max(finals):.3f} rad"],
              *rows]
     return Figure([png], "MAE per trial and final error for round-trip delays with the LTD kernel peak at the "
-                  f"delay + the arm's own lag ({DEFAULT.arm_lag_ms:g} ms, constructed; 1 kg object). Paper: the delay hardly "
-                  "changes the final error.", table)
+                  f"delay + the arm's own lag ({DEFAULT.arm_lag_ms:g} ms, constructed; 1 kg object). Paper: the "
+                  "delay hardly changes the final error.", table)
 
 
 @figure("luque2011_fig10", "Luque 2011 Fig. 10: kernel peak vs delay mismatch", studies=("luque2011_fig10",))
@@ -166,8 +166,8 @@ def fig10(runs: RunSet, stem: Path) -> Figure:
     table = [HEADER, ["mismatch 50-70 ms", "still learns, final error constant", "see rows"],
              ["mismatch > 70 ms", "unstable", "see rows"], *rows]
     return Figure([png], "Kernel peak moved away from the 100 ms teaching delay (1 kg object; the kernel peaks at "
-                  f"the setting + the arm's own lag, {DEFAULT.arm_lag_ms:g} ms, constructed). Paper: 50-70 ms of mismatch still "
-                  "learn; beyond about 70 ms learning becomes unstable.", table)
+                  f"the setting + the arm's own lag, {DEFAULT.arm_lag_ms:g} ms, constructed). Paper: 50-70 ms of "
+                  "mismatch still learn; beyond about 70 ms learning becomes unstable.", table)
 
 
 # ---- Fig. 11 / 12 and Fig. 7c ---------------------------------------------------------------------------------------
