@@ -15,8 +15,9 @@ def shrink(job: Job) -> Job:
 
     exp, _ = load([*job.args, *job.sweep_args])
     job.trials = exp.warmup_trials + (3 if "reaching" in job.study else 4 if job.study == "fig2_10_adaptation" else 2)
-    if exp.controller.kind == "snn" and exp.network.name != "upper_limb":  # the 2-joint network is small enough
-        small = {"multikernel": "small_multikernel", "thesis_ch2": "small_ch2"}.get(exp.network.name, "small")
+    net = getattr(exp.controller, "network", None)
+    if net is not None and net.name != "upper_limb":  # the 2-joint network is small enough
+        small = {"multikernel": "small_multikernel", "thesis_ch2": "small_ch2"}.get(net.name, "small")
         job.args = [*job.args, f"network={small}", *SMALL]
     return job
 

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from cerebx.build import build_components
-from cerebx.controllers.ann import ANN
 from cerebx.controllers.base import ControlInput, SensorMsg
 from cerebx.errors import StateMismatchError
 from cerebx.loop.loop import ClosedLoop
-from cerebx.schema.ann import ANNController
 from cerebx.schema.controller import GivenRanges
+from cerebx_thesis.ann.controller import ANN
+from cerebx_thesis.ann.schema import ANNController
 
 NJ = 6
 RANGES = GivenRanges(

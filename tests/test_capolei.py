@@ -9,11 +9,13 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from cerebx.capolei.circuit import ModularCerebellarCircuit, k
-from cerebx.capolei.stages import ForwardModuleStage, PIDVelocityStage
+from cerebx.controllers.pid import PIDVelocityStage
 from cerebx.loop.runner import run_experiment
-from cerebx.schema.capolei import CapoleiForward, CapoleiInverse, PIDVelocity
+from cerebx.schema.controller import PIDVelocity
 from cerebx.signals import Frame
+from cerebx_capolei2020.modules.circuit import ModularCerebellarCircuit, k
+from cerebx_capolei2020.modules.controller import ForwardModuleStage
+from cerebx_capolei2020.modules.schema import CapoleiForward, CapoleiInverse
 
 CTX = SimpleNamespace(cfg=SimpleNamespace(control_dt_ms=2.0))
 

@@ -41,7 +41,7 @@ def test_every_network_validates(load, network):
     if network == "upper_limb":
         extra, task = ["+experiment=upper_limb"], "+task=vertical_circle_slow"
     cfg = load([task, *extra, f"network={network}"])
-    assert cfg.network.n_neurons > 0
+    assert cfg.controller.network.n_neurons > 0
 
 
 @pytest.mark.parametrize("group", ["controller", "plant", "delay", "recording"])
@@ -76,11 +76,11 @@ def test_every_experiment_validates(load, experiment):
 
 
 def test_thesis_tables_are_encoded(load):
-    ch3 = load(["+task=circle", "network=thesis_ch3"]).network
+    ch3 = load(["+task=circle", "network=thesis_ch3"]).controller.network
     assert ch3.n_neurons == 62_040
     assert ch3.n_synapses == 36_386_400
     assert ch3.projections["pf_pc"].weight_nS == 2.0
-    ch2 = load(["+task=circle", "network=thesis_ch2"]).network
+    ch2 = load(["+task=circle", "network=thesis_ch2"]).controller.network
     assert ch2.projections["pf_pc"].weight_nS == 1.6
     assert ch2.projections["pf_pc"].plasticity.kernel_peak_ms == 100.0
 
@@ -88,18 +88,20 @@ def test_thesis_tables_are_encoded(load):
 INVALID = [
     (["+task=circle", "controller=nope"], "controller: unknown option 'nope'"),
     (["plant=planar2"], "task: no task chosen"),
-    (["+task=circle", "network.populations.gc.size=-5"], "network.populations.gc.size: Input should be greater than 0"),
-    (["+task=circle", "network.projections.pf_pc.synapses=35000000"],
-     "network.projections.pf_pc.synapses: declared 35,000,000 but rule all_to_all gives 36,000,000"),
-    (["+task=circle", "network.projections.pf_pc.weight_range_nS=[5.0,0.0]"],
-     "network.projections.pf_pc: weight_range_nS min (5.0) is greater than max (0.0)"),
+    (["+task=circle", "controller.network.populations.gc.size=-5"],
+     "controller.network.populations.gc.size: Input should be greater than 0"),
+    (["+task=circle", "controller.network.projections.pf_pc.synapses=35000000"],
+     "controller.network.projections.pf_pc.synapses: declared 35,000,000 but rule all_to_all gives 36,000,000"),
+    (["+task=circle", "controller.network.projections.pf_pc.weight_range_nS=[5.0,0.0]"],
+     "controller.network.projections.pf_pc: weight_range_nS min (5.0) is greater than max (0.0)"),
     (["+task=circle", "plant.physics_dt_ms=0.3"],
      "plant.physics_dt_ms: 0.3 ms does not divide the 2.0 ms control step"),
     (["+task=circle", "+plant.colour=red"], "plant.colour: Extra inputs are not permitted"),
-    (["+task=circle", "network.projections.pf_pc.plasticity.kernel_peak_ms=100"],
-     "network.projections.pf_pc.plasticity: kernel_peak_ms (100.0) must be greater than kernel_onset_ms (120.0)"),
-    (["+task=circle", "network.populations.pc.microcomplexes=7"],
-     "network.populations.pc: microcomplexes (7) must divide the population size (600)"),
+    (["+task=circle", "controller.network.projections.pf_pc.plasticity.kernel_peak_ms=100"],
+     "controller.network.projections.pf_pc.plasticity: kernel_peak_ms (100.0) must be greater than "
+     "kernel_onset_ms (120.0)"),
+    (["+task=circle", "controller.network.populations.pc.microcomplexes=7"],
+     "controller.network.populations.pc: microcomplexes (7) must divide the population size (600)"),
     (["+task=square"], "task: unknown option 'square'"),
     (["+task=circle", "init_from=/nonexistent/run"], "init_from: /nonexistent/run/controller_state.npz does not exist"),
     (["+task=circle", "plant.colour=red"], "plant.colour: not in the composed config"),
@@ -143,7 +145,7 @@ def test_config_cannot_import_code(load):
 def test_every_global_option_validates(load, group):
     for option in _options(group):
         cfg = load(["+task=circle", f"+{group}={option}"])
-        k = cfg.network.projections["pf_pc"].plasticity
+        k = cfg.controller.network.projections["pf_pc"].plasticity
         assert k.kernel_peak_ms - k.kernel_onset_ms == 30.0
         if group == "biodelay":
             assert k.kernel_peak_ms == 2 * cfg.controller.pathway_delay_ms + 50
@@ -162,8 +164,8 @@ def test_table_2_3_2_4_presets_use_chapter_2_settings(load, experiment, ranges_q
     """Tables 2.3/2.4 ([B], IEEE T-Cyb 2019): PF-PC 1.6 nS, kernel peak/onset 100/70 ms, LTD -0.001,
     [B] gains and decoder, CF 40 ms / MF 50 ms, and the [B] launch files' MF ranges."""
     cfg = load([f"+experiment={experiment}"])
-    pf = cfg.network.projections["pf_pc"]
-    assert cfg.network.name == "thesis_ch2" and pf.weight_nS == 1.6
+    pf = cfg.controller.network.projections["pf_pc"]
+    assert cfg.controller.network.name == "thesis_ch2" and pf.weight_nS == 1.6
     k = pf.plasticity
     assert (k.kernel_peak_ms, k.kernel_onset_ms, k.ltp_nS, k.ltd_nS) == (100.0, 70.0, 0.002, -0.001)
     c = cfg.controller
@@ -183,8 +185,8 @@ def test_table_2_3_2_4_presets_use_chapter_2_settings(load, experiment, ranges_q
 
 def test_chapter_3_studies_keep_chapter_3_settings(load):
     cfg = load(["+experiment=learn_circle_ch3"])
-    k = cfg.network.projections["pf_pc"].plasticity
-    assert cfg.network.name == "thesis_ch3" and (k.kernel_peak_ms, k.ltd_nS) == (150.0, -0.0008)
+    k = cfg.controller.network.projections["pf_pc"].plasticity
+    assert cfg.controller.network.name == "thesis_ch3" and (k.kernel_peak_ms, k.ltd_nS) == (150.0, -0.0008)
     assert cfg.controller.error.kpos == CH3_D["kpos"] and cfg.controller.cf_pathway_delay_ms is None
     assert cfg.controller.mf.ranges.kind == "from_task"
     from cerebx.report.studies import load_studies
@@ -214,10 +216,10 @@ def test_default_snn_is_delay_robust_under_any_delay(load, overrides, efferent, 
 
 
 def test_delayed_default_receiver_is_the_snn_delays_one(load):
-    from cerebx.schema.experiment import DELAYED_SNN_RECEIVER
+    from cerebx.controllers.snn.schema import DELAYED_RECEIVER as DELAYED_SNN_RECEIVER
 
     explicit = load(["+task=circle", "controller=snn_delays", "delay=gamma45"])
-    auto = load(["+task=circle", "delay=gamma45"])
+    auto = load(["+task=circle", "network=thesis_ch3", "delay=gamma45"])
     assert explicit.robot[0].model_dump() == auto.robot[0].model_dump()
     assert explicit.robot[0].model_dump() == {**explicit.robot[0].model_dump(), **DELAYED_SNN_RECEIVER}
     assert explicit.controller.model_dump() == {**auto.controller.model_dump(), "efferent": "stamp"}

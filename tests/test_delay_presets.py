@@ -10,6 +10,7 @@ import pytest
 
 from cerebx import registry
 from cerebx.build import BuildContext
+from cerebx.guard import conf_roots
 from cerebx.loop.delays import Percentiles
 from cerebx.loop.link import DelayChannel
 
@@ -64,7 +65,7 @@ def _samples(model, n: int = 10_000) -> tuple[np.ndarray, np.ndarray]:
 
 
 def test_every_preset_is_covered():
-    presets = {p.stem for p in (ROOT / "conf" / "delay").glob("*.yaml")} - {"none", "constant"}
+    presets = {p.stem for root in conf_roots() for p in (root / "delay").glob("*.yaml")} - {"none", "constant"}
     assert presets == set(DOCUMENTED)
 
 

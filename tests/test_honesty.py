@@ -278,7 +278,7 @@ def test_a_damaged_state_is_refused_at_validation(how, small_state, in_tmp, caps
 def test_a_state_of_another_network_is_refused_at_validation(small_state, in_tmp, capsys):
     assert main(["run", "+task=circle", "trials=1", f"init_from={small_state}"]) == 2
     line = _one_line(capsys)
-    assert "fingerprint" in line and "'thesis_ch3'" in line and not (in_tmp / "runs").exists()
+    assert "fingerprint" in line and "'full'" in line and not (in_tmp / "runs").exists()
     assert main(["validate", *SMALL, f"init_from={small_state}"]) == 0  # the same network is fine
     capsys.readouterr()
     assert main(["validate", "+task=circle", "controller=ann", f"init_from={small_state}"]) == 2

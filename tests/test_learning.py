@@ -52,7 +52,8 @@ def test_init_from_other_network_is_one_clear_error(load, tmp_path, capsys):
 
     first = run_experiment(load(["+task=circle", "+experiment=small_snn", "trials=1"]), tmp_path / "small")
     assert first["status"] == "completed" and (tmp_path / "small" / "controller_state.npz").exists()
-    cfg = load(["+task=circle", "+experiment=small_snn", "trials=1", "network.projections.mf_dcn.weight_nS=0.2",
+    cfg = load(["+task=circle", "+experiment=small_snn", "trials=1",
+                "controller.network.projections.mf_dcn.weight_nS=0.2",
                 f"init_from={tmp_path / 'small'}"])
     same = run_experiment(cfg, tmp_path / "same")  # same structure, other weights: allowed
     assert same["status"] == "completed"

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from cerebx import metrics
-from cerebx.snn import luque as k
+from cerebx_luque2011.cerebellum import kernels as k
 
 # ---- kernel (Eq. 5) ---------------------------------------------------------------------------------------
 
@@ -89,7 +89,7 @@ PENDULUM = """<mujoco><option gravity="0 0 -9.81"/><worldbody><body>
 
 
 def test_inverse_dynamics_reproduces_a_single_joint_torque():
-    from cerebx.controllers.inverse_dynamics import inverse_torque
+    from cerebx_luque2011.inverse_dynamics import inverse_torque
 
     model = mujoco.MjModel.from_xml_string(PENDULUM)
     data = mujoco.MjData(model)
@@ -101,16 +101,16 @@ def test_inverse_dynamics_reproduces_a_single_joint_torque():
 
 
 def _lwr3(**kw):
-    from cerebx.plants.lwr3 import LWR3Arm
-    from cerebx.schema.plant import LWR3Config
+    from cerebx_luque2011.arm import LWR3Arm
+    from cerebx_luque2011.schema import LWR3Config
 
     return LWR3Arm(LWR3Config(**kw))
 
 
 def test_crude_model_ignores_exactly_the_object():
-    from cerebx.controllers.inverse_dynamics import CrudeInverseDynamicsStage
-    from cerebx.schema.luque import CrudeInverseDynamics
     from cerebx.signals import Frame
+    from cerebx_luque2011.inverse_dynamics import CrudeInverseDynamicsStage
+    from cerebx_luque2011.schema import CrudeInverseDynamics
 
     plant = _lwr3(object_mass_kg=2.0)
     stage = CrudeInverseDynamicsStage(CrudeInverseDynamics(), SimpleNamespace(plant=plant))
@@ -160,8 +160,8 @@ def _crossings(p: np.ndarray) -> int:
 
 
 def test_luque_eight_is_an_eight_with_exact_derivatives():
-    from cerebx.schema.task import LuqueEightTask
-    from cerebx.tasks.luque_eight import LuqueEight, luque_eight
+    from cerebx_luque2011.schema import LuqueEightTask
+    from cerebx_luque2011.task import LuqueEight, luque_eight
 
     cfg = LuqueEightTask()
     ref = LuqueEight(cfg).trial(0, np.random.default_rng(0))
@@ -200,7 +200,7 @@ def test_learning_estimators_on_a_known_curve():
 
 
 def test_ref_qdd_reaches_the_brain_side(load):
-    from cerebx.stages.base import wire
+    from cerebx.wiring import wire
 
     cfg = load(["+experiment=luque2011_eight"])
     wire(cfg)  # the crude inverse dynamics reads ref.qdd: validation passes

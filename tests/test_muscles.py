@@ -82,8 +82,8 @@ def test_arm_stays_at_rest_with_zero_commands_and_no_gravity(load, tmp_path):
 
 
 def test_payload_sags_less_with_more_cocontraction_and_fig4_6_shows_it(load, tmp_path):
-    from cerebx.report.ch4_muscles import fig4_6, payload_sag_cm
     from cerebx.report.runs import Run, RunSet
+    from cerebx_thesis.report.ch4_muscles import fig4_6, payload_sag_cm
 
     runs = RunSet()
     for k in (0, 12):

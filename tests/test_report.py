@@ -248,12 +248,13 @@ def test_init_from_a_study_with_the_same_sweep_pairs_jobs_by_sweep_value(tmp_pat
 
 
 def test_plant_realism_takes_the_study_runs_not_chapter_3_runs_on_the_same_plant(tmp_path):
-    from cerebx.report.ch3 import realism_cells
     from cerebx.report.runs import Run, RunSet
+    from cerebx_thesis.report.ch3 import realism_cells
 
     def run(name, preset, peaks, trials, mae):
         kern = {f"pf_pc{i}": {"plasticity": {"kind": "kernel_stdp", "kernel_peak_ms": p}} for i, p in enumerate(peaks)}
-        cfg = {"delay": {"total_ms": 0.0}, "init_from": "learned", "events": [], "network": {"projections": kern}}
+        cfg = {"delay": {"total_ms": 0.0}, "init_from": "learned", "events": [],
+               "controller": {"kind": "snn", "network": {"projections": kern}}}
         summary = {"task": "circle", "controller": "snn", "delay": "constant", "status": "completed",
                    "trials_completed": trials, "mae_per_trial": [mae] * trials, "sim_seconds": 2.0 * trials,
                    "presets": {"plant": "baxter", "controller": preset}}

@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 
 from cerebx.config import compose
-from cerebx.report.ch4 import PATHWAY_MS, fig4_5, learning_runs, perturbation_runs, trials_to
 from cerebx.report.runs import Run, RunSet
+from cerebx_thesis.report.ch4 import PATHWAY_MS, fig4_5, learning_runs, perturbation_runs, trials_to
 
 
 def _run(tmp: Path, name: str, task: str, period: float, spinal: str, mae, vel, events=(), warmup=0,
@@ -75,5 +75,5 @@ def test_other_pathways_are_sensitivity_rows_not_panels(tmp_path):
 def test_preset_pathway_is_the_reports():
     cfg = compose(["+experiment=upper_limb", "+task=vertical_circle_fast"])
     assert cfg.controller.pathway_delay_ms == PATHWAY_MS
-    plast = cfg.network.projections.pf_pc.plasticity
+    plast = cfg.controller.network.projections.pf_pc.plasticity
     assert (plast.kernel_peak_ms, plast.kernel_onset_ms) == (2 * PATHWAY_MS + 50, 2 * PATHWAY_MS + 20)

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cerebx.controllers.snn.schema import SNNController
 from cerebx.errors import ConfigError
 from cerebx.loop import resume
 from cerebx.recording.reader import channel_counts, read_messages, read_metadata
@@ -171,23 +172,37 @@ def test_resume_auto_reuses_only_a_run_of_todays_config_after_its_source(tmp_pat
     assert resume.stale(run, {**other, "init_from": str(source)}, done).startswith("the configuration changed: seed")
     assert resume.continued(load([*RUN, "trials=2", "resume=auto", "seed=1"]),
                             {**other, "init_from": str(source)}, run)[2] is None
-    # an option added later with the old behaviour's value does not count; another value does
-    dotted, old_value = next(iter(resume.ADDED_WITHOUT_EFFECT.items()))
-    *parents, last = dotted.split(".")
-
-    def with_option(value):  # `named` with the option set to value (None: without it)
-        out = json.loads(json.dumps(named))
-        node = functools.reduce(lambda d, k: d.setdefault(k, {}), parents, out)
-        node.pop(last, None)
-        if value is not None:
-            node[last] = value
-        return out
-
-    older = tmp_path / "older"
-    run_experiment(exp, older, with_option(None))
-    assert resume.stale(older, with_option(old_value), read_summary(older)) is None
-    assert resume.stale(older, with_option("something else"), read_summary(older)) is not None
     # the run it started from was written again after it started: run again
     later = float(done["started_at"]) + 60.0
     os.utime(source / "summary.json", (later, later))
     assert "was written after it started" in resume.stale(run, named, done)
+
+
+def test_older_recorded_layouts_are_the_same_experiment(tmp_path):
+    """A run recorded before an option was added (with the value that does what it did) or when the network
+    was a top-level key of every experiment still counts as the same experiment; another value does not."""
+    from cerebx.config import load as compose
+    from cerebx.loop.runner import run_experiment
+    from cerebx.recording.summary import read_summary
+
+    exp, plain = compose(["+task=circle", "+experiment=small_snn", "trials=1", "recording.progress=off"])
+    dotted, old_value = next(iter(SNNController.added_without_effect.items()))
+    *parents, last = ["controller", *dotted.split(".")]
+
+    def recorded(value=None, flat=False):  # `plain` as an older version recorded it
+        out = json.loads(json.dumps(plain))
+        node = functools.reduce(lambda d, k: d.setdefault(k, {}), parents, out)
+        node.pop(last, None)
+        if value is not None:
+            node[last] = value
+        if flat:
+            out["network"] = out["controller"].pop("network")
+        return out
+
+    older = tmp_path / "older"
+    run_experiment(exp, older, recorded(flat=True))
+    done = read_summary(older)
+    assert resume.stale(older, plain, done) is None
+    assert resume.stale(older, recorded(old_value), done) is None
+    assert resume.stale(older, recorded("something else"), done) is not None
+    assert resume.stale(older, {**plain, "seed": 7}, done).startswith("the configuration changed: seed")

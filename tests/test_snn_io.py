@@ -9,17 +9,18 @@ import pytest
 
 from cerebx.build import BuildContext
 from cerebx.controllers.base import ControlInput, SensorMsg
-from cerebx.controllers.snn import SNNControllerImpl
+from cerebx.controllers.snn.controller import SNNControllerImpl
+from cerebx.controllers.snn.schema import BoxEncoder, CFEncoder, SNNController
 from cerebx.errors import StateMismatchError
-from cerebx.schema.controller import BoxEncoder, CFEncoder, GivenRanges, SNNController
+from cerebx.schema.controller import GivenRanges
 from cerebx.snn.decoder import DCNDecoder
 from cerebx.snn.encoders import ClimbingEncoder, MossyEncoder
-from cerebx.snn.presets import thesis_network
+from cerebx.snn.presets import network as full_network
 from cerebx.snn.topology import build_topology
 
 
 def test_every_mf_combination_drives_exactly_one_gc_per_joint():
-    topo = build_topology(thesis_network())
+    topo = build_topology(full_network())
     mf_gc = next(s for s in topo.sparse if s.name == "mf_gc")
     gc0 = topo.slice("gc").start
     counts = np.zeros(60000, np.int64)
@@ -79,10 +80,10 @@ class _Task:
 
 
 def make_ctrl(fibers=5, per_joint=10, **kw) -> SNNControllerImpl:
-    net = thesis_network(fibers=fibers, per_joint=per_joint)
+    net = full_network(fibers=fibers, per_joint=per_joint)
     kw.setdefault("mf", BoxEncoder(fibers_per_signal=fibers))
-    ccfg = SNNController(**kw)
-    cfg = SimpleNamespace(network=net, controller=ccfg, seed=3)
+    ccfg = SNNController(network=net, **kw)
+    cfg = SimpleNamespace(controller=ccfg, seed=3)
     return SNNControllerImpl(ccfg, BuildContext(cfg=cfg, task=_Task()))
 
 
@@ -270,17 +271,17 @@ def test_agonist_antagonist_output_is_the_torque_split_by_side():
 
 
 def test_max_spikes_per_step_follows_the_refractory_period():
-    from cerebx.schema.controller import max_spikes_per_step
+    from cerebx.controllers.snn.schema import max_spikes_per_step
 
-    dcn = thesis_network().populations["dcn"].neuron  # t_ref 1 ms at 0.5 ms steps: fires at most every 1.5 ms
+    dcn = full_network().populations["dcn"].neuron  # t_ref 1 ms at 0.5 ms steps: fires at most every 1.5 ms
     assert max_spikes_per_step(dcn, 0.5) == 2
     assert max_spikes_per_step(dcn.model_copy(update={"t_ref_ms": 0.0}), 0.5) == 4
     assert max_spikes_per_step(dcn.model_copy(update={"t_ref_ms": 2.0}), 0.5) == 1
-    assert max_spikes_per_step(thesis_network().populations["mf"].neuron, 0.5) == 1
+    assert max_spikes_per_step(full_network().populations["mf"].neuron, 0.5) == 1
 
 
 def test_agonist_antagonist_io_declares_the_two_muscle_signals():
-    io = SNNController(output="agonist_antagonist").io(6)
+    io = SNNController(output="agonist_antagonist", network=full_network()).io(6)
     assert [(s.name, s.size, s.low, s.high) for s in io.writes] == [("muscle.ag", 6, 0.0, 1.0),
                                                                     ("muscle.at", 6, 0.0, 1.0)]
-    assert [s.name for s in SNNController().io(6).writes] == ["joint.torque"]
+    assert [s.name for s in SNNController(network=full_network()).io(6).writes] == ["joint.torque"]

@@ -8,10 +8,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cerebx.schema.network import NetworkConfig
 from cerebx.snn import kernels
 from cerebx.snn.network import Network
-from cerebx.snn.presets import DCN, GC, GC_RK4, PC, thesis_network
+from cerebx.snn.presets import DCN, GC, GC_RK4, PC
+from cerebx.snn.presets import network as full_network
+from cerebx.snn.schema import NetworkConfig
 
 
 def step_ms(neuron: dict) -> float:
@@ -212,7 +213,7 @@ def _drive(net: Network, n_steps: int, seed: int = 0) -> list[tuple[np.ndarray, 
 def test_skipping_resting_neurons_is_exact():
     """Integrating only the non-resting GCs (compact list) gives bit-identical spikes, weights and
     state to integrating all of them, and neurons without input leave the list."""
-    cfg = thesis_network(fibers=5, per_joint=20)
+    cfg = full_network(fibers=5, per_joint=20)
     a = Network(cfg, parallel=False, compact_min=1)  # every AMPA-only population compact
     b = Network(cfg, parallel=False, compact_min=10**9)  # nothing compact: all neurons integrated
     gc = a.index("gc")
@@ -235,7 +236,7 @@ def test_skipping_resting_neurons_is_exact():
 
 
 def test_state_roundtrip_with_compact_population():
-    cfg = thesis_network(fibers=5, per_joint=20)
+    cfg = full_network(fibers=5, per_joint=20)
     a = Network(cfg, parallel=False, compact_min=1)
     _drive(a, 150)
     st = {k: v.copy() for k, v in a.state_arrays().items()}
@@ -253,7 +254,7 @@ def test_delivery_caches_and_compaction_are_exact_and_consistent():
     (rebuilt after every compaction). Rebuilding them before every step gives bit-identical
     results; the compact list stays consistent (slot/cid inverse, resting neurons off the list)
     and a compaction leaves it in global index order."""
-    cfg = thesis_network(fibers=5, per_joint=20)
+    cfg = full_network(fibers=5, per_joint=20)
     a = Network(cfg, parallel=False, compact_min=1)
     b = Network(cfg, parallel=False, compact_min=1)
     gi = a.topo.index["gc"]

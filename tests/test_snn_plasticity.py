@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cerebx.schema.network import NetworkConfig
 from cerebx.snn.network import Network
 from cerebx.snn.presets import PC
+from cerebx.snn.schema import NetworkConfig
 from cerebx.snn.topology import ltd_kernel_table
 
 W0, LTP, LTD = 2.0, 0.002, -0.0008

@@ -171,7 +171,7 @@ def test_mismatched_stages_refused_with_one_line(muscle_plugin, load, capsys, tm
 
 
 def test_body_slots_run_after_the_receiver_before_the_robot_list(muscle_plugin, load, tmp_path):
-    from cerebx.stages.base import wire
+    from cerebx.wiring import wire
 
     cfg = load([*DEMO, "trials=1", "plant.kind=muscle_arm_test", "+muscle={kind: split_test}",
                 "robot=[{kind: mean}]"])

@@ -20,8 +20,8 @@ def _per_post(net, name):
 def test_the_2_joint_network_keeps_the_table_2_1_drive_per_cell(load):
     """PF-PC and MF-DCN are all-to-all: 2 joints instead of 6 give each PC / DCN a third of the inputs (and a
     third of them active per step), so the weights are 3 x Table 2.1's: synapses per cell x weight agree."""
-    ul = load([*FAST]).network
-    ch2 = load(["+task=circle", "network=thesis_ch2"]).network
+    ul = load([*FAST]).controller.network
+    ch2 = load(["+task=circle", "network=thesis_ch2"]).controller.network
     assert ul.name == "upper_limb" and ch2.name == "thesis_ch2"
     assert _per_post(ch2, "pf_pc") == 3 * _per_post(ul, "pf_pc") == 60000
     assert _per_post(ch2, "mf_dcn") == 3 * _per_post(ul, "mf_dcn") == 240
@@ -45,7 +45,7 @@ def test_the_pcs_hold_the_dcn_below_their_mf_drive_from_the_start(load, tmp_path
     """With the PCs silenced (PF-PC 0) the DCN fire at their MF/CF drive; at the preset's initial PF-PC weight
     the PCs fire and inhibit them, so PF-PC learning can move the output both ways. (At Table 2.1's
     unscaled weights both rates were the same, ~108 Hz: the PCs never fired and nothing was learned.)"""
-    silent = _dcn_rate(load, tmp_path / "silent", ["network.projections.pf_pc.weight_nS=0.0"])
+    silent = _dcn_rate(load, tmp_path / "silent", ["controller.network.projections.pf_pc.weight_nS=0.0"])
     preset = _dcn_rate(load, tmp_path / "preset", [])
     assert silent > 200.0  # ~260 Hz: up to 26 spikes of 50 cells per 2 ms, M up to ~0.65 at full scale 40
     assert 30.0 < preset < 0.5 * silent  # ~80 Hz

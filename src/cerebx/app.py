@@ -11,10 +11,10 @@ from hydra.core.hydra_config import HydraConfig
 from hydra.types import RunMode
 from omegaconf import DictConfig
 
+from cerebx import runfiles
 from cerebx.config import to_plain, user_choices
 from cerebx.errors import ConfigError
 from cerebx.schema.experiment import validate
-from cerebx.sweep import ERROR_FILE
 
 log = logging.getLogger("cerebx")
 
@@ -39,7 +39,7 @@ def run_app(cfg: DictConfig) -> float | None:
         for line in err.problems:
             print(line, file=sys.stderr)
         if in_sweep:
-            (run_dir / ERROR_FILE).write_text("; ".join(err.problems) + "\n")
+            (run_dir / runfiles.ERROR).write_text("; ".join(err.problems) + "\n")
             return None
         raise SystemExit(2) from None
     if reused is not None:

@@ -15,10 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.schema.controller import BoxEncoder, CFEncoder, ErrorGains
-from cerebx.schema.network import NetworkConfig
+from cerebx.controllers.snn.schema import BoxEncoder, CFEncoder, ErrorGains
 from cerebx.snn.encoders import ClimbingEncoder, MossyEncoder
 from cerebx.snn.network import Network
+from cerebx.snn.schema import NetworkConfig
 
 STEP_S = 0.002
 

@@ -13,7 +13,7 @@ import sys
 import time
 from typing import Any
 
-DEFAULT_NETWORKS = ("thesis_ch3", "multikernel")
+DEFAULT_NETWORKS = ("full", "multikernel")
 
 
 def _one_network(name: str, seconds: float, warmup: float, parallel: bool) -> dict[str, Any]:
@@ -25,7 +25,7 @@ def _one_network(name: str, seconds: float, warmup: float, parallel: bool) -> di
 
     import_s = time.perf_counter() - t0
     exp, _ = load(["+task=circle", f"network={name}"])
-    out = bench_network(exp.network, seconds=seconds, warmup=warmup, parallel=parallel)
+    out = bench_network(exp.controller.network, seconds=seconds, warmup=warmup, parallel=parallel)
     out["import_s"] = round(import_s, 3)
     loop = closed_loop_rt(["+task=circle", f"network={name}", f"controller.parallel={str(parallel).lower()}"],
                           seconds=seconds, warmup_s=warmup)

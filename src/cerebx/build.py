@@ -23,8 +23,9 @@ from cerebx.controllers.base import Controller
 from cerebx.errors import ConfigError
 from cerebx.loop.link import Link
 from cerebx.signals import Signal
-from cerebx.stages.base import Receiver, Stage, wire
+from cerebx.stages.base import Receiver, Stage
 from cerebx.stages.controllers import Composite, TorqueControllerStage
+from cerebx.wiring import wire
 
 
 def component_rng(seed: int, name: str) -> np.random.Generator:

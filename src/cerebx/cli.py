@@ -13,6 +13,7 @@ import re
 import sys
 from pathlib import Path
 
+from cerebx import runfiles
 from cerebx.errors import CerebxError
 
 USAGE = """usage: cerebx COMMAND [args]
@@ -28,7 +29,7 @@ commands:
   tune [--out PATH] OVERRIDES...                       Ziegler-Nichols PD gains on the simulated plant
 
 groups: task (required, +task=), controller (snn), plant (baxter), delay (none),
-        network (thesis_ch3), experiment (presets: +experiment=NAME)
+        experiment (presets: +experiment=NAME); network (full), with controller=snn
 """
 
 COMMANDS = ("run", "validate", "inspect", "bench", "report", "tune", "summarize")
@@ -138,10 +139,11 @@ def _validate(args: list[str]) -> int:
     import yaml
 
     print(yaml.safe_dump(plain, sort_keys=False, default_flow_style=None, width=120), end="")
-    net = exp.network
+    net = getattr(exp.controller, "network", None)
+    about = "" if net is None else (f" network={net.name} ({net.n_neurons:,} neurons, {net.n_synapses:,} synapses, "
+                                    f"{net.n_plastic:,} plastic)")
     print(f"# valid: task={exp.task.kind} controller={exp.controller.kind} plant={exp.plant.kind} "
-          f"delay={exp.delay.kind} network={net.name} ({net.n_neurons:,} neurons, "
-          f"{net.n_synapses:,} synapses, {net.n_plastic:,} plastic)")
+          f"delay={exp.delay.kind}{about}")
     return 0
 
 
@@ -158,7 +160,7 @@ def _inspect(args: list[str]) -> int:
         return _fail([f"{p}: no such file or folder"])
     run_dir = p if p.is_dir() else p.parent
     problems: list[str] = []
-    if (run_dir / "summary.json").exists() or p.is_dir():
+    if (run_dir / runfiles.SUMMARY).exists() or p.is_dir():
         try:
             print(format_summary(read_summary(run_dir), run_dir))
         except CerebxError as err:

@@ -12,9 +12,18 @@ import threading
 from pathlib import Path
 from typing import Any
 
-from omegaconf import DictConfig, OmegaConf
+import yaml
+from hydra import compose as hydra_compose
+from hydra import initialize_config_module
+from hydra.core.global_hydra import GlobalHydra
+from hydra.core.override_parser.overrides_parser import OverridesParser
+from hydra.errors import HydraException
+from omegaconf import DictConfig, OmegaConf, open_dict
+from omegaconf.errors import OmegaConfBaseException
 
 from cerebx.errors import ConfigError
+from cerebx.estimate import Estimate, estimate, total
+from cerebx.guard import check_args, conf_roots
 from cerebx.schema.experiment import validate
 
 MAX_SWEEP_JOBS = 1000
@@ -23,8 +32,6 @@ MAX_SWEEP_JOBS = 1000
 
 def to_plain(cfg: DictConfig) -> dict[str, Any]:
     """The composed config as plain data (interpolations resolved, Hydra's own node dropped)."""
-    from omegaconf.errors import OmegaConfBaseException
-
     try:
         data = OmegaConf.to_container(cfg, resolve=True, throw_on_missing=True)
     except OmegaConfBaseException as err:
@@ -48,6 +55,9 @@ def _hydra_lines(err: Exception) -> list[str]:
         key = m.group(1)
         if "." in key:
             return [f"{key}: not in the composed config (schema defaults are not); set it with +{key}=VALUE"]
+        if "No match in the defaults list" in text and _is_group(key):
+            return [f"{key}: none of the chosen options takes a {key} (it is chosen inside another option, "
+                    f"e.g. network inside controller=snn)"]
         return [f"{key}: '{key}' has no default to override; add it with +{key}=NAME"]
     m = re.search(r"Could not append to config. An item is already at '([^']+)'", text)
     if m:
@@ -57,6 +67,11 @@ def _hydra_lines(err: Exception) -> list[str]:
         return [f"{m.group(1)}: unknown key (add it with +{m.group(1)}=... only if the schema has it)"]
     first = next((ln.strip() for ln in text.splitlines() if ln.strip()), type(err).__name__)
     return [f"overrides: {first}"]
+
+
+def _is_group(name: str) -> bool:
+    """``name`` is a config group of cerebx or of a plugin."""
+    return any((root / name).is_dir() for root in conf_roots())
 
 
 _COMPOSING = threading.RLock()  # Hydra's global state and the lazily built schema: one thread at a time
@@ -69,15 +84,6 @@ def compose(overrides: list[str]) -> DictConfig:
 
 def compose_with_choices(overrides: list[str]) -> tuple[DictConfig, dict[str, str]]:
     """Compose, and return the option chosen in each config group (what ``cerebx run`` records as presets)."""
-    from hydra import compose as hydra_compose
-    from hydra import initialize_config_module
-    from hydra.core.global_hydra import GlobalHydra
-    from hydra.errors import HydraException
-    from omegaconf import open_dict
-    from omegaconf.errors import OmegaConfBaseException
-
-    from cerebx.guard import check_args
-
     problems = check_args(overrides)
     if problems:
         raise ConfigError(problems)
@@ -117,41 +123,38 @@ def load(overrides: list[str]) -> tuple[Any, dict[str, Any]]:
 
 def _with_hints(problems: list[str], plain: dict[str, Any]) -> list[str]:
     """Point a network/encoder size mismatch to the experiment presets made for that network."""
-    net = (plain.get("network") or {}).get("name") if isinstance(plain.get("network"), dict) else None
-    presets = _presets_for_network(str(net)) if net else ()
+    ctrl = plain.get("controller")
+    net = ctrl.get("network") if isinstance(ctrl, dict) else None
+    presets = _presets_for_network(str(net.get("name"))) if isinstance(net, dict) else ()
     if not presets:
         return problems
-    hint = f" (network {net!r} comes with matching encoders in +experiment={' or +experiment='.join(presets)})"
+    choices = " or +experiment=".join(presets)
+    hint = f" (network {net.get('name')!r} comes with matching encoders in +experiment={choices})"
     return [p + hint if p.startswith("controller.mf.fibers_per_signal:") else p for p in problems]
 
 
 @functools.cache
 def _presets_for_network(name: str) -> tuple[str, ...]:
-    """Experiment presets that choose network ``name`` for the SNN controller (``override /network: NAME``)."""
-    import yaml
-
-    from cerebx.guard import CONF_ROOT
-
+    """Experiment presets (of cerebx and its plugins) that choose network ``name`` for a spiking controller
+    (``override /network: NAME``)."""
     out = []
-    for f in sorted((CONF_ROOT / "experiment").glob("*.yaml")):
-        try:
-            doc = yaml.safe_load(f.read_text()) or {}
-        except (OSError, yaml.YAMLError):
-            continue
-        chosen: dict[str, Any] = {}
-        for entry in doc.get("defaults") or [] if isinstance(doc, dict) else []:
-            if isinstance(entry, dict):
-                chosen.update(entry)
-        if chosen.get("override /network") == name and str(chosen.get("override /controller", "snn")).startswith("snn"):
-            out.append(f.stem)
+    for root in conf_roots():
+        for f in sorted((root / "experiment").glob("*.yaml")):
+            try:
+                doc = yaml.safe_load(f.read_text()) or {}
+            except (OSError, yaml.YAMLError):
+                continue
+            chosen: dict[str, Any] = {}
+            for entry in doc.get("defaults") or [] if isinstance(doc, dict) else []:
+                if isinstance(entry, dict):
+                    chosen.update(entry)
+            if chosen.get("override /network") == name:
+                out.append(f.stem)
     return tuple(out)
 
 
 def expand_sweep(overrides: list[str]) -> list[list[str]]:
     """All override combinations of a ``-m`` sweep (``a=1,2 b=x,y`` -> four lists)."""
-    from hydra.core.override_parser.overrides_parser import OverridesParser
-    from hydra.errors import HydraException
-
     try:
         parsed = OverridesParser.create().parse_overrides([o for o in overrides if not _is_hydra(o)])
     except HydraException as err:
@@ -172,8 +175,6 @@ def expand_sweep(overrides: list[str]) -> list[list[str]]:
 def check(overrides: list[str], multirun: bool = False, estimates: list | None = None) -> list[str]:
     """Every problem of every job the command would run, one line each (empty when all is well);
     the disk and time estimate of each valid job is appended to ``estimates``."""
-    from cerebx.estimate import estimate
-
     try:
         jobs = expand_sweep(overrides) if multirun else [overrides]
     except ConfigError as err:
@@ -190,6 +191,18 @@ def check(overrides: list[str], multirun: bool = False, estimates: list | None =
                 if prefix + line not in seen:
                     seen.append(prefix + line)
     return seen
+
+
+def estimate_jobs(jobs: list[list[str]]) -> tuple[Estimate, list[str]]:
+    """The summed estimate of runs given by their overrides (``init_from`` left out: the run it names may
+    not exist yet, and it changes no size); one line per job that does not validate."""
+    parts, problems = [], []
+    for overrides in jobs:
+        try:
+            parts.append(estimate(load([o for o in overrides if not o.lstrip("+").startswith("init_from=")])[0]))
+        except ConfigError as err:
+            problems.append(f"[{' '.join(overrides)}] {err.problems[0]}")
+    return total(parts), problems
 
 
 RUN_DIR_DEFAULTS = {"run": "runs", "sweep": "runs/multirun"}

@@ -8,16 +8,16 @@ run                                          run.mcap per sim. s     wall
 ===========================================  ======================  ==========================
 planar2 + PD (``+experiment=demo``)          113 kB                  README bench
 Baxter + PD                                  288 kB                  README bench
-Baxter + SNN ``small`` / ``thesis_ch3``      285 kB / 320 kB         README bench
+Baxter + SNN ``small`` / ``full``      285 kB / 320 kB         README bench
 ===========================================  ======================  ==========================
 
 hence about 25 kB/s plus 44 kB/s per joint for the joint and control channels, and 32 kB/s for the
 default spike channels of an SNN; without joint states (``recording.joint_states=false``) a third of the
 per-joint rate is kept for ``/control`` (*constructed*: one of three per-step channels). The learned SNN
-state holds 4 bytes per plastic synapse and ~44 bytes per neuron before compression (``thesis_ch3``:
+state holds 4 bytes per plastic synapse and ~44 bytes per neuron before compression (``full``:
 147.9 MB raw, 0.7 MB of weights once zlib-compressed after 2 trials, because most PF-PC weights stay at
 their initial value); it is written compressed. Wall
-time uses the bench's real-time factors of a quiet machine (Baxter + PD 30x; ``thesis_ch3`` closed
+time uses the bench's real-time factors of a quiet machine (Baxter + PD 30x; ``full`` closed
 loop with recording 7x, i.e. 0.033 s + 3.1 ns per plastic synapse per simulated second); a shared
 machine is slower.
 """
@@ -70,10 +70,11 @@ def _duration(s: float) -> str:
     return f"{s:.0f} s"
 
 
-def _snn_parts(exp: Any) -> list[Any]:
+def _network_parts(exp: Any) -> list[Any]:
+    """The controller parts that run a spiking network (a ``network`` field)."""
     c = exp.controller
     parts = c.parts if c.kind == "composite" else [c]
-    return [p for p in parts if p.kind == "snn"]
+    return [p for p in parts if getattr(p, "network", None) is not None]
 
 
 def estimate(exp: Any) -> Estimate:
@@ -83,12 +84,12 @@ def estimate(exp: Any) -> Estimate:
     per_joint = BYTES_PER_S_PER_JOINT if exp.recording.joint_states else BYTES_PER_S_PER_JOINT / 3
     per_s = BYTES_PER_S_BASE + per_joint * n
     per_s /= exp.recording.decimation
-    snn = _snn_parts(exp)
-    plastic = exp.network.n_plastic if snn else 0
-    if snn and any(p.record_spikes for p in snn):
+    snn = _network_parts(exp)
+    plastic = sum(p.network.n_plastic for p in snn)
+    if any(getattr(p, "record_spikes", None) for p in snn):
         per_s += BYTES_PER_S_SPIKES
-    state = (STATE_BYTES_PER_PLASTIC * plastic + STATE_BYTES_PER_NEURON * exp.network.n_neurons
-             if snn and exp.recording.save_state else 0.0)
+    neurons = sum(p.network.n_neurons for p in snn)
+    state = STATE_BYTES_PER_PLASTIC * plastic + STATE_BYTES_PER_NEURON * neurons if exp.recording.save_state else 0.0
     wall = sim_s * (WALL_PER_SIM_S + WALL_PER_SIM_S_PER_PLASTIC * plastic)
     return Estimate(sim_s, per_s * sim_s, state, wall)
 
@@ -108,21 +109,6 @@ def disk_problem(total_bytes: float, folder: Path, what: str) -> str | None:
         return (f"{what}: needs ~{_size(total_bytes)} but {folder} has {_size(free)} free; lower trials or "
                 "record less (recording.decimation=N, recording.joint_states=false)")
     return None
-
-
-def estimate_jobs(jobs: list[list[str]]) -> tuple[Estimate, list[str]]:
-    """The summed estimate of runs given by their overrides (``init_from`` left out: the run it names may
-    not exist yet, and it changes no size); one line per job that does not validate."""
-    from cerebx.config import load
-    from cerebx.errors import ConfigError
-
-    parts, problems = [], []
-    for overrides in jobs:
-        try:
-            parts.append(estimate(load([o for o in overrides if not o.lstrip("+").startswith("init_from=")])[0]))
-        except ConfigError as err:
-            problems.append(f"[{' '.join(overrides)}] {err.problems[0]}")
-    return total(parts), problems
 
 
 def total(parts: list[Estimate]) -> Estimate:

@@ -13,11 +13,14 @@ sets values of an installed plugin and is checked like every shipped preset); an
 from __future__ import annotations
 
 import functools
+import importlib.resources
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import yaml
+
+from cerebx import registry
 
 CODE_KEYS = ("_target_", "()")
 """Keys that name a callable: Hydra's instantiate and logging.config's factory key."""
@@ -158,9 +161,15 @@ def check_tree(root: Path, label_root: Path | None = None) -> list[str]:
     return problems
 
 
+def conf_roots() -> list[Path]:
+    """cerebx's own preset tree, then each loaded plugin's (``registry.add_config_source``)."""
+    registry.load_plugins()
+    return [CONF_ROOT, *(Path(str(importlib.resources.files(s.target))) for s in registry.config_sources)]
+
+
 @functools.cache
 def _package_tree_problems() -> tuple[str, ...]:
-    return tuple(check_tree(CONF_ROOT, CONF_ROOT.parent))
+    return tuple(line for root in conf_roots() for line in check_tree(root, root.parent))
 
 
 def _flag_value(args: list[str], i: int) -> tuple[str | None, int]:

@@ -79,7 +79,7 @@ def trials_to_threshold(mae_per_trial: list[float], threshold: float) -> int | N
     return None
 
 
-# ---- Luque et al. 2011, Eq. 8-11: learning estimators over a MAE curve (one value per trial) ----------
+# ---- learning estimators over a MAE curve (one value per trial; docs/models.md) ----------------------
 
 def final_error(mae_per_trial: list[float], n: int = 30) -> float:
     """Eq. 9: mean MAE of the last ``n`` trials."""

@@ -1,20 +1,25 @@
-"""Named registries that map a config ``kind`` to its schema and builder.
+"""Named registries that map a config ``kind`` to its schema and builder, and the plugins that fill them.
 
 Groups: ``task``, ``plant``, ``controller`` (brain-side parts), ``stage`` (brain- or robot-side
 stages: torque filters, the supervisor, muscles, ...), ``delay`` (link delay models), ``event``
-(plant events) and ``encoder`` (cerebellar input codes). Built-in variants register in
-``schema/builtin.py``; third-party packages register through the ``cerebx.plugins`` entry-point
-group (each entry point is a callable taking no arguments that registers its variants).
-Configuration only ever names a ``kind``: it cannot import anything.
+(plant events) and ``encoder`` (cerebellar input codes). Every kind arrives through a plugin: a callable
+taking no arguments, exposed as a ``cerebx.plugins`` entry point, that registers its kinds here. The
+platform's own kinds come the same way (entry point ``core``, ``cerebx.builtin:register``). A plugin may
+also add a folder of Hydra presets (:func:`add_config_source`) and a report module with its figures and
+studies (:func:`add_report`). Configuration only ever names a ``kind``: it cannot import anything.
 
 A config field that holds "any registered kind of group G" is typed ``Plugin("G")``: the kind is
 looked up when the config is validated, so a plugin's kinds are accepted everywhere the built-in
 ones are.
+
+``CEREBX_PLUGINS`` (comma-separated entry-point names, e.g. ``core``) loads only those plugins; unset,
+every installed plugin is loaded.
 """
 
 from __future__ import annotations
 
 import importlib
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from importlib.metadata import entry_points
@@ -22,15 +27,20 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, WrapValidator
 
+ENTRY_POINTS = "cerebx.plugins"
+ONLY_ENV = "CEREBX_PLUGINS"
+
 
 @dataclass(frozen=True)
 class Entry:
     kind: str
     schema: type[BaseModel]
     builder: str | Callable[..., Any]
+    plugin: str
 
     def resolve(self) -> Callable[..., Any]:
-        """The builder callable; a ``"module:attr"`` string is imported on first use."""
+        """The builder callable; a ``"module:attr"`` string is imported on first use (a plugin's module,
+        loaded by name)."""
         if callable(self.builder):
             return self.builder
         module, _, attr = self.builder.partition(":")
@@ -38,7 +48,7 @@ class Entry:
 
 
 class Registry:
-    """Variants of one component group (``task``, ``plant``, ``controller``, ``delay``)."""
+    """Variants of one component group (``task``, ``plant``, ``controller``, ``delay`` ...)."""
 
     def __init__(self, group: str):
         self.group = group
@@ -50,8 +60,9 @@ class Registry:
         if not isinstance(kind, str):
             raise TypeError(f"{schema.__name__}: the 'kind' field needs a string default")
         if kind in self._entries and self._entries[kind].schema is not schema:
-            raise ValueError(f"{self.group} kind {kind!r} is already registered")
-        self._entries[kind] = Entry(kind, schema, builder)
+            raise ValueError(f"{self.group} kind {kind!r} is already registered by plugin "
+                             f"{self._entries[kind].plugin!r}")
+        self._entries[kind] = Entry(kind, schema, builder, _loading or "<direct>")
         return schema
 
     def kinds(self) -> list[str]:
@@ -104,15 +115,58 @@ def Plugin(group: str) -> Any:  # noqa: N802 - reads as a type in schemas
 
     return Annotated[Any, WrapValidator(pick)]
 
-_plugins_loaded = False
+
+@dataclass(frozen=True)
+class Source:
+    """Something a plugin adds besides kinds: a folder of presets or a report module."""
+
+    plugin: str
+    target: str
+
+
+config_sources: list[Source] = []
+"""Hydra config folders of plugins (``pkg://package.conf``), searched after cerebx's own ``conf/``."""
+
+report_modules: list[Source] = []
+"""Modules that register figures and studies (imported by the report engine only)."""
+
+
+def add_config_source(package: str) -> None:
+    """Add the presets in ``package`` (a Python package holding config-group folders, e.g.
+    ``my_lab.conf`` with ``experiment/``, ``controller/`` ...) to every composition."""
+    config_sources.append(Source(_loading or "<direct>", package))
+
+
+def add_report(module: str) -> None:
+    """Name the module whose import registers this plugin's figures and studies (``cerebx.report``)."""
+    report_modules.append(Source(_loading or "<direct>", module))
+
+
+_loaded: list[str] = []
+_loading: str | None = None
+_done = False
 
 
 def load_plugins() -> None:
-    """Import the built-in variants, then every ``cerebx.plugins`` entry point (once)."""
-    global _plugins_loaded
-    if _plugins_loaded:
+    """Call every ``cerebx.plugins`` entry point once (those named in ``CEREBX_PLUGINS`` when it is set)."""
+    global _done, _loading
+    if _done:
         return
-    _plugins_loaded = True
-    importlib.import_module("cerebx.schema.builtin")
-    for ep in entry_points(group="cerebx.plugins"):
-        ep.load()()
+    _done = True
+    only = os.environ.get(ONLY_ENV)
+    wanted = None if only is None else {n.strip() for n in only.split(",") if n.strip()}
+    for ep in sorted(entry_points(group=ENTRY_POINTS), key=lambda e: (e.name != "core", e.name)):
+        if wanted is not None and ep.name not in wanted:
+            continue
+        _loading = ep.name
+        try:
+            ep.load()()
+        finally:
+            _loading = None
+        _loaded.append(ep.name)
+
+
+def loaded_plugins() -> list[str]:
+    """Names of the plugins loaded so far, ``core`` first."""
+    load_plugins()
+    return list(_loaded)

@@ -12,9 +12,6 @@ from __future__ import annotations
 import datetime as _dt
 from pathlib import Path
 
-ERROR_FILE = "error.txt"
-"""Written into a job folder when the job failed before its run could start (its config was refused)."""
-
 MAX_EXIT_CODE = 100
 OK_STATUSES = ("completed", "diverged")  # diverging is a result of the experiment, not a failure of the job
 

@@ -1,4 +1,4 @@
-"""Ziegler-Nichols PD tuning on the simulated plant (the thesis tuned its PD baseline this way, §3.3.1).
+"""Ziegler-Nichols PD tuning on the simulated plant (how a PD baseline is commonly tuned on a robot).
 
 Per joint: the arm is first settled at a posture with the hold PD (the configured PD controller); the
 settled torque is kept as a feedforward so gravity stays balanced. Then the joint under test runs

@@ -27,15 +27,16 @@ from typing import Any
 
 import cloudpickle
 
-from cerebx import __version__
+from cerebx import __version__, runfiles
 from cerebx.errors import CerebxError, ConfigError
 from cerebx.loop.loop import ClosedLoop
 from cerebx.recording.recorder import Recorder
 from cerebx.recording.segments import FIRST, add_segment
+from cerebx.schema.legacy import upgrade
 
 log = logging.getLogger("cerebx")
 
-CHECKPOINT = "checkpoint.pkl"
+CHECKPOINT = runfiles.CHECKPOINT
 AUTO = "auto"  # resume=auto: reuse, continue or start the run in its own output folder
 _LOOP_FIELDS = ("tick", "trials_done", "metrics", "_sensed", "_task_rng", "_events")
 _RECORDER = "recorder"  # persistent id of the run's recorder inside the pickle
@@ -75,7 +76,7 @@ def recorder_path(cfg: Any, run_dir: Path) -> Path:
 
 def _checkpoint_head(run_dir: Path) -> dict:
     try:
-        return json.loads((run_dir / (CHECKPOINT + ".json")).read_text())
+        return json.loads((run_dir / runfiles.CHECKPOINT_HEAD).read_text())
     except FileNotFoundError:
         raise CerebxError(f"resume: {run_dir / CHECKPOINT} does not exist (the run saved no checkpoint)") from None
 
@@ -96,9 +97,7 @@ def save(loop: ClosedLoop, run_dir: Path, wall_seconds: float) -> None:
     tmp_head.write_text(json.dumps(head))
     os.replace(tmp_head, run_dir / (CHECKPOINT + ".json"))
     if loop.cfg.recording.save_state:
-        from cerebx.loop.runner import STATE_FILE
-
-        loop.controller.save_state(run_dir / STATE_FILE)
+        loop.controller.save_state(run_dir / runfiles.STATE)
 
 
 def due(loop: ClosedLoop) -> bool:
@@ -145,7 +144,7 @@ def expand_args(args: list[str]) -> list[str]:
     if not given or given[-1] == f"resume={AUTO}":
         return args
     run_dir = Path(given[-1].split("=", 1)[1].strip("'\""))
-    saved = run_dir / ".hydra" / "overrides.yaml"
+    saved = run_dir / runfiles.OVERRIDES
     try:
         import yaml
 
@@ -168,7 +167,7 @@ def _check_same(old: Any, new: Any, where: str = "", whose: str = "the resumed r
 
 def finish(run_dir: Path) -> None:
     """The run completed: its checkpoint is no longer needed."""
-    for name in (CHECKPOINT, CHECKPOINT + ".json"):
+    for name in (CHECKPOINT, runfiles.CHECKPOINT_HEAD):
         (run_dir / name).unlink(missing_ok=True)
 
 
@@ -215,23 +214,6 @@ def continued(exp: Any, plain: dict, output_dir: Path) -> tuple[Any, Path, dict 
     return exp, Path(exp.resume), None
 
 
-# Options added since runs were first recorded, with the value that does what runs without them did
-# (CHANGELOG: their recorded data did not change). A config that lacks one counts as having that value.
-ADDED_WITHOUT_EFFECT: dict[str, Any] = {"controller.output": "torque", "controller.decoder.spikes_full_scale": 100.0}
-
-
-def _with_added(config: dict) -> dict:
-    out = json.loads(json.dumps(config))
-    for dotted, value in ADDED_WITHOUT_EFFECT.items():
-        *parents, last = dotted.split(".")
-        node = out
-        for part in parents:
-            node = node.get(part) if isinstance(node, dict) else None
-        if isinstance(node, dict) and last not in node:
-            node[last] = value
-    return out
-
-
 def stale(run_dir: Path, plain: dict, summary: dict) -> str | None:
     """Why the completed run in ``run_dir`` cannot stand for the run ``plain`` asks for now, or None: its
     recorded configuration must equal ``plain`` (but for the trial count, logging and resumption), and
@@ -243,14 +225,14 @@ def stale(run_dir: Path, plain: dict, summary: dict) -> str | None:
     except (CerebxError, KeyError, OSError, ValueError):
         return "its recorded configuration cannot be read"
     try:
-        _check_same(*({k: v for k, v in _with_added(d).items() if k not in NOT_SHARED} for d in (old, plain)),
+        _check_same(*({k: v for k, v in upgrade(d).items() if k not in NOT_SHARED} for d in (old, plain)),
                     whose="its")
     except ConfigError as err:
         return f"the configuration changed: {err}"
     source = plain.get("init_from")
     if source:
         try:
-            written = (Path(source) / "summary.json").stat().st_mtime
+            written = (Path(source) / runfiles.SUMMARY).stat().st_mtime
         except OSError:
             return None  # validation reports a missing init_from run
         if written > float(summary.get("started_at") or 0.0):
@@ -260,7 +242,7 @@ def stale(run_dir: Path, plain: dict, summary: dict) -> str | None:
 
 def _completed(run_dir: Path) -> dict | None:
     try:
-        s = json.loads((run_dir / "summary.json").read_text())
+        s = json.loads((run_dir / runfiles.SUMMARY).read_text())
     except (OSError, ValueError):
         return None
     return s if s.get("status") == "completed" else None
@@ -268,6 +250,6 @@ def _completed(run_dir: Path) -> dict | None:
 
 def _clear(run_dir: Path) -> None:
     """Drop what an unfinished attempt without a usable checkpoint left (a fresh run writes it anew)."""
-    for p in [*run_dir.glob("run.*.mcap"), run_dir / "segments.json", run_dir / CHECKPOINT,
-              run_dir / (CHECKPOINT + ".json"), run_dir / "summary.json"]:
+    for p in [*run_dir.glob("run.*.mcap"), run_dir / runfiles.SEGMENTS, run_dir / CHECKPOINT,
+              run_dir / runfiles.CHECKPOINT_HEAD, run_dir / runfiles.SUMMARY]:
         p.unlink(missing_ok=True)

@@ -13,7 +13,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from cerebx import __version__
+from cerebx import __version__, runfiles
 from cerebx.build import build_components
 from cerebx.errors import CerebxError, Diverged
 from cerebx.loop import resume
@@ -23,9 +23,6 @@ from cerebx.recording.sentinel import Sentinel
 from cerebx.recording.summary import new_summary, trial_fields, write_summary
 
 log = logging.getLogger("cerebx")
-
-STATE_FILE = "controller_state.npz"
-
 
 @contextmanager
 def _sigterm_as_interrupt():
@@ -79,7 +76,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             ctx = loop.ctx if loop is not None else build_components(cfg, run_dir)
             rec.joint_names = tuple(ctx.plant.joint_names)
             if cfg.init_from and loop is None:
-                state = Path(cfg.init_from) / STATE_FILE
+                state = Path(cfg.init_from) / runfiles.STATE
                 if not state.exists():
                     raise CerebxError(f"init_from: {state} does not exist")
                 ctx.brain[0].load_state(state)
@@ -122,7 +119,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             summary.update(trial_fields(loop.metrics, loop.sim_seconds))
             if cfg.recording.save_state and loop.trials_done > 0:
                 try:
-                    loop.controller.save_state(run_dir / STATE_FILE)
+                    loop.controller.save_state(run_dir / runfiles.STATE)
                 except Exception as err:  # the state is a bonus; the log must still be finished
                     log.error("could not save controller state: %s", err)
         summary["wall_seconds"] = wall

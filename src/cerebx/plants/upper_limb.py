@@ -1,5 +1,5 @@
 """A musculoskeletal upper limb: shoulder and elbow flexion-extension in a vertical plane, moved by
-seven Hill-type muscles (thesis §4.3.1, Fig. 4.1), built from ``upper_limb.xml`` (OpenSim Arm26 after
+seven Hill-type muscles, built from ``upper_limb.xml`` (OpenSim Arm26 after
 Holzbaur et al. 2005, plus the MoBL-ARMS anterior deltoid; the sources are named in the MJCF header).
 
 Command: ``muscle.activation[7]`` is each muscle's neural excitation u in [0, 1] (the motor-neuron rate).

@@ -10,6 +10,7 @@ from typing import Any
 from mcap.decoder import DecoderFactory
 from mcap.reader import make_reader
 
+from cerebx import runfiles
 from cerebx.errors import CerebxError
 from cerebx.recording.segments import segments
 from cerebx.recording.summary import read_summary
@@ -31,7 +32,7 @@ class JsonDecoderFactory(DecoderFactory):
 
 def mcap_path(path: Path | str) -> Path:
     p = Path(path)
-    return p / "run.mcap" if p.is_dir() else p
+    return p / runfiles.MCAP if p.is_dir() else p
 
 
 def _reader(fh):

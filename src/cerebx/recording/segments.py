@@ -15,10 +15,11 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+from cerebx import runfiles
 from cerebx.errors import CerebxError
 
-FIRST = "run.mcap"
-INDEX = "segments.json"
+FIRST = runfiles.MCAP
+INDEX = runfiles.SEGMENTS
 # Written when a trial ends, stamped with the time of the next trial's first tick: at a segment boundary
 # (a checkpoint, taken between trials) they belong to the segment before it, every other topic to the one after.
 TRIAL_END_TOPICS = frozenset({"/trial_metrics", "/weights"})

@@ -20,6 +20,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+from cerebx import runfiles
 from cerebx.errors import CerebxError
 from cerebx.recording.segments import segments
 
@@ -80,7 +81,7 @@ def seal(path: Path) -> bool:
 
 def mark_killed(run_dir: Path) -> None:
     """Set a ``running`` summary to ``killed`` (written atomically, other keys kept)."""
-    path = run_dir / "summary.json"
+    path = run_dir / runfiles.SUMMARY
     try:
         s = json.loads(path.read_text())
     except (OSError, ValueError):
@@ -121,7 +122,7 @@ def _watch(run_dir: Path) -> int:
     try:
         files = [seg.path for seg in segments(run_dir)]  # a resumed run writes into its last segment
     except CerebxError:
-        files = [run_dir / "run.mcap"]
+        files = [run_dir / runfiles.MCAP]
     for path in files:
         seal(path)
     mark_killed(run_dir)

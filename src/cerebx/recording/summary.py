@@ -16,9 +16,10 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
+from cerebx import runfiles
 from cerebx.errors import CerebxError
 
-SUMMARY_FILE = "summary.json"
+SUMMARY_FILE = runfiles.SUMMARY
 
 Status = Literal["running", "completed", "interrupted", "diverged", "failed", "killed"]
 
@@ -33,7 +34,7 @@ class RunSummary(BaseModel):
     controller: str = Field(description="controller kind")
     plant: str = Field(description="plant kind")
     delay: str = Field(description="delay kind")
-    network: str = Field("", description="network preset name")
+    network: str | None = Field(None, description="name of the controller's spiking network (null: it has none)")
     seed: int = Field(ge=0)
     trials: int = Field(ge=1, description="trials asked for")
     warmup_trials: int = Field(0, ge=0)
@@ -57,10 +58,19 @@ class RunSummary(BaseModel):
     host: str | None = Field(None, description="host of that process")
 
 
+def network_name(controller: Any) -> str | None:
+    """The name of the spiking network a controller (or a part of a composite one) runs, or None."""
+    net = getattr(controller, "network", None)
+    if net is not None:
+        return net.name
+    names = [n for part in getattr(controller, "parts", ()) if (n := network_name(part))]
+    return names[0] if names else None
+
+
 def new_summary(cfg: Any, **fields: Any) -> dict[str, Any]:
     """The summary a run starts with: status running, nothing done yet."""
     return {"status": "running", "task": cfg.task.kind, "controller": cfg.controller.kind,
-            "plant": cfg.plant.kind, "delay": cfg.delay.kind, "network": cfg.network.name, "seed": cfg.seed,
+            "plant": cfg.plant.kind, "delay": cfg.delay.kind, "network": network_name(cfg.controller), "seed": cfg.seed,
             "trials": cfg.trials, "warmup_trials": cfg.warmup_trials, "trials_completed": 0,
             "mae_per_trial": [], "final_mae": None, "sim_seconds": 0.0, "wall_seconds": 0.0, "rt_factor": None,
             "error": None, "pid": os.getpid(), "host": socket.gethostname(), **fields}

@@ -18,8 +18,11 @@ import time
 from collections import defaultdict
 from pathlib import Path
 
+from cerebx import runfiles
 from cerebx.errors import CerebxError
-from cerebx.report.registry import Figure, MissingRuns, all_figures, fmt
+from cerebx.report.delays import delay_rows
+from cerebx.report.plot import fmt
+from cerebx.report.registry import Figure, MissingRuns, all_figures
 from cerebx.report.runs import RunSet, find_run_dirs, load_runs
 
 MAX_TRACKING_RUNS = 12  # per-run joint-tracking figures only for small run sets
@@ -128,8 +131,6 @@ def build(run_dirs: list[Path], out: Path, names: list[str] | None = None,
     runs_rows = _runs_table(runs)
     _write_table(out, "runs", runs_rows)
     _write_table(out, "paper_vs_cerebx", paper_rows)
-    from cerebx.report.delays import delay_rows
-
     _write_table(out, "delays", delay_rows(runs))
     miss = "".join(f"<li>{html.escape(m)}</li>" for m in missing)
     probs = "".join(f"<li>{html.escape(p)}</li>" for p in problems)
@@ -140,9 +141,9 @@ table{{border-collapse:collapse;font-size:13px}}td,th{{border:1px solid #ccc;pad
 .cap{{font-size:14px;color:#333}}.runs{{font-size:12px;color:#777}}section{{border-top:1px solid #ddd;
 margin-top:2em}}</style></head><body>
 <h1>cerebx report</h1>
-<p>{len(runs)} runs, {len(drawn)} of {len(chosen)} thesis figures drawn from their logs. Each figure is shown
-with the thesis's numbers beside cerebx's (all numbers in paper_vs_cerebx.csv). Absolute numbers depend on the
-plant (the real Baxter vs a MuJoCo model); the shapes and orderings are what should hold.</p>
+<p>{len(runs)} runs, {len(drawn)} of {len(chosen)} figures drawn from their logs. Each figure is shown
+with the paper's numbers beside cerebx's (all numbers in paper_vs_cerebx.csv). Absolute numbers depend on the
+plant (a real robot vs a MuJoCo model); the shapes and orderings are what should hold.</p>
 <ul>{''.join(toc)}</ul>
 {'<h3>Not drawn (runs missing)</h3><ul>' + miss + '</ul>' if miss else ''}
 {''.join(sections)}
@@ -169,7 +170,7 @@ def main(argv: list[str]) -> int:
     ap.add_argument("runs", nargs="*", type=Path, help="run folders or folders of runs (default: runs/)")
     ap.add_argument("--profile", choices=("quick", "full"),
                     help="run the missing studies of this profile into runs/report/PROFILE first")
-    ap.add_argument("--figures", help="comma-separated figure names (default: all), e.g. fig3_4,fig3_6")
+    ap.add_argument("--figures", help="comma-separated figure names (default: all; --list shows them)")
     ap.add_argument("--jobs", type=int, default=2, help="studies run at once (default 2); each is one "
                     "`cerebx run -m`, whose launcher runs its jobs")
     ap.add_argument("-o", "--override", action="append", default=[], metavar="OVERRIDE",
@@ -193,7 +194,7 @@ def main(argv: list[str]) -> int:
             root = Path("runs") / "report"
             jobs = plan(a.profile, root, needed_studies(names))
             if a.dry_run:
-                from cerebx.estimate import estimate_jobs
+                from cerebx.config import estimate_jobs
 
                 for j in jobs:
                     print(f"{'reuse' if j.done() else 'run  '} {j.run_dir}  cerebx run {' '.join(j.overrides())}")
@@ -211,7 +212,7 @@ def main(argv: list[str]) -> int:
         else:
             dirs = []
             for p in a.runs or [Path("runs")]:
-                dirs.extend(find_run_dirs(p) if p.is_dir() and not (p / "summary.json").exists() else [p])
+                dirs.extend(find_run_dirs(p) if p.is_dir() and not (p / runfiles.SUMMARY).exists() else [p])
         index, problems, n = build(dirs, a.out, names, log=print)
     except CerebxError as err:
         for line in str(err).splitlines():

@@ -1,6 +1,6 @@
-"""Realised delays read back from run logs, and the delay-study table (thesis Fig. 3.4 / 3.7 / 3.8):
-per run, the controller and delay presets, the realised round trip, MAE and torque variability
-(Eq. 3.14-3.15) over the run's measured trials."""
+"""Realised delays read back from run logs, and the report's delay table (``delays.csv``): per run with a
+delay, the controller and delay presets, the realised round trip, MAE and torque variability over the run's
+measured trials."""
 
 from __future__ import annotations
 

@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from cerebx.recording.reader import read_messages  # noqa: E402
-from cerebx.report.registry import save  # noqa: E402
+from cerebx.report.plot import save  # noqa: E402
 
 
 def _label(s: dict[str, Any]) -> str:
@@ -22,7 +22,7 @@ def _label(s: dict[str, Any]) -> str:
 
 
 def learning_curves(runs: list[tuple[Path, dict]], task: str, out: Path) -> Path:
-    """MAE per trial for every run of one task (thesis Fig. 2.6 g / 2.7 g style)."""
+    """MAE per trial for every run of one task."""
     fig, ax = plt.subplots(figsize=(7.5, 4))
     longest = max((len(s.get("mae_per_trial") or []) for _, s in runs), default=0)
     for i, (_, s) in enumerate(runs):
@@ -44,7 +44,7 @@ def learning_curves(runs: list[tuple[Path, dict]], task: str, out: Path) -> Path
 
 
 def joint_tracking(run_dir: Path, s: dict, out: Path) -> Path:
-    """Desired vs actual joint positions over the last completed trial (thesis Fig. 2.6 third row)."""
+    """Desired vs actual joint positions over the last completed trial."""
     n_done = s.get("trials_completed") or 0
     period = s["sim_seconds"] / max(n_done, 1)
     t_start = int((s["sim_seconds"] - period) * 1e9)

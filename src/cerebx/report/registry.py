@@ -1,23 +1,22 @@
-"""The figure registry: each thesis figure is one function of the runs, declared with the studies
-(experiment presets, conf/report/studies.yaml) whose runs it needs.
+"""The figure registry: each figure of a reproduction is one function of the runs, declared with the
+studies (experiment presets run once or as a sweep) whose runs it needs.
 
-A figure function takes the run set and an output stem (``reports/figures/fig3_4``), draws from
-the logs, saves PNG + SVG and returns a :class:`Figure` with its caption and a table of the paper's
-numbers beside cerebx's. When no run it needs is there it raises :class:`MissingRuns`.
+Figures and studies come from plugins: a plugin names its report module (``registry.add_report``), whose
+import registers figures with :func:`figure` and its studies file with :func:`studies`. A figure function
+takes the run set and an output stem (``reports/figures/<name>``), draws from the logs, saves PNG + SVG
+(``report.plot.save``) and returns a :class:`Figure` with its caption and a table of the paper's numbers
+beside cerebx's. When no run it needs is there it raises :class:`MissingRuns`.
 """
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from cerebx.report.runs import RunSet  # noqa: E402
+from cerebx import registry
+from cerebx.report.runs import RunSet
 
 
 class MissingRuns(Exception):
@@ -42,10 +41,11 @@ class FigureSpec:
 
 
 FIGURES: dict[str, FigureSpec] = {}
+STUDY_FILES: list[Path] = []
 
 
 def figure(name: str, title: str, studies: tuple[str, ...]) -> Callable:
-    """Register a figure function under ``name`` (the thesis figure, e.g. ``fig3_4``)."""
+    """Register a figure function under ``name`` (unique across plugins)."""
     def deco(fn: Callable[[RunSet, Path], Figure]) -> Callable[[RunSet, Path], Figure]:
         if name in FIGURES:
             raise ValueError(f"figure {name!r} registered twice")
@@ -54,39 +54,27 @@ def figure(name: str, title: str, studies: tuple[str, ...]) -> Callable:
     return deco
 
 
+def studies(path: Path) -> None:
+    """Register a studies file (YAML, ``report/studies.py``) whose runs the plugin's figures need."""
+    path = Path(path).resolve()
+    if path not in STUDY_FILES:
+        STUDY_FILES.append(path)
+
+
+def load_reports() -> None:
+    """Import the report module of every loaded plugin (their imports register figures and studies)."""
+    registry.load_plugins()
+    for source in registry.report_modules:
+        importlib.import_module(source.target)
+
+
 def all_figures() -> dict[str, FigureSpec]:
-    """Every registered figure, in thesis order (importing the modules registers them)."""
-    from cerebx.report import capolei, ch2, ch3, ch4, ch4_muscles, luque2011  # noqa: F401
-
-    def order(name: str) -> tuple:
-        parts = name.replace("fig", "").replace("table", "").split("_")
-        return tuple(int(p) if p.isdigit() else 0 for p in parts)
-    return {k: FIGURES[k] for k in sorted(FIGURES, key=order)}
+    """Every registered figure, in the order of the numbers in their names."""
+    load_reports()
+    return {k: FIGURES[k] for k in sorted(FIGURES, key=figure_order)}
 
 
-def save(fig, stem: Path) -> Path:
-    """Write ``stem``.png and ``stem``.svg and close the figure; returns the PNG path."""
-    stem.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(stem.with_suffix(".png"), dpi=110)
-    fig.savefig(stem.with_suffix(".svg"))
-    plt.close(fig)
-    return stem.with_suffix(".png")
-
-
-def panel_letter(ax, letter: str) -> None:
-    """A bold panel letter above the axes' top-left corner."""
-    ax.annotate(letter, (0, 1), xycoords="axes fraction", xytext=(-34, 8), textcoords="offset points",
-                fontsize=13, fontweight="bold", va="bottom")
-
-
-def fmt(x: float | None, nd: int = 3) -> str:
-    return "–" if x is None else f"{x:.{nd}f}"
-
-
-def mean_std(values, nd: int = 3) -> str:
-    import numpy as np
-
-    v = np.asarray(values, dtype=float)
-    if v.size == 0:
-        return "–"
-    return f"{v.mean():.{nd}f} ± {v.std():.{nd}f}"
+def figure_order(name: str) -> tuple:
+    """Sort key of a figure name: its numeric parts (``x3_4`` -> (3, 4), ``fig`` and ``table`` prefixes dropped)."""
+    parts = name.replace("fig", "").replace("table", "").split("_")
+    return tuple(int(p) if p.isdigit() else 0 for p in parts)

@@ -15,8 +15,10 @@ from typing import Any
 
 import numpy as np
 
+from cerebx import runfiles
 from cerebx.errors import CerebxError
 from cerebx.recording.reader import read_messages, read_metadata, read_summary
+from cerebx.schema.legacy import upgrade
 
 
 @dataclass
@@ -36,7 +38,7 @@ class Run:
         if self._config is not None:
             return self._config
         try:
-            return json.loads(read_metadata(self.dir)["config"]["json"])
+            return upgrade(json.loads(read_metadata(self.dir)["config"]["json"]))
         except (CerebxError, KeyError, OSError, json.JSONDecodeError):
             return {}
 
@@ -91,7 +93,7 @@ class Run:
     @property
     def kernel_peaks_ms(self) -> list[float]:
         """Peak (ms) of every plastic projection's PF-PC kernel, in network order."""
-        projections = self.get("network.projections", {}) or {}
+        projections = self.get("controller.network.projections", {}) or {}
         return [float(p["plasticity"]["kernel_peak_ms"]) for p in projections.values()
                 if isinstance(p, dict) and (p.get("plasticity") or {}).get("kind") == "kernel_stdp"]
 
@@ -191,13 +193,13 @@ class RunSet(list):
 
 def _mtime(d: Path) -> float:
     try:
-        return (d / "summary.json").stat().st_mtime
+        return (d / runfiles.SUMMARY).stat().st_mtime
     except OSError:
         return 0.0
 
 
 def find_run_dirs(root: Path) -> list[Path]:
-    return sorted(p.parent for p in root.rglob("summary.json"))
+    return sorted(p.parent for p in root.rglob(runfiles.SUMMARY))
 
 
 def load_runs(dirs: Iterable[Path]) -> tuple[RunSet, list[str]]:

@@ -28,10 +28,10 @@ import yaml
 from pydantic import Field, ValidationError
 
 from cerebx.errors import CerebxError, ConfigError
+from cerebx.report.registry import STUDY_FILES, load_reports
 from cerebx.schema.base import Strict
 from cerebx.schema.experiment import format_errors
 
-STUDIES_FILE = Path(__file__).resolve().parents[1] / "conf" / "report" / "studies.yaml"
 PROFILES = ("quick", "full")
 
 
@@ -53,31 +53,45 @@ class StudySpec(Strict):
         None, description="study whose learned state starts each job: a single-run study, or one with the same "
         "sweep (each job then starts from the job of the same sweep values)")
     quick: ProfileSpec = Field(description="the quick profile (< 30 min on 2 cores in all)")
-    full: ProfileSpec = Field(description="the full profile (the thesis's trial counts)")
+    full: ProfileSpec = Field(description="the full profile (the paper's trial counts)")
 
 
 class StudiesFile(Strict):
     studies: dict[str, StudySpec] = Field(description="study name -> study")
 
 
-def load_studies(path: Path = STUDIES_FILE) -> dict[str, StudySpec]:
+def load_studies(*paths: Path) -> dict[str, StudySpec]:
+    """The studies of ``paths`` (default: every plugin's registered studies file), one name space."""
+    if not paths:
+        load_reports()
+        paths = tuple(STUDY_FILES)
+    studies: dict[str, StudySpec] = {}
+    where: dict[str, Path] = {}
+    for path in paths:
+        for name, spec in _read_studies(path).items():
+            if name in studies:
+                raise ConfigError(f"{path}: studies.{name}: already defined in {where[name]}")
+            studies[name], where[name] = spec, path
+    for name, s in studies.items():
+        for prof in PROFILES:
+            src = _init_from(s, prof)
+            if src is not None and (src not in studies or _sweep_of(studies[src], prof) not in (
+                    [[]], _sweep_of(s, prof))):
+                raise ConfigError(f"{where[name]}: studies.{name}.init_from: {src!r} is not a single-run study "
+                                  "or one with the same sweep")
+    return studies
+
+
+def _read_studies(path: Path) -> dict[str, StudySpec]:
     try:
-        raw = yaml.safe_load(path.read_text())
-        studies = StudiesFile.model_validate(raw).studies
+        raw = yaml.safe_load(Path(path).read_text())
+        return StudiesFile.model_validate(raw).studies
     except OSError as err:
         raise ConfigError(f"{path}: {err.strerror}") from None
     except yaml.YAMLError as err:
         raise ConfigError(f"{path}: not valid YAML ({str(err).splitlines()[0]})") from None
     except ValidationError as err:
         raise ConfigError([f"{path}: {line}" for line in format_errors(err)]) from None
-    for name, s in studies.items():
-        for prof in PROFILES:
-            src = _init_from(s, prof)
-            if src is not None and (src not in studies or _sweep_of(studies[src], prof) not in (
-                    [[]], _sweep_of(s, prof))):
-                raise ConfigError(f"{path}: studies.{name}.init_from: {src!r} is not a single-run study "
-                                  "or one with the same sweep")
-    return studies
 
 
 def _key(override: str) -> str:
@@ -209,7 +223,7 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
 
     def want(n: str) -> None:
         if n not in studies:
-            raise ConfigError(f"study {n!r}: not in {STUDIES_FILE.name} (known: {', '.join(studies)})")
+            raise ConfigError(f"study {n!r}: no plugin defines it (known: {', '.join(studies)})")
         src = _init_from(studies[n], profile)
         if src is not None:
             want(src)

@@ -20,9 +20,10 @@ from typing import Any
 
 import yaml
 
+from cerebx import runfiles
 from cerebx.errors import CerebxError
 from cerebx.recording.summary import SUMMARY_FILE, read_summary
-from cerebx.sweep import ERROR_FILE, MAX_EXIT_CODE, OK_STATUSES
+from cerebx.sweep import MAX_EXIT_CODE, OK_STATUSES
 
 STEM = "sweep_summary"
 RESULT_COLUMNS = ("status", "trials", "final_mae_rad", "rt_factor")
@@ -46,7 +47,7 @@ class JobRow:
 
 
 def _overrides(job_dir: Path) -> dict[str, str]:
-    path = job_dir / ".hydra" / "overrides.yaml"
+    path = job_dir / runfiles.OVERRIDES
     try:
         items = yaml.safe_load(path.read_text()) or []
     except (OSError, yaml.YAMLError):
@@ -65,8 +66,8 @@ def _first_line(text: str | None) -> str:
 
 def _job_row(job_dir: Path) -> JobRow:
     over = _overrides(job_dir)
-    if (job_dir / ERROR_FILE).exists():  # refused before its run started
-        return JobRow(job_dir.name, over, "failed", "", None, None, _first_line((job_dir / ERROR_FILE).read_text()))
+    if (job_dir / runfiles.ERROR).exists():  # refused before its run started
+        return JobRow(job_dir.name, over, "failed", "", None, None, _first_line((job_dir / runfiles.ERROR).read_text()))
     if not (job_dir / SUMMARY_FILE).exists():
         return JobRow(job_dir.name, over, "missing", "", None, None, "the job left no summary.json")
     try:
@@ -80,7 +81,7 @@ def _job_row(job_dir: Path) -> JobRow:
 def job_dirs(sweep_dir: Path) -> list[Path]:
     """The job folders of a sweep, in job order (Hydra names them by job number)."""
     dirs = [p for p in sweep_dir.iterdir() if p.is_dir() and not p.name.startswith(".")
-            and ((p / "summary.json").exists() or (p / ".hydra").is_dir())]
+            and ((p / runfiles.SUMMARY).exists() or (p / runfiles.HYDRA).is_dir())]
     return sorted(dirs, key=lambda p: (0, int(p.name), "") if p.name.isdigit() else (1, 0, p.name))
 
 

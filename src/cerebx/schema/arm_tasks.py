@@ -1,6 +1,6 @@
-"""Task schemas of the upper limb (thesis §4.3.4, Fig. 4.4): a flexion-extension and a circle in the
-vertical plane, both with bell-shaped (minimum-jerk) velocity profiles. The thesis shows the paths only as
-a figure; every number here is constructed (chosen to lie well inside the arm's joint range)."""
+"""Task schemas of the upper limb: a flexion-extension and a circle in the
+vertical plane, both with bell-shaped (minimum-jerk) velocity profiles. Every number here is
+constructed (chosen to lie well inside the arm's joint range)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ class FlexionExtensionTask(Strict):
     second, each half a minimum-jerk movement (bell-shaped velocity, at rest at both ends). Constructed."""
 
     kind: Literal["flexion_extension"] = "flexion_extension"
-    period_s: PositiveFloat = Field(3.0, description="one trial: out and back (thesis: 3 s)")
+    period_s: PositiveFloat = Field(3.0, description="one trial: out and back")
     start_rad: tuple[float, float] = Field((0.1, 0.3), description="shoulder, elbow at the start (constructed)")
     end_rad: tuple[float, float] = Field((0.8, 1.5), description="shoulder, elbow at full flexion (constructed)")
     n_joints: int = 2
@@ -28,7 +28,7 @@ class VerticalCircleTask(Strict):
     kinematics of the upper limb's planar geometry (elbow flexed). Constructed centre, radius and start."""
 
     kind: Literal["vertical_circle"] = "vertical_circle"
-    period_s: PositiveFloat = Field(3.0, description="one revolution (thesis: slow 3 s, fast 1.5 s)")
+    period_s: PositiveFloat = Field(3.0, description="one revolution")
     centre_m: tuple[float, float] = Field(
         (0.22, -0.28), description="circle centre from the shoulder: forward, up (m; constructed)")
     radius_m: PositiveFloat = Field(0.07, description="constructed")

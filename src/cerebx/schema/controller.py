@@ -1,11 +1,12 @@
-"""Controller schemas: baselines, the spiking cerebellum and its encoders/decoders, and the
-composite controller whose parts' outputs add up. The robot-side torque filters and the supervisor
-are stages (``schema/stages.py``)."""
+"""Controller schemas: the contract every controller kind's schema follows, the baselines (PD, the
+stiff position servo, the velocity PID), encoder input ranges, and the composite controller whose parts'
+outputs add up. Learning controllers (cerebellum models) keep their schema beside their code (e.g.
+``controllers/snn/schema.py``). The robot-side torque filters and the supervisor are stages
+(``schema/stages.py``)."""
 
 from __future__ import annotations
 
-import math
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -14,9 +15,24 @@ from cerebx.registry import Plugin
 from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
 from cerebx.signals import Signal, StageIO, torque_controller_io
 
+VELOCITY_ERROR = "pid.velocity_error"
+"""The velocity PID's error signal, for parts that learn from it."""
+
 
 class ControllerConfig(Strict):
-    """Base of every controller schema (a brain-side part of the loop)."""
+    """Base of every controller schema (a brain-side part of the loop).
+
+    A kind overrides what differs from a joint-torque controller without learned state:
+
+    - :meth:`io`: the signals it reads and writes;
+    - :meth:`cross_check`: problems that involve other parts of the experiment;
+    - :meth:`complete`: values that depend on the rest of the experiment, filled in before validation;
+    - :meth:`state_problems`: why a saved state cannot start it (``init_from``);
+    - :attr:`added_without_effect`: fields added after runs were recorded, with the value that does
+      what those runs did, so an older run still counts as the same experiment.
+    """
+
+    added_without_effect: ClassVar[dict[str, Any]] = {}
 
     def cross_check(self, exp: Any) -> list[str]:
         """Problems that involve other parts of the experiment (one ``path: message`` line each)."""
@@ -25,6 +41,18 @@ class ControllerConfig(Strict):
     def io(self, n_joints: int) -> StageIO:
         """The signals this controller reads and writes (default: a joint-torque controller)."""
         return torque_controller_io(n_joints)
+
+    @classmethod
+    def complete(cls, experiment: dict[str, Any]) -> dict[str, Any]:
+        """The experiment (plain data, not yet validated) with this controller's context-dependent values
+        filled in; the default changes nothing."""
+        return experiment
+
+    def state_problems(self, meta: dict[str, Any], exp: Any) -> str | None:
+        """Why a learned state with metadata ``meta`` cannot start this controller in ``exp``, or None.
+        The default accepts states saved by the same kind (or states that name no kind)."""
+        saved = meta.get("kind")
+        return None if saved in (None, self.kind) else f"was saved by a {saved!r} controller"  # type: ignore[attr-defined]
 
 
 class PDController(ControllerConfig):
@@ -61,6 +89,54 @@ class PositionController(ControllerConfig):
     @property
     def n_joints(self) -> int:
         return len(self.kp)
+
+class PIDVelocity(ControllerConfig):
+    """tau = K_P e + K_I int e dt + K_D de/dt on the velocity error e = qdot_r - qdot (+ the signal
+    ``correction_signal`` names, e.g. a learned velocity correction written by an earlier part), run at
+    ``rate_hz`` and held between updates. Also writes e as ``pid.velocity_error``."""
+
+    kind: Literal["pid_velocity"] = "pid_velocity"
+    kp: tuple[float, ...] = Field((2.9, 2.3, 2.35), description="K_P, N·m per rad/s")
+    ki: tuple[float, ...] = Field((1.94, 1.9, 1.9), description="K_I, N·m per rad")
+    kd: tuple[float, ...] = Field((0.005, 0.0001, 0.0004), description="K_D, N·m per rad/s^2")
+    rate_hz: PositiveFloat = Field(50.0, description="update rate; the torque is held between updates")
+    correction_signal: str | None = Field(
+        None, description="a signal added to the velocity error (written by an earlier part); null: none")
+
+    @model_validator(mode="after")
+    def _lengths(self) -> PIDVelocity:
+        if not len(self.kp) == len(self.ki) == len(self.kd):
+            raise ValueError("kp, ki and kd need the same number of joints")
+        return self
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.kp)
+
+    def cross_check(self, exp: Any) -> list[str]:
+        out = []
+        if self.n_joints != exp.plant.n_joints:
+            out.append(f"kp: {self.n_joints} joints, plant {exp.plant.kind} has {exp.plant.n_joints}")
+        why = rate_problem(self.rate_hz, exp.control_dt_ms)
+        return out + ([why] if why else [])
+
+    def io(self, n_joints: int) -> StageIO:
+        reads = ("ref.qd",) + ((self.correction_signal,) if self.correction_signal else ())
+        return StageIO(reads, (Signal("joint.torque", n_joints, "N·m"), Signal(VELOCITY_ERROR, n_joints, "rad/s")))
+
+
+def rate_problem(rate_hz: float, control_dt_ms: float) -> str | None:
+    """Why a part cannot update at ``rate_hz`` on the loop's control step (it must be the loop rate divided
+    by a whole number), or None."""
+    n = 1000.0 / (rate_hz * control_dt_ms)
+    if abs(n - round(n)) > 1e-9 or round(n) < 1:
+        return f"rate_hz: {rate_hz:g} Hz is not the loop rate divided by a whole number"
+    return None
+
+
+def muscle_command_signals(n_joints: int) -> tuple[Signal, Signal]:
+    """The agonist and antagonist commands of an antagonist muscle pair per joint, each in [0, 1]."""
+    return (Signal("muscle.ag", n_joints, "1", 0.0, 1.0), Signal("muscle.at", n_joints, "1", 0.0, 1.0))
 
 
 class GivenRanges(Strict):
@@ -118,164 +194,6 @@ class TaskRanges(Strict):
 def _widen(a: np.ndarray, b: np.ndarray, margin: float) -> tuple[np.ndarray, np.ndarray]:
     span = np.maximum(b - a, 1e-3)
     return a - margin * span, b + margin * span
-
-
-class BoxEncoder(Strict):
-    """MF interval coding (Eq. 2.12-2.15): per signal, 10 fibres with box receptive fields;
-    the active fibre fires once per 2 ms step."""
-
-    role: ClassVar[str] = "mossy"
-
-    kind: Literal["box"] = "box"
-    fibers_per_signal: int = Field(10, gt=1)
-    width_factor: PositiveFloat = Field(0.500000000001, description="half-width in units of the centre step")
-    ranges: Annotated[GivenRanges | TaskRanges, Field(discriminator="kind")] = TaskRanges()
-
-
-class CFEncoder(Strict):
-    """CF stochastic error coding (facts §3): agonist/antagonist split by error sign;
-    rate = r_min + (r_max - r_min)(tanh((|e| - c_k)/w) + 1)/2, Bernoulli per 2 ms, bursts."""
-
-    role: ClassVar[str] = "climbing"
-
-    kind: Literal["tanh_bernoulli"] = "tanh_bernoulli"
-    rate_min_hz: NonNegFloat = 1.0
-    rate_max_hz: PositiveFloat = 10.0
-    center_min: NonNegFloat = 0.001
-    center_max: PositiveFloat = 0.01
-    max_burst: int = Field(6, ge=1)
-
-    @model_validator(mode="after")
-    def _ranges(self) -> CFEncoder:
-        if self.rate_min_hz >= self.rate_max_hz:
-            raise ValueError("rate_min_hz must be below rate_max_hz")
-        if self.center_min >= self.center_max:
-            raise ValueError("center_min must be below center_max")
-        return self
-
-
-class ErrorGains(Strict):
-    """Teaching error e = kpos (q_d - q) + kvel (qd_d - qd) (Eq. 2.1)."""
-
-    kpos: tuple[float, ...] = (1.5, 2.0, 3.0, 2.0, 2.0, 1.5)
-    kvel: tuple[float, ...] = (1.5, 1.0, 3.0, 1.0, 2.0, 1.5)
-
-
-class DCNDecoderConfig(Strict):
-    """Torque = alpha_j (agonist - antagonist DCN spikes per 2 ms) (Eq. 2.16-2.17, 3.5); with the
-    controller's ``output: agonist_antagonist`` the two sides are kept apart instead (thesis §4.6.2):
-    M = spikes of the side in the 2 ms step / ``spikes_full_scale`` (capped at 1 with ``saturate``)."""
-
-    alpha_Nm_per_spike: tuple[PositiveFloat, ...] = (0.75, 1.1, 0.375, 0.63, 0.078, 0.078)
-    spikes_full_scale: PositiveFloat | tuple[PositiveFloat, ...] = Field(
-        100.0, description="agonist_antagonist output: DCN spikes of one side of one joint in one 2 ms step "
-        "that give M = 1 (one value, or one per joint); without saturate it must be at least the most that "
-        "side can fire (cells x spikes per cell per step allowed by the refractory period: 50 x 2 in the "
-        "thesis networks), so M stays in [0, 1]. Unused for torque output")
-    saturate: bool = Field(
-        False, description="agonist_antagonist output: M = min(1, spikes / full scale), the saturation of "
-        "the cerebellar output the thesis names (§4.7); allows a full scale below the most a side can fire")
-
-    def full_scale(self, n_joints: int) -> tuple[float, ...]:
-        fs = self.spikes_full_scale
-        return tuple(fs) if isinstance(fs, tuple) else (float(fs),) * n_joints
-
-
-class SNNController(ControllerConfig):
-    """The cerebellar spiking network (thesis §2.2.3-2.2.7, §3.2.2-3.2.4). The topology comes
-    from the top-level ``network`` group."""
-
-    kind: Literal["snn"] = "snn"
-    output: Literal["torque", "agonist_antagonist"] = Field(
-        "torque", description="'torque': joint.torque = alpha (agonist - antagonist DCN spikes) (Eq. 3.5); "
-        "'agonist_antagonist': the two sides as muscle.ag and muscle.at, each spikes / "
-        "decoder.spikes_full_scale in [0, 1], no subtraction (thesis §4.6.2), for a muscle stage")
-    mf: Plugin("encoder") = Field(BoxEncoder(), description="mossy-fibre encoder (registered kind, role mossy)")
-    cf: Plugin("encoder") = Field(CFEncoder(), description="climbing-fibre encoder (registered kind, role climbing)")
-    error: ErrorGains = ErrorGains()
-    decoder: DCNDecoderConfig = DCNDecoderConfig()
-    pathway_delay_ms: NonNegFloat = Field(50.0, description="afferent = efferent sensorimotor delay D")
-    cf_pathway_delay_ms: NonNegFloat | None = Field(
-        None, description="afferent delay of the CF (error) spikes; null = pathway_delay_ms ([B]: 40 ms "
-        "with 50 ms for the MF)")
-    efferent: Literal["auto", "hold", "stamp"] = Field(
-        "hold",
-        description="'hold': a torque is emitted D after the network computed it; 'stamp': it is sent at "
-        "once, stamped with its application time (network time + D), for the plant-side future/past "
-        "filter (Eq. 3.6) as in the original delay setup; 'auto' (the snn preset): 'stamp' with the "
-        "Eq. 3.6 receiver whenever the experiment's delay is not 'none', else 'hold'",
-    )
-    plasticity: bool = True
-    parallel: bool = Field(True, description="use numba threads in the network kernels (when not pipelined)")
-    pipeline: bool = Field(
-        True,
-        description="simulate the network one pathway-delay chunk ahead on a second thread "
-        "(identical results; needs pathway_delay_ms > 0)",
-    )
-    record_spikes: list[str] = Field(default_factory=lambda: ["dcn"])
-    weight_summary_every_trials: int = Field(
-        10, ge=0, description="plastic-weight statistics every n trials (a pass over all weights); 0 = never"
-    )
-
-    @model_validator(mode="after")
-    def _encoder_roles(self) -> SNNController:
-        for field, role in (("mf", "mossy"), ("cf", "climbing")):
-            got = getattr(getattr(self, field), "role", None)
-            if got != role:
-                raise ValueError(f"{field}: kind {getattr(self, field).kind!r} is a {got} encoder, not a {role} one")
-        return self
-
-    @property
-    def n_joints(self) -> int:
-        return len(self.decoder.alpha_Nm_per_spike)
-
-    def io(self, n_joints: int) -> StageIO:
-        if self.output == "torque":
-            return torque_controller_io(n_joints)
-        return StageIO(("ref.q", "ref.qd"), muscle_command_signals(n_joints))
-
-    def cross_check(self, exp: Any) -> list[str]:
-        """The encoders and decoder must match the population sizes they drive and read."""
-        out = []
-        n_joints = exp.plant.n_joints
-        pops, io = exp.network.populations, exp.network.io
-        mf = pops.get(io.mossy)
-        fibres = getattr(self.mf, "fibers_per_signal", None)
-        need = n_joints * 4 * fibres if fibres else None
-        if mf is not None and need is not None and mf.size != need:
-            out.append(f"controller.mf.fibers_per_signal: {fibres} fibres x 4 signals x {n_joints} joints = {need}, "
-                       f"but network population {io.mossy!r} has {mf.size}")
-        for name in (io.climbing, io.output):
-            p = pops.get(name)
-            if p is not None and p.size % (2 * n_joints):
-                out.append(f"network.populations.{name}.size: {p.size} is not an agonist/antagonist pair per joint "
-                           f"({n_joints} joints)")
-        dcn = pops.get(io.output)
-        if self.output == "agonist_antagonist" and dcn is not None and not dcn.size % (2 * n_joints):
-            most = dcn.size // (2 * n_joints) * max_spikes_per_step(dcn.neuron, exp.network.dt_ms)
-            fs = self.decoder.spikes_full_scale
-            low = min(self.decoder.full_scale(n_joints))
-            if (not isinstance(fs, tuple) or len(fs) == n_joints) and not self.decoder.saturate and low < most:
-                out.append(f"controller.decoder.spikes_full_scale: {low:g} "
-                           f"spikes, but one side of a joint of {io.output!r} can fire {most} in a 2 ms step (M "
-                           "would exceed 1, unless controller.decoder.saturate caps it)")
-        return out
-
-
-def muscle_command_signals(n_joints: int) -> tuple[Signal, Signal]:
-    """The agonist and antagonist commands of an antagonist muscle pair per joint, each in [0, 1]."""
-    return (Signal("muscle.ag", n_joints, "1", 0.0, 1.0), Signal("muscle.at", n_joints, "1", 0.0, 1.0))
-
-
-def max_spikes_per_step(neuron: Any, network_dt_ms: float, step_ms: float = 2.0) -> int:
-    """The most spikes one neuron can fire in a control step: it may fire at the end of any integration
-    step h, then is held for round(t_ref / h) steps (as the kernels count it); an input fibre fires at
-    most once per step."""
-    if getattr(neuron, "kind", None) != "lif_cond":
-        return 1
-    h = neuron.integration.dt_ms or network_dt_ms
-    steps = int(round(step_ms / h))
-    return math.ceil(steps / (round(neuron.t_ref_ms / h) + 1))
 
 
 class CompositeController(ControllerConfig):

@@ -48,7 +48,7 @@ class ForcePulse(Strict):
 
 
 class FingerPush(Strict):
-    """A person pushes the end-effector with one finger (thesis §2.3.1, Fig. 2.10): a half-sine force
+    """A person pushes the end-effector with one finger: a half-sine force
     of peak ``force_N`` over ``duration_ms``."""
 
     plant_method: ClassVar[str] = "finger_push"  # what a plant offers to support it
@@ -59,7 +59,7 @@ class FingerPush(Strict):
 
 class Grab(Strict):
     """A person grabs the end-effector through a soft spring and drags it along ``displacement_m``
-    (minimum jerk over ``drag_ms``), holds for ``hold_ms``, then lets go (thesis §2.3.1, Fig. 2.10)."""
+    (minimum jerk over ``drag_ms``), holds for ``hold_ms``, then lets go."""
 
     plant_method: ClassVar[str] = "grab"  # what a plant offers to support it
     kind: Literal["grab"] = "grab"

@@ -3,15 +3,17 @@
 from __future__ import annotations
 
 import functools
+from pathlib import Path
 from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, Field, ValidationError, create_model, model_validator
 
-from cerebx import registry
+from cerebx import registry, runfiles
 from cerebx.errors import ConfigError
 from cerebx.registry import Plugin
 from cerebx.schema.base import CONTROL_DT_MS, NonNegFloat, Strict
-from cerebx.schema.network import NetworkConfig
+from cerebx.schema.init_state import init_from_problems
+from cerebx.wiring import BODY_SLOTS, wire
 
 
 class ScheduledEvent(Strict):
@@ -29,7 +31,7 @@ class ScheduledEvent(Strict):
 
 
 MAX_TRIALS = 100_000
-"""The largest run cerebx accepts (the thesis's longest study has 1,000 trials); a larger one is a typo."""
+"""The largest run cerebx accepts (the longest report study has 1,000 trials); a larger one is a typo."""
 
 
 class RecordingConfig(Strict):
@@ -60,30 +62,17 @@ def tuple_union(types: tuple[type, ...]) -> Any:
     return out
 
 
-BODY_SLOTS = ("spinal", "muscle")
-"""Named robot-side stage slots, in the order they run between the receiver and the ``robot`` list."""
-
-# The receiver of the delay-robust SNN (conf/controller/snn_delays.yaml, facts §7): the mean of the
-# nearest future and past stamped torques (Eq. 3.6), decaying by 0.998 per step when starved.
-DELAYED_SNN_RECEIVER = {"kind": "future_past", "min_future_samples": 2, "past_samples": 10, "decay_per_step": 0.998}
-
-
-def delay_robust_default(data: Any) -> Any:
-    """Resolve ``controller.efferent: auto`` of a spiking controller: with any delay other than
-    ``none`` the torques are stamped and a ``mean`` receiver becomes the Eq. 3.6 future/past filter
-    (the thesis's delay-robust controller, what ``controller=snn_delays`` sets explicitly); without
-    delay the torques are held as before."""
+def complete(data: Any) -> Any:
+    """The experiment with its controller's context-dependent values filled in (its kind's
+    ``complete`` hook), before validation."""
     if not isinstance(data, dict):
         return data
-    ctrl, delay = data.get("controller"), data.get("delay")
-    if not (isinstance(ctrl, dict) and ctrl.get("kind") == "snn" and ctrl.get("efferent") == "auto"):
-        return data
-    delayed = isinstance(delay, dict) and delay.get("kind", "none") != "none"
-    out = {**data, "controller": {**ctrl, "efferent": "stamp" if delayed else "hold"}}
-    robot = data.get("robot")  # not a list: left for the schema to refuse
-    if delayed and isinstance(robot, list) and robot and isinstance(robot[0], dict) and robot[0].get("kind") == "mean":
-        out["robot"] = [dict(DELAYED_SNN_RECEIVER), *robot[1:]]
-    return out
+    ctrl = data.get("controller")
+    kind = ctrl.get("kind") if isinstance(ctrl, dict) else None
+    registry.load_plugins()
+    if isinstance(kind, str) and kind in registry.controllers:
+        return registry.controllers[kind].schema.complete(data)
+    return data
 
 
 class _ExperimentBase(Strict):
@@ -93,7 +82,6 @@ class _ExperimentBase(Strict):
     seed: int = Field(0, ge=0)
     trials: int = Field(10, ge=1, le=MAX_TRIALS, description="trials to run (at most 100,000: 55 h of a 2 s task)")
     control_dt_ms: Literal[2.0] = CONTROL_DT_MS
-    network: NetworkConfig
     recording: RecordingConfig = RecordingConfig()
     events: list[ScheduledEvent] = Field(default_factory=list)
     brain: list[Plugin("stage")] = Field(
@@ -121,8 +109,8 @@ class _ExperimentBase(Strict):
 
     @model_validator(mode="before")
     @classmethod
-    def _delay_robust_default(cls, data: Any) -> Any:
-        return delay_robust_default(data)
+    def _complete(cls, data: Any) -> Any:
+        return complete(data)
 
     @model_validator(mode="after")
     def _cross_checks(self) -> _ExperimentBase:
@@ -156,9 +144,6 @@ class _ExperimentBase(Strict):
             if method and not callable(getattr(plant_cls, method, None)):
                 problems.append(f"events.{i}.action: plant {plant.kind} does not support event {ev.action.kind!r}")
         if not problems:
-            from cerebx.errors import ConfigError
-            from cerebx.stages.base import wire
-
             try:
                 wire(self)
             except ConfigError as err:
@@ -166,15 +151,11 @@ class _ExperimentBase(Strict):
         if self.warmup_trials >= self.trials:
             problems.append(f"warmup_trials: {self.warmup_trials} leaves no measured trial of {self.trials}")
         if self.init_from is not None:
-            from cerebx.schema.init_state import init_from_problems
-
             problems += init_from_problems(self)
         if self.resume not in (None, "auto"):
-            from pathlib import Path
-
-            if not (Path(self.resume) / "checkpoint.pkl").is_file():
-                problems.append(f"resume: {Path(self.resume) / 'checkpoint.pkl'} does not exist (the run saved no "
-                                "checkpoint, or it completed)")
+            checkpoint = Path(self.resume) / runfiles.CHECKPOINT
+            if not checkpoint.is_file():
+                problems.append(f"resume: {checkpoint} does not exist (the run saved no checkpoint, or it completed)")
         if problems:
             raise ValueError("; ".join(problems))
         return self

@@ -1,24 +1,23 @@
 """``init_from`` checked at validation: every state file the run would load is opened, read through
 (a truncated or corrupt file fails here, not after the run folder exists) and matched to the controller
-it starts. An SNN state must carry the structure fingerprint of this experiment's network, computed
-from the network config alone (``snn.topology.structure_fingerprint``, no network is built)."""
+it starts by that controller kind's ``state_problems`` hook (an SNN state, for example, must carry the
+structure fingerprint of this experiment's network, computed from the config alone)."""
 
 from __future__ import annotations
 
 import functools
+import json
 from pathlib import Path
 from typing import Any
 
-STATE_FILE = "controller_state.npz"
+import numpy as np
+
+from cerebx import runfiles
 
 
 @functools.lru_cache(maxsize=64)
 def _read_meta(path: str, mtime_ns: int, size: int) -> tuple[dict[str, Any] | None, str | None]:
     """(metadata, problem) of a state file; every array is read so a damaged archive shows now."""
-    import json
-
-    import numpy as np
-
     try:
         with np.load(path, allow_pickle=False) as data:
             for name in data.files:
@@ -33,30 +32,10 @@ def _read_meta(path: str, mtime_ns: int, size: int) -> tuple[dict[str, Any] | No
 
 def _files(init_from: Path, controller: Any) -> list[tuple[str, Path, Any]]:
     """(config path, state file, controller part) of every state the run would load."""
-    from cerebx.stages.controllers import Composite
-
-    state = init_from / STATE_FILE
     if controller.kind == "composite":
         return [(f"controller.parts.{i}", p, part) for i, part in enumerate(controller.parts)
-                if (p := Composite.part_path(state, i)).exists()]
-    return [("controller", state, controller)]
-
-
-def _mismatch(meta: dict[str, Any], part: Any, exp: Any) -> str | None:
-    if part.kind == "snn":
-        from cerebx.snn.topology import structure_fingerprint
-
-        saved, want = meta.get("fingerprint"), structure_fingerprint(exp.network)
-        if saved is None:
-            return f"is not an SNN state (saved by a {meta.get('kind', 'different')!r} controller)"
-        if saved != want:
-            return (f"was saved from network {meta.get('network')!r} (fingerprint {saved}), but this run's network "
-                    f"{exp.network.name!r} has fingerprint {want}: sizes or connections differ")
-    elif part.kind == "ann" and meta.get("kind") != "ann":
-        return "is not an ANN state (saved by another controller)"
-    elif meta.get("kind") not in (None, part.kind):
-        return f"was saved by a {meta['kind']!r} controller"
-    return None
+                if (p := init_from / runfiles.part_state(runfiles.STATE, i)).exists()]
+    return [("controller", init_from / runfiles.STATE, controller)]
 
 
 def init_from_problems(exp: Any) -> list[str]:
@@ -64,7 +43,7 @@ def init_from_problems(exp: Any) -> list[str]:
     if exp.init_from is None:
         return []
     root = Path(exp.init_from)
-    state = root / STATE_FILE
+    state = root / runfiles.STATE
     if not state.is_file():
         return [f"init_from: {state} does not exist (give a run folder that saved its state)"]
     problems = []
@@ -76,7 +55,7 @@ def init_from_problems(exp: Any) -> list[str]:
             continue
         meta, problem = _read_meta(str(path), st.st_mtime_ns, st.st_size)
         if problem is None:
-            why = _mismatch(meta, part, exp)
+            why = part.state_problems(meta, exp)
             problem = None if why is None else f"{path} {why} ({where} is {part.kind!r})"
         if problem:
             problems.append(f"init_from: {problem}")

@@ -1,4 +1,4 @@
-"""Muscle schemas: the Ekeberg antagonist muscle pair per joint (thesis §4.6.1, Eq. 4.6, Table 4.1)
+"""Muscle schemas: the Ekeberg antagonist muscle pair per joint (docs/models.md)
 and the brain-side ``muscle_rest`` controller that gives the muscles no active command."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from cerebx.signals import Signal, StageIO
 
 
 class EkebergConfig(StageConfig):
-    """One Ekeberg antagonist muscle pair per joint (thesis Eq. 4.6):
+    """One Ekeberg antagonist muscle pair per joint:
 
     tau_j = alpha_j (M_ag - M_at) + beta_j [(M_ag + c_j) + (M_at + c_j) + gamma_j] (Q_r,j - Q_j) + delta_j Qd_j
 
@@ -32,11 +32,11 @@ class EkebergConfig(StageConfig):
     delta_Nms_per_rad: tuple[float, ...] = Field(
         (-1.0, -1.0, -1.0, -1.0, -1.0, -1.0), description="damping coefficient (negative opposes motion)")
     rest_pose_rad: tuple[float, ...] = Field(
-        (0.0, 0.22, 0.0, 1.34, 0.0, 0.0), description="resting position Q_r per joint (thesis §4.6.1)")
+        (0.0, 0.22, 0.0, 1.34, 0.0, 0.0), description="resting position Q_r per joint")
     cocontraction_base: tuple[NonNegFloat, ...] = Field(
-        (1.5, 1.5, 1.5, 1.5, 0.5, 0.5), description="the baseline (x1) cocontraction c per joint (thesis §4.7)")
+        (1.5, 1.5, 1.5, 1.5, 0.5, 0.5), description="the baseline (x1) cocontraction c per joint")
     cocontraction: NonNegFloat = Field(
-        1.0, description="multiplier k of the baseline: c_j = k x cocontraction_base_j (thesis: 0, 1, 5, 9, 10, 12)")
+        1.0, description="multiplier k of the baseline: c_j = k x cocontraction_base_j")
 
     @model_validator(mode="after")
     def _rows(self) -> EkebergConfig:
@@ -52,7 +52,7 @@ class EkebergConfig(StageConfig):
 
 
 class MuscleRestController(ControllerConfig):
-    """No active muscle component: writes M_ag = M_at = 0 every step (thesis Fig. 4.6 B), so only the
+    """No active muscle component: writes M_ag = M_at = 0 every step, so only the
     muscles' passive stiffness and damping hold the arm."""
 
     kind: Literal["muscle_rest"] = "muscle_rest"

@@ -120,68 +120,15 @@ class BaxterConfig(PlantSchema):
         return 6
 
 
-class LWR3Config(PlantSchema):
-    """Three joints (A1, A2, A4) of a KUKA LWR 4+ as a stand-in for the DLR LWR-III of Luque et al. 2011;
-    link masses, lengths and inertias from a published URDF (facts luque2011_capolei2020.md §1), the other
-    joints fixed at 0. An object can hang at the end of the last segment (``object_mass_kg`` from the start,
-    or the ``attach_payload`` event)."""
-
-    kind: Literal["lwr3"] = "lwr3"
-    physics_dt_ms: PhysicsStepMs = 0.5
-    torque_limit_Nm: tuple[PositiveFloat, PositiveFloat, PositiveFloat] = Field(
-        (176.0, 176.0, 100.0), description="actuator saturation of A1, A2, A4 (LWR 4+ limits, facts §1.2)"
-    )
-    damping_Nms_per_rad: NonNegFloat = Field(1.0, description="viscous joint damping (the Gazebo URDF's 1.0)")
-    stiffness_Nm_per_rad: tuple[NonNegFloat, NonNegFloat, NonNegFloat] = Field(
-        (0.0, 0.0, 0.0), description="passive joint springs toward spring_ref_rad (a non-stiff, elastic arm)"
-    )
-    spring_ref_rad: tuple[float, float, float] = Field((0.0, 0.0, 0.0), description="where the springs are slack")
-    object_mass_kg: NonNegFloat = Field(
-        0.0, description="mass held at the end of the last segment from the start (paper: 0.5, 1, 1.5 or 2 kg)"
-    )
-    sensor_noise_rad: NonNegFloat = Field(0.0, description="std of Gaussian noise on measured joint positions")
-
-    @property
-    def n_joints(self) -> int:
-        return 3
-
-
-class ICubWristConfig(PlantSchema):
-    """iCub right wrist (prosup, yaw, pitch) holding a table with a free ball (Capolei 2020); MJCF in
-    ``plants/icub_wrist.xml``. Efforts and damping from the NRP iCub model; armature constructed."""
-
-    kind: Literal["icub_wrist"] = "icub_wrist"
-    physics_dt_ms: PhysicsStepMs = 0.5
-    torque_limit_Nm: tuple[PositiveFloat, PositiveFloat, PositiveFloat] = Field(
-        (0.45, 0.65, 0.65), description="effort limits prosup, yaw, pitch (NRP iCub model)")
-    damping_Nms_per_rad: NonNegFloat = Field(1.0, description="joint damping (NRP iCub model)")
-    armature_kgm2: NonNegFloat = Field(0.03, description="reflected rotor inertia per joint (constructed)")
-    sample_rate_hz: PositiveFloat = Field(50.0, le=500.0, description="encoder sampling rate; readings are "
-                                          "held between samples (the paper's f_samp)")
-    sensor_noise: NonNegFloat = Field(0.0, description="a: U(-a, a) added to each sampled position (rad) and "
-                                      "velocity (rad/s); the paper's case B uses 0.1")
-    ball: bool = Field(True, description="a free ball rolls on the table")
-    ball_drop_height_m: NonNegFloat = Field(0.1, description="the ball starts at rest this high above the "
-                                            "table centre at reset")
-    ball_drop_jitter_m: NonNegFloat = Field(0.03, description="the drop point is drawn from U(-j, j) in x and y "
-                                            "about the table centre (constructed: makes seeds differ)")
-    ball_reset: bool = Field(True, description="drop the ball again when it falls off the table")
-    ball_lost_below_m: PositiveFloat = Field(0.1, description="the ball counts as fallen this far below the table")
-
-    @property
-    def n_joints(self) -> int:
-        return 3
-
-
 MUSCLES_UPPER_LIMB = ("deltoid", "biceps_long", "biceps_short", "brachialis", "triceps_long", "triceps_lateral",
                       "triceps_medial")
-"""The upper limb's muscles in command/sensor order (thesis Fig. 4.1)."""
+"""The upper limb's muscles in command/sensor order."""
 
 
 class UpperLimbConfig(PlantSchema):
     """Human arm, shoulder and elbow flexion-extension in a vertical plane, 7 Hill-type muscles on
-    spatial tendons (OpenSim Arm26, Holzbaur et al. 2005, + MoBL-ARMS anterior deltoid; thesis §4.3.1).
-    Commanded with the muscles' neural excitations; MuJoCo integrates the activation dynamics (Eq. 4.4-4.5)."""
+    spatial tendons (OpenSim Arm26, Holzbaur et al. 2005, + MoBL-ARMS anterior deltoid).
+    Commanded with the muscles' neural excitations; MuJoCo integrates the activation dynamics (docs/models.md)."""
 
     kind: Literal["upper_limb"] = "upper_limb"
     physics_dt_ms: PhysicsStepMs = 0.5

@@ -1,4 +1,4 @@
-"""Schemas of the upper limb's robot-side stages between the cerebellum and the muscles (thesis §4.3.2-4.3.3):
+"""Schemas of the upper limb's robot-side stages between the cerebellum and the muscles:
 the spinal cord (stretch reflex and reciprocal inhibition) and, without it, the cerebellum's agonist /
 antagonist commands as the muscle activations directly; plus a brain-side split of a joint torque into
 agonist/antagonist commands (lets a torque controller such as PD drive a muscle plant)."""
@@ -14,12 +14,12 @@ from cerebx.schema.plant import MUSCLES_UPPER_LIMB
 from cerebx.schema.stages import StageConfig
 from cerebx.signals import Signal, StageIO
 
-# Thesis Fig. 4.1: which joints' commands drive each muscle (bi-articular: the mean of both) and whether it
+# Which joints' commands drive each muscle (bi-articular: the mean of both) and whether it
 # takes the agonist (flexor) or antagonist (extensor) command.
 JOINTS = {"deltoid": (0,), "biceps_long": (0, 1), "biceps_short": (1,), "brachialis": (1,),
           "triceps_long": (0, 1), "triceps_lateral": (1,), "triceps_medial": (1,)}
 FLEXORS = ("deltoid", "biceps_long", "biceps_short", "brachialis")
-# Fig. 4.2B pairs (constructed one-to-one where the thesis figure is not in the text): each muscle's MN is
+# Antagonist pairs (constructed one-to-one; docs/models.md): each muscle's MN is
 # inhibited by the mean of its antagonists' Ia interneurons.
 ANTAGONISTS = {"deltoid": ("triceps_long",), "biceps_long": ("triceps_long",),
                "biceps_short": ("triceps_lateral",), "brachialis": ("triceps_medial",),
@@ -52,14 +52,14 @@ class _MuscleMap(StageConfig):
 
 
 class DirectMusclesConfig(_MuscleMap):
-    """No spinal cord (thesis Fig. 4.3B): each muscle's activation command is its agonist or antagonist command
+    """No spinal cord: each muscle's activation command is its agonist or antagonist command
     (bi-articular muscles: the mean over both joints)."""
 
     kind: Literal["direct_muscles"] = "direct_muscles"
 
 
 class SpinalCordConfig(_MuscleMap):
-    """Spinal cord (thesis §4.3.2, Eq. 4.1-4.3): per muscle one motor neuron (MN) and one Ia interneuron
+    """Spinal cord (docs/models.md): per muscle one motor neuron (MN) and one Ia interneuron
     (Ia IN), leaky rate neurons tau_m dr/dt = -r + sigma(sum w_i r_i), sigma(x) = 1/(1 + exp(-k (x - x0))).
     MN input: w_exc (command + own Ia afferent) - w_inh (mean of the antagonists' Ia INs); Ia IN input:
     w_exc own Ia afferent. Ia afferent r = a |v|^p sign(v) + b l + c of the length/velocity measured

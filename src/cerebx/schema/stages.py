@@ -34,7 +34,7 @@ class HoldConfig(StageConfig):
 
 
 class MeanFilterConfig(StageConfig):
-    """Mean of the last ``taps`` command samples (thesis Eq. 2.18: 15 taps = 30 ms)."""
+    """Mean of the last ``taps`` command samples (15 taps = 30 ms)."""
 
     sides: ClassVar[tuple[str, ...]] = ("robot",)
     receiver: ClassVar[bool] = True
@@ -54,7 +54,7 @@ class FuturePastFilterConfig(StageConfig):
 
 
 class SupervisorConfig(StageConfig):
-    """Watchdog PD acting only outside the joint bounds (thesis §2.2.8, facts §4):
+    """Watchdog PD acting only outside the joint bounds (docs/models.md):
     tau = kp (bound - q) - s kd qd, s ramping by ``ramp_per_step`` to 1 while outside; added to the
     joint torque command."""
 

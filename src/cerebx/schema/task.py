@@ -4,7 +4,7 @@ small plants."""
 
 from __future__ import annotations
 
-from typing import ClassVar, Literal
+from typing import Literal
 
 from pydantic import Field, model_validator
 
@@ -33,7 +33,7 @@ class JointSineTask(Strict):
 
 
 class _CartesianTask(Strict):
-    """Common fields of the Cartesian Baxter tasks (thesis §2.2.9, §3.2.5)."""
+    """Common fields of the Cartesian Baxter tasks (docs/models.md, tasks)."""
 
     period_s: PositiveFloat = Field(2.0, description="one trial")
     radius_m: PositiveFloat = Field(0.12, description="circle radius / eight half-height")
@@ -63,7 +63,7 @@ class InclinedCircleTask(_CartesianTask):
 
 
 class CircleEightTask(_CartesianTask):
-    """One circle then one eight (thesis Fig. 3.3 C)."""
+    """One circle then one eight, 4 s in all."""
 
     kind: Literal["circle_eight"] = "circle_eight"
     period_s: PositiveFloat = 4.0
@@ -92,48 +92,3 @@ class ReachingTask(_CartesianTask):
         if self.out_s >= self.period_s:
             raise ValueError(f"out_s ({self.out_s}) must be shorter than period_s ({self.period_s})")
         return self
-
-
-class LuqueEightTask(Strict):
-    """Luque et al. 2011 Eq. 1, three joints: q1 = A1 sin(w t) + C1, q2 = A2 sin(w t + theta) + C2,
-    q3 = A2 sin(w t + 2 theta) + C3, one trial = one period. The paper gives no constants and writes
-    sin(pi t) for a 1 s trial, which does not close; here w = 2 pi / period_s, and the constants are
-    constructed so that the LWR hand traces an eight (seen from above, one self-crossing) as in its Fig. 2.
-    Also gives the desired acceleration ``ref.qdd`` (for the crude inverse dynamics)."""
-
-    extra_reference: ClassVar[dict[str, str]] = {"qdd": "rad/s^2"}
-
-    kind: Literal["luque_eight"] = "luque_eight"
-    period_s: PositiveFloat = Field(1.0, description="one trial (paper: 1 s)")
-    amplitude1_rad: float = Field(0.5, description="A1 (constructed)")
-    amplitude2_rad: float = Field(0.5, description="A2, shared by q2 and q3 (constructed)")
-    theta_rad: float = Field(2.356194490192345, description="theta, phase step between joints (constructed: 3 pi/4)")
-    offset_rad: tuple[float, float, float] = Field((0.0, 0.6, 0.6), description="C1, C2, C3 (constructed)")
-
-    @property
-    def n_joints(self) -> int:
-        return 3
-
-
-class WristOscillationTask(Strict):
-    """Capolei et al. 2020 Eq. 1-2: q_r = A sin(2 pi f t + phi), qdot_r = 2 pi f A cos(2 pi f t + phi);
-    one trial is one period 1/f."""
-
-    kind: Literal["wrist_oscillation"] = "wrist_oscillation"
-    frequency_hz: PositiveFloat = Field(0.25, description="f")
-    amplitude_rad: tuple[float, ...] = Field((0.1727, 0.1363, 0.0345), description="A per joint (prosup, yaw, pitch)")
-    phase_rad: tuple[float, ...] = Field((1.5707963267948966, 1.5707963267948966, 0.0), description="phi per joint")
-
-    @model_validator(mode="after")
-    def _same_length(self) -> WristOscillationTask:
-        if len(self.amplitude_rad) != len(self.phase_rad):
-            raise ValueError("amplitude_rad and phase_rad need one value per joint each")
-        return self
-
-    @property
-    def period_s(self) -> float:
-        return 1.0 / self.frequency_hz
-
-    @property
-    def n_joints(self) -> int:
-        return len(self.amplitude_rad)

@@ -1,6 +1,6 @@
-"""Spike-to-torque decoder (thesis Eq. 2.16-2.17 / 3.4-3.5, facts §4): per joint,
+"""Spike-to-torque decoder (docs/models.md): per joint,
 tau_j = alpha_j (agonist - antagonist DCN spikes in the 2 ms bin), no offset, no memory.
-For a muscle stage the two sides are kept apart (thesis §4.6.2): M_ag,j and M_at,j = the side's
+For a muscle stage the two sides are kept apart: M_ag,j and M_at,j = the side's
 spikes in the bin / full scale, each in [0, 1] when the full scale is the most the side can fire,
 or capped at 1 (saturate)."""
 

@@ -1,4 +1,4 @@
-"""Analog-to-spike encoders (thesis §2.2.6, facts §3).
+"""Analog-to-spike encoders (docs/models.md).
 
 MF box coding: per joint and signal (q_d, q, qd_d, qd), ``F`` fibres with centres evenly spaced
 over [r_min, r_max] and half-width step * width_factor; the input is clipped to the range and
@@ -16,7 +16,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from cerebx.schema.controller import BoxEncoder, CFEncoder
+from cerebx.controllers.snn.schema import BoxEncoder, CFEncoder
 
 STEP_S = 0.002
 

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from cerebx.schema.network import NetworkConfig
 from cerebx.snn import kernels
+from cerebx.snn.schema import NetworkConfig
 from cerebx.snn.topology import (
     I_COMPACT,
     I_RATIO,
@@ -17,7 +17,6 @@ from cerebx.snn.topology import (
     KIND_LIF_AMPA,
     P_EL,
     build_topology,
-    structure_fingerprint,
 )
 
 COMPACT_MIN = 4096  # AMPA-only populations this large integrate only their non-resting neurons
@@ -53,7 +52,7 @@ class Network:
         self.n_threads = numba.get_num_threads() if parallel else 1
         self.topo = topo = build_topology(cfg)
         self.n_sub = topo.n_sub
-        self.fingerprint = structure_fingerprint(cfg)
+        self.fingerprint = cfg.fingerprint()
         n = topo.n_neurons
         self.u = np.zeros(n, dtype=np.float32)
         self._g = np.zeros((3, n), dtype=np.float32)

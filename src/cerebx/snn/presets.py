@@ -1,4 +1,4 @@
-"""The thesis network (Table 3.1 + Table 2.2) built in code, scaled by fibres per signal.
+"""The ``full`` network (conf/network/full.yaml) built in code, scaled by fibres per signal.
 
 conf/network/*.yaml are the user-facing presets; this module gives tests and the benchmark the
 same topology without going through Hydra. ``fibers=10, per_joint=100`` is the full network.
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from cerebx.schema.network import NetworkConfig
+from cerebx.snn.schema import NetworkConfig
 
 # GC integration as EDLUT's GPU granule model (facts §2): RK2 with a 1 ms step, 3 sub-steps once V
 # is above (E_rest + V_th)/2. GC_RK4 is the same neuron with the default RK4 at the network dt.
@@ -21,10 +21,10 @@ DCN = dict(kind="lif_cond", C_m_pF=2.0, g_L_nS=0.2, E_L_mV=-70.0, E_AMPA_mV=0.0,
            tau_AMPA_ms=0.5, tau_NMDA_ms=14.0, tau_GABA_ms=10.0, V_thr_mV=-40.0, t_ref_ms=1.0)
 
 
-def thesis_network_dict(joints: int = 6, fibers: int = 10, per_joint: int = 100, kernels: int = 1,
-                        pf_weight: float = 2.0) -> dict[str, Any]:
-    """Table 3.1 topology; ``kernels`` > 1 gives the multikernel variant (thesis Fig. 3.10, facts
-    §2 "[D] 3-kernel variant"): one PC population per kernel, PC->DCN weight 1/kernels each."""
+def network_dict(joints: int = 6, fibers: int = 10, per_joint: int = 100, kernels: int = 1,
+                 pf_weight: float = 2.0) -> dict[str, Any]:
+    """The ``full`` topology; ``kernels`` > 1 gives the ``multikernel`` variant (one PC population per
+    kernel, PC->DCN weight 1/kernels each)."""
     n_mf, n_gc, n_x = joints * 4 * fibers, joints * fibers**4, joints * per_joint
     pops: dict[str, Any] = {
         "mf": {"size": n_mf, "neuron": {"kind": "input"}, "microcomplexes": joints},
@@ -61,10 +61,11 @@ def thesis_network_dict(joints: int = 6, fibers: int = 10, per_joint: int = 100,
                            "synapses": n_x, "weight_nS": 0.5}
     proj["cf_dcn_nmda"] = {"pre": "cf", "post": "dcn", "rule": {"kind": "one_to_one"}, "receptor": "nmda",
                            "synapses": n_x, "weight_nS": 0.25}
-    name = "thesis_ch3" if kernels == 1 else "multikernel"
+    name = "full" if kernels == 1 else "multikernel"
     return {"name": name, "dt_ms": 0.5, "populations": pops, "projections": proj,
             "io": {"mossy": "mf", "climbing": "cf", "output": "dcn", "purkinje": pcs, "granule": "gc"}}
 
 
-def thesis_network(**kw: Any) -> NetworkConfig:
-    return NetworkConfig.model_validate(thesis_network_dict(**kw))
+def network(**kw: Any) -> NetworkConfig:
+    """:func:`network_dict` validated."""
+    return NetworkConfig.model_validate(network_dict(**kw))

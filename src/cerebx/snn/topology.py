@@ -1,4 +1,4 @@
-"""Flatten a :class:`~cerebx.schema.network.NetworkConfig` into the arrays the kernels use.
+"""Flatten a :class:`~cerebx.snn.schema.NetworkConfig` into the arrays the kernels use.
 
 All neurons share one global index space (populations concatenated in config order, input
 fibres included). Small projections (one-to-one, joint combinations) become CSR tables keyed
@@ -8,13 +8,11 @@ by the global presynaptic index; all-to-all projections become dense float32 blo
 
 from __future__ import annotations
 
-import hashlib
-import json
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from cerebx.schema.network import AllToAll, JointCombinations, LIFNeuron, NetworkConfig, OneToOne
+from cerebx.snn.schema import AllToAll, JointCombinations, LIFNeuron, NetworkConfig, OneToOne
 
 RECEPTORS = {"ampa": 0, "nmda": 1, "gaba": 2}
 
@@ -166,20 +164,6 @@ def ltd_kernel_table(peak_ms: float, onset_ms: float, cutoff: float, dt_ms: floa
     return k.astype(np.float32)
 
 
-def structure_fingerprint(cfg: NetworkConfig) -> str:
-    """Hash of what shapes the state arrays (sizes, rules, receptors), not of weights or kernels,
-    so a learned state can be reloaded under a different learning-rule setting."""
-    shape = {
-        "dt_ms": cfg.dt_ms,
-        "pops": {k: [p.size, p.neuron.kind] for k, p in cfg.populations.items()},
-        "proj": {
-            k: [p.pre, p.post, p.rule.model_dump(), p.receptor, p.synapses, p.plasticity is not None]
-            for k, p in cfg.projections.items()
-        },
-    }
-    return hashlib.sha256(json.dumps(shape, sort_keys=True).encode()).hexdigest()[:16]
-
-
 def _pairs(rule, n_pre: int, n_post: int) -> tuple[np.ndarray, np.ndarray]:
     """(pre_local, post_local) synapse pairs of a sparse rule."""
     if isinstance(rule, OneToOne):
@@ -199,7 +183,7 @@ def _pairs(rule, n_pre: int, n_post: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def build_topology(cfg: NetworkConfig) -> Topology:
-    """Lay out populations and build every projection (a few seconds for the thesis network)."""
+    """Lay out populations and build every projection (a few seconds for the full network)."""
     dt = cfg.dt_ms
     n_sub = int(round(2.0 / dt))
     names = list(cfg.populations)

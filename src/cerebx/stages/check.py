@@ -16,7 +16,8 @@ from typing import Any
 import numpy as np
 
 from cerebx.signals import Frame, Message, Signal
-from cerebx.stages.base import Receiver, Stage, reference_signals
+from cerebx.stages.base import Receiver, Stage
+from cerebx.wiring import reference_signals
 
 
 class StageContractError(AssertionError):

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from cerebx import runfiles
 from cerebx.controllers.base import CommandMsg, ControlInput, Controller, SensorMsg
 from cerebx.signals import Frame, Signal, torque_controller_io
 from cerebx.stages.base import Stage
@@ -110,7 +111,7 @@ class Composite(Stage):
     def part_path(path: Path, i: int) -> Path:
         """Where part ``i`` keeps its state beside the run's state file."""
         path = Path(path)
-        return path.with_name(f"{path.stem}.part{i}{path.suffix}")
+        return path.with_name(runfiles.part_state(path.name, i))
 
     def save_state(self, path: Path) -> bool:
         saved = [part.save_state(self.part_path(path, i)) for i, part in enumerate(self.parts)]

@@ -1,4 +1,4 @@
-"""The upper limb's stages between the cerebellum and the muscles (thesis §4.3.2-4.3.3, Fig. 4.2-4.3).
+"""The upper limb's stages between the cerebellum and the muscles (docs/models.md).
 
 ``spinal_cord``: one motor neuron (MN) and one Ia interneuron (Ia IN) per muscle, leaky rate neurons
 (Eq. 4.1-4.2) updated exactly for an input held over the 2 ms step: r <- s + (r - s) exp(-dt / tau_m),
@@ -11,10 +11,10 @@ lasted that long, the first sample (the arm at rest before t = 0). Its rate is n
 
 with [l_min, l_max] each muscle's length range over the joint range (the plant's ``muscle.length`` bounds)
 and V = ``velocity_range_mm_per_s``; by default (``normalise: peak``) r_lo = 0, i.e. the rate over its peak.
-Both are constructed (the thesis only says "normalised to [0, 1]"): the default keeps the 30 ms-delayed
+Both are constructed (the source only says "normalised to [0, 1]"): the default keeps the 30 ms-delayed
 reflex loop of this strong arm from turning into clonus (with 'range' and V = 100 mm/s the resting arm
 oscillates at ~3 Hz; v^0.6 has an infinite slope at v = 0, so some small limit cycle always remains).
-Shortening (v < 0) lowers the rate (odd extension of v^0.6; the thesis gives the law only for lengthening).
+Shortening (v < 0) lowers the rate (odd extension of v^0.6; the source gives the law only for lengthening).
 The MN rates are the muscle excitations: the plant's MuJoCo muscles integrate the activation dynamics
 (Eq. 4.4-4.5) once.
 

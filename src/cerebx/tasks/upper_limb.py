@@ -1,6 +1,6 @@
-"""Upper-limb tasks (thesis §4.3.4, Fig. 4.4): flexion-extension and a vertical circle, both with
+"""Upper-limb tasks: flexion-extension and a vertical circle, both with
 bell-shaped velocity profiles from the minimum-jerk polynomial s(u) = 10u^3 - 15u^4 + 6u^5. The paths are
-constructed (the thesis shows them only as a figure); see :mod:`cerebx.schema.arm_tasks`."""
+constructed; see :mod:`cerebx.schema.arm_tasks`."""
 
 from __future__ import annotations
 

@@ -1,0 +1,66 @@
+"""The platform's own kinds, registered through the ``cerebx.plugins`` entry point ``core`` like any
+plugin's. Builders are named as ``module:attr`` strings written here in code (never in configuration), so
+heavy modules (MuJoCo, numba kernels) load only when a run uses them."""
+
+from cerebx import registry
+from cerebx.controllers.snn import schema as snn
+from cerebx.schema import arm_tasks as at
+from cerebx.schema import controller as c
+from cerebx.schema import delay as d
+from cerebx.schema import events as e
+from cerebx.schema import muscles as m
+from cerebx.schema import plant as p
+from cerebx.schema import spinal as sp
+from cerebx.schema import stages as s
+from cerebx.schema import task as t
+
+
+def register() -> None:
+    registry.tasks.register(t.JointSineTask, "cerebx.tasks.joint_sine:JointSine")
+    registry.tasks.register(t.CircleTask, "cerebx.tasks.cartesian:build_circle")
+    registry.tasks.register(t.EightTask, "cerebx.tasks.cartesian:build_eight")
+    registry.tasks.register(t.InclinedCircleTask, "cerebx.tasks.cartesian:build_inclined_circle")
+    registry.tasks.register(t.CircleEightTask, "cerebx.tasks.cartesian:build_circle_eight")
+    registry.tasks.register(t.ReachingTask, "cerebx.tasks.cartesian:build_reaching")
+    registry.tasks.register(at.FlexionExtensionTask, "cerebx.tasks.upper_limb:FlexionExtension")
+    registry.tasks.register(at.VerticalCircleTask, "cerebx.tasks.upper_limb:VerticalCircle")
+
+    registry.plants.register(p.Planar2Config, "cerebx.plants.planar2:Planar2Arm")
+    registry.plants.register(p.BaxterConfig, "cerebx.plants.baxter:BaxterArm")
+    registry.plants.register(p.UpperLimbConfig, "cerebx.plants.upper_limb:UpperLimb")
+
+    registry.controllers.register(c.PDController, "cerebx.controllers.pd:PD")
+    registry.controllers.register(c.PositionController, "cerebx.controllers.position:PositionServo")
+    registry.controllers.register(c.PIDVelocity, "cerebx.controllers.pid:build_pid")
+    registry.controllers.register(c.CompositeController, "cerebx.build:build_composite")
+    registry.controllers.register(snn.SNNController, "cerebx.controllers.snn.controller:SNNControllerImpl")
+    registry.controllers.register(m.MuscleRestController, "cerebx.stages.muscles:build_muscle_rest")
+
+    # receivers take (cfg, ctx, signals the link delivers); other stages (cfg, ctx)
+    registry.stages.register(s.HoldConfig, "cerebx.stages.receivers:build_hold")
+    registry.stages.register(s.MeanFilterConfig, "cerebx.stages.receivers:build_mean")
+    registry.stages.register(s.FuturePastFilterConfig, "cerebx.stages.receivers:build_future_past")
+    registry.stages.register(s.SupervisorConfig, "cerebx.stages.supervisor:build_supervisor")
+    registry.stages.register(m.EkebergConfig, "cerebx.stages.muscles:build_ekeberg")
+    registry.stages.register(sp.SpinalCordConfig, "cerebx.stages.spinal:SpinalCord")
+    registry.stages.register(sp.DirectMusclesConfig, "cerebx.stages.spinal:DirectMuscles")
+    registry.stages.register(sp.SplitPairsConfig, "cerebx.stages.spinal:SplitPairs")
+
+    registry.delays.register(d.NoDelay, "cerebx.loop.delays:no_delay")
+    registry.delays.register(d.ConstantDelay, "cerebx.loop.delays:constant_delay")
+    registry.delays.register(d.GammaDelay, "cerebx.loop.delays:gamma_delay")
+    registry.delays.register(d.TraceDelay, "cerebx.loop.delays:trace_delay")
+    registry.delays.register(d.PercentileDelay, "cerebx.loop.delays:percentile_delay")
+
+    # event builders take (cfg, plant) and return the function that fires the event
+    registry.events.register(e.AttachPayload, "cerebx.plants.events:attach_payload")
+    registry.events.register(e.DetachPayload, "cerebx.plants.events:detach_payload")
+    registry.events.register(e.ElasticBand, "cerebx.plants.events:elastic_band")
+    registry.events.register(e.RemoveBand, "cerebx.plants.events:remove_band")
+    registry.events.register(e.ForcePulse, "cerebx.plants.events:force_pulse")
+    registry.events.register(e.FingerPush, "cerebx.plants.events:finger_push")
+    registry.events.register(e.Grab, "cerebx.plants.events:grab")
+
+    # mossy encoders take (cfg, lo, hi); climbing encoders (cfg, n_joints, fibres_per_joint, kpos, kvel, rng)
+    registry.encoders.register(snn.BoxEncoder, "cerebx.snn.encoders:MossyEncoder")
+    registry.encoders.register(snn.CFEncoder, "cerebx.snn.encoders:ClimbingEncoder")

@@ -1,0 +1,1 @@
+"""The cerebellar spiking controller: its schema (``schema.py``) beside its code (``controller.py``)."""

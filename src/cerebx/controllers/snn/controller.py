@@ -1,0 +1,316 @@
+"""The cerebellar spiking-network torque controller (docs/models.md).
+
+Pathway delay model (facts §7 "Spike timestamps"): the original stamps MF/CF spikes with the
+sample time + D and the DCN output with the network time + D. Here both are FIFOs of
+round(D / 2 ms) control steps: spikes encoded from the sample of step n enter the network at step
+n + k (afferent), and the torque the network decodes at step m is returned at step m + k
+(efferent), stamped with the step's own time. The CF error pairs the measured state with the
+desired state of the same sample time (the sensor message's stamp). ``cf_pathway_delay_ms`` gives
+the CF spikes their own afferent delay (the [B] setup shifted CF spikes by 40 ms and MF spikes by
+50 ms): the shared input FIFO is as long as the shorter of the two, and the longer one's spikes
+wait the difference in a FIFO of their own first.
+
+Pipelining: because the network's output is not needed until k steps after its input exists,
+the network can run ahead on a second thread, one chunk of k steps at a time, while the loop
+steps the plant and records (``pipeline: true``). The network sees the same inputs in the same
+order, so the results are identical to the synchronous order; only the wall time changes.
+
+Output (``output``): a joint torque (Eq. 3.5), or for a muscle stage the agonist and antagonist
+sides apart as ``muscle.ag``/``muscle.at`` = spikes of the side in the step / ``spikes_full_scale``
+The teaching signal is the joint error either way.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import threading
+import time
+from collections import deque
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cerebx import registry
+from cerebx.controllers.base import CommandMsg, ControlInput, Controller, TorqueMsg
+from cerebx.controllers.ranges import mf_ranges
+from cerebx.controllers.snn.schema import SNNController
+from cerebx.controllers.state import load_state_npz, save_state_npz
+from cerebx.errors import StateMismatchError
+from cerebx.snn.decoder import DCNDecoder
+from cerebx.snn.network import Network
+
+STEP_S = 0.002
+STATE_VERSION = 1
+
+
+def encoder_ranges(cfg: SNNController, n_joints: int, task: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi) of shape (n_joints, 4) for the MF signals q_d, q, qd_d, qd."""
+    return mf_ranges(cfg.mf.ranges, n_joints, task)
+
+
+class SNNControllerImpl(Controller):
+    def __init__(self, cfg: SNNController, ctx: Any):
+        t0 = time.perf_counter()
+        self.cfg = cfg
+        self.net_cfg = cfg.network
+        self.k_delay = int(round(cfg.pathway_delay_ms / (STEP_S * 1000)))
+        cf_ms = cfg.pathway_delay_ms if cfg.cf_pathway_delay_ms is None else cfg.cf_pathway_delay_ms
+        self.k_cf = int(round(cf_ms / (STEP_S * 1000)))
+        self.k_in = min(self.k_delay, self.k_cf)  # the shared afferent FIFO
+        # pipelined: the network gets its own core, so its kernels run single-threaded
+        self.hold = cfg.efferent != "stamp"  # 'auto' is resolved by the experiment; alone it means hold
+        # steps the network may run ahead of the tick that needs its output: afferent D, plus the
+        # efferent D when outputs are held back; a chunk is half of that so one can be in flight
+        slack = self.k_in + (self.k_delay if self.hold else 0)
+        self.chunk = max(1, slack // 2)
+        self.pipeline = cfg.pipeline and slack >= 2
+        self._worker: tuple[threading.Thread, dict] | None = None
+        self.net = Network(self.net_cfg, parallel=cfg.parallel and not self.pipeline)
+        self.net.learn = cfg.plasticity
+        io = self.net_cfg.io
+        self.sl_mf, self.sl_cf, self.sl_dcn = (self.net.index(p) for p in (io.mossy, io.climbing, io.output))
+        nj = cfg.n_joints
+        self.n_ctrl = nj
+        plant = getattr(ctx, "plant", None)
+        self.n_joints = plant.n_joints if plant is not None else nj
+        n_dcn = self.sl_dcn.stop - self.sl_dcn.start
+        n_cf = self.sl_cf.stop - self.sl_cf.start
+        if n_dcn % nj or n_cf % nj:
+            raise ValueError(f"network: {io.output} ({n_dcn}) and {io.climbing} ({n_cf}) must split "
+                             f"evenly into {nj} joints")
+        lo, hi = encoder_ranges(cfg, nj, getattr(ctx, "task", None))
+        self.mf = registry.encoders.build(cfg.mf, lo, hi)
+        if self.mf.n_fibers != self.sl_mf.stop - self.sl_mf.start:
+            raise ValueError(f"network: {io.mossy} has {self.sl_mf.stop - self.sl_mf.start} fibres, the "
+                             f"encoder needs {self.mf.n_fibers} ({nj} joints x 4 signals x "
+                             f"{cfg.mf.fibers_per_signal})")
+        self._rng_seed = ctx.rng("controller.snn.cf")
+        self.cf = registry.encoders.build(cfg.cf, nj, n_cf // nj, cfg.error.kpos, cfg.error.kvel, self._rng_seed)
+        self.decoder = DCNDecoder(cfg.decoder.alpha_Nm_per_spike, nj, n_dcn // nj)
+        self.muscles = cfg.output == "agonist_antagonist"
+        self.width = 2 * nj if self.muscles else nj  # values per step in the output FIFO ([ag, at] or tau)
+        self.full_scale = np.asarray(cfg.decoder.full_scale(nj), float)  # M = 1 (agonist_antagonist output)
+        self.recorder = None
+        self.record = {name: self.net.index(name) for name in cfg.record_spikes}
+        self.fingerprint = self.net.fingerprint
+        self.config_hash = hashlib.sha256(
+            json.dumps([self.net_cfg.model_dump(mode="json"), cfg.model_dump(mode="json")],
+                       sort_keys=True).encode()).hexdigest()[:16]
+        self._reset_loop_state()
+        self.build_s = time.perf_counter() - t0
+
+    # ------------------------------------------------------------------ loop
+    def _reset_loop_state(self) -> None:
+        self._join()
+        k = self.k_delay
+        empty = np.zeros(0, np.int32)
+        self._pending: deque[np.ndarray] = deque([empty] * self.k_in)  # inputs not yet simulated
+        # MF / CF spikes waiting for the shared FIFO (the longer pathway's extra delay)
+        self._mf_lag: deque[np.ndarray] = deque([empty] * (k - self.k_in))
+        self._cf_lag: deque[np.ndarray] = deque([empty] * (self.k_cf - self.k_in))
+        # outputs not yet emitted (held back by the efferent delay unless they are stamped instead)
+        self._ready: deque[np.ndarray] = deque([np.zeros(self.width)] * (k if self.hold else 0))
+        self._net_step = 0  # network steps simulated so far (step m is stamped m * 2 ms)
+        self._des: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._dcn_spikes = 0
+        self._steps = 0
+        self.last_error = np.zeros(self.n_ctrl)
+
+    # ------------------------------------------------------------------ network execution
+    def _simulate(self, inputs: list[np.ndarray], first_step: int) -> list[tuple]:
+        """Run the network over ``inputs`` (one GIL-free call); per step: (time, output, DCN spike
+        count, recorded spikes), the output a torque or [M_ag, M_at]. Decoding is done for the whole
+        chunk at once."""
+        idx, off = self.net.step_many(inputs)
+        n, nj = len(inputs), self.n_ctrl
+        step_of = np.repeat(np.arange(n), np.diff(off))
+        lo, hi = self.sl_dcn.start, self.sl_dcn.stop
+        sel = (idx >= lo) & (idx < hi)
+        dcn, st = idx[sel] - lo, step_of[sel]
+        dec = self.decoder
+        if self.muscles:
+            taus = dec.sides(dcn, st, n, self.full_scale, self.cfg.decoder.saturate)
+        else:
+            net = np.bincount(st * nj + dcn // dec.per_joint, weights=dec.sign[dcn], minlength=n * nj)
+            taus = dec.alpha * net.reshape(n, nj)
+        counts = np.bincount(st, minlength=n)
+        out = []
+        for i in range(n):
+            rec = None
+            if self.recorder is not None:
+                step_idx = idx[off[i]:off[i + 1]]
+                rec = {name: step_idx[(step_idx >= sl.start) & (step_idx < sl.stop)] - sl.start
+                       for name, sl in self.record.items()}
+            out.append(((first_step + i) * STEP_S, taus[i], int(counts[i]), rec))
+        return out
+
+    def _absorb(self, results: list[tuple]) -> None:
+        for t, tau, n_dcn, rec in results:
+            self._ready.append(tau)
+            self._dcn_spikes += n_dcn
+            if rec is not None:
+                for name, sel in rec.items():
+                    self.recorder.spikes(f"/spikes/{name}", t, sel)
+        self._net_step += len(results)
+
+    def _launch(self) -> None:
+        """Start simulating the next chunk of pending inputs on the worker thread."""
+        chunk = [self._pending.popleft() for _ in range(self.chunk)]
+        first = self._net_step  # no chunk is in flight when a new one starts
+        box: dict[str, Any] = {}
+
+        def work() -> None:
+            try:
+                box["out"] = self._simulate(chunk, first)
+            except BaseException as exc:  # re-raised in the loop's thread by _join
+                box["err"] = exc
+
+        self._worker = (threading.Thread(target=work, name="cerebx-snn", daemon=True), box)
+        self._worker[0].start()
+
+    def _join(self) -> None:
+        worker = self._worker
+        if worker is None:
+            return
+        thread, box = worker
+        thread.join()
+        self._worker = None
+        if "err" in box:
+            raise box["err"]
+        self._absorb(box["out"])
+
+    def _advance(self) -> None:
+        """Make sure this tick's torque is ready; in pipeline mode keep one chunk in flight."""
+        if not self.pipeline:
+            self._absorb(self._simulate([self._pending.popleft()], self._net_step))
+            return
+        while not self._ready:
+            if self._worker is not None:
+                self._join()
+            else:
+                self._absorb(self._simulate([self._pending.popleft()], self._net_step))
+        if self._worker is None and len(self._pending) >= self.chunk:
+            self._launch()
+
+    def reset(self, rng: np.random.Generator) -> None:
+        self.cf.rng = rng
+        self.cf.reset()
+        self.net.reset_state()
+        self._reset_loop_state()
+
+    def position_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The MF position-encoder ranges, which the original used as watchdog bounds."""
+        lo, hi = self.mf.lo[:, 1], self.mf.hi[:, 1]
+        if self.n_joints > self.n_ctrl:
+            pad = self.n_joints - self.n_ctrl
+            lo, hi = np.concatenate([lo, np.zeros(pad)]), np.concatenate([hi, np.zeros(pad)])
+        return lo.copy(), hi.copy()
+
+    def _desired_at(self, stamp_s: float, inp: ControlInput) -> tuple[np.ndarray, np.ndarray]:
+        return self._des.get(int(round(stamp_s / STEP_S)), (inp.q_des, inp.qd_des))
+
+    def step(self, inp: ControlInput) -> TorqueMsg:
+        self._des[inp.tick] = (inp.q_des, inp.qd_des)
+        self._des.pop(inp.tick - 2000, None)
+        s = inp.sensor
+        if s is None:
+            mf = cf = np.zeros(0, np.int32)
+        else:
+            q_des, qd_des = self._desired_at(s.stamp_s, inp)
+            mf = (self.mf.active(q_des, s.q, qd_des, s.qd) + self.sl_mf.start).astype(np.int32)
+            e = self.cf.error(q_des, s.q, qd_des, s.qd)
+            self.last_error = e
+            cf = (self.cf.active(e) + self.sl_cf.start).astype(np.int32)
+        self._mf_lag.append(mf)
+        self._cf_lag.append(cf)
+        self._pending.append(np.concatenate([self._mf_lag.popleft(), self._cf_lag.popleft()]))
+        self._advance()
+        self._steps += 1
+        stamp = inp.t_s if self.hold else inp.t_s + self.k_delay * STEP_S
+        out = self._ready.popleft()
+        if self.muscles:
+            ag, at = np.zeros(self.n_joints), np.zeros(self.n_joints)
+            ag[: self.n_ctrl], at[: self.n_ctrl] = out[: self.n_ctrl], out[self.n_ctrl:]
+            return CommandMsg(stamp, {"muscle.ag": ag, "muscle.at": at})
+        tau = np.zeros(self.n_joints)
+        tau[: self.n_ctrl] = out
+        return TorqueMsg(stamp, tau)
+
+    # ------------------------------------------------------------------ reporting
+    def end_trial(self, trial: int) -> dict[str, float]:
+        self._join()  # weights and counters must not change while they are read
+        out: dict[str, float] = {}
+        n_dcn = self.sl_dcn.stop - self.sl_dcn.start
+        if self._steps:
+            out["dcn_rate_hz"] = self._dcn_spikes / (n_dcn * self._steps * STEP_S)
+        self._dcn_spikes = self._steps = 0
+        every = self.cfg.weight_summary_every_trials
+        if every and trial % every == 0:
+            for name in self.net.plastic_projections:
+                w = self.net.weights(name)
+                out[f"w_{name}_mean"] = float(w.mean(dtype=np.float64))
+                out[f"w_{name}_std"] = float(w.std(dtype=np.float64))
+                out[f"w_{name}_min"] = float(w.min())
+                out[f"w_{name}_max"] = float(w.max())
+        lost = int(self.net.pf_lost.sum())
+        if lost:
+            out["ltd_pf_spikes_dropped"] = float(lost)
+        return out
+
+    def attach_recorder(self, recorder: Any) -> None:
+        self.recorder = recorder if hasattr(recorder, "spikes") else None
+
+    def describe(self) -> dict[str, Any]:
+        return {
+            "network": self.net_cfg.name,
+            "neurons": self.net.n_neurons,
+            "synapses": self.net.n_synapses,
+            "plastic_synapses": self.net.n_plastic,
+            "build_s": round(self.build_s, 3),
+            "pathway_delay_steps": self.k_delay,
+            "cf_pathway_delay_steps": self.k_cf,
+            "fingerprint": self.fingerprint,
+        }
+
+    # ------------------------------------------------------------------ state
+    def save_state(self, path: Path) -> None:
+        self._join()
+        path = Path(path)
+        arrays = {f"net_{k}": v for k, v in self.net.state_arrays().items()}
+        arrays["cf_burst_left"] = self.cf.burst_left
+        arrays["out_fifo"] = np.array(list(self._ready)).reshape(len(self._ready), self.width)
+        meta = {"version": STATE_VERSION, "fingerprint": self.fingerprint, "config": self.config_hash,
+                "network": self.net_cfg.name, "rng": self.cf.rng.bit_generator.state}
+        arrays["in_fifo"] = np.array(json.dumps([a.tolist() for a in self._pending]))
+        arrays["lag_fifos"] = np.array(json.dumps([[a.tolist() for a in self._mf_lag],
+                                                   [a.tolist() for a in self._cf_lag]]))
+        save_state_npz(path, meta, **arrays)
+
+    def load_state(self, path: Path) -> None:
+        path = Path(path)
+        data, meta = load_state_npz(path, "SNN")
+        if meta.get("fingerprint") != self.fingerprint:
+            raise StateMismatchError(
+                f"{path}: saved from network {meta.get('network')!r} with a different structure "
+                f"(fingerprint {meta.get('fingerprint')}), this controller runs {self.net_cfg.name!r} "
+                f"({self.fingerprint})")
+        try:
+            self.net.load_arrays({k[4:]: data[k] for k in data.files if k.startswith("net_")})
+        except (KeyError, ValueError) as exc:
+            raise StateMismatchError(f"{path}: {exc}") from None
+        self.cf.burst_left[:] = data["cf_burst_left"]
+        self.cf.rng.bit_generator.state = meta["rng"]
+        fifo = json.loads(str(data["in_fifo"]))
+        self._join()
+        lags = json.loads(str(data["lag_fifos"])) if "lag_fifos" in data.files else [[], []]
+        out_fifo = data["out_fifo"]
+        same = (len(fifo) + len(out_fifo) == self.k_in + (self.k_delay if self.hold else 0)
+                and len(lags[0]) == self.k_delay - self.k_in and len(lags[1]) == self.k_cf - self.k_in
+                and out_fifo.shape[1:] == (self.width,))
+        if same:  # resume exactly (same delays and output kind)
+            self._pending = deque(np.asarray(a, dtype=np.int32) for a in fifo)
+            self._ready = deque(np.asarray(r, dtype=float) for r in out_fifo)
+            self._mf_lag = deque(np.asarray(a, dtype=np.int32) for a in lags[0])
+            self._cf_lag = deque(np.asarray(a, dtype=np.int32) for a in lags[1])

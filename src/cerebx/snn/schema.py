@@ -1,0 +1,280 @@
+"""Spiking network topology as data: populations, projections, neuron models, plasticity.
+
+A network preset is a table of populations and projections (``conf/network``). Validation checks
+that each projection's declared synapse count is what its connection rule produces from the
+population sizes, so a typo in a table is caught before anything is built.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from typing import Annotated, Literal
+
+from pydantic import Field, model_validator
+
+from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
+
+
+class Integration(Strict):
+    """How a LIF population's membrane equation is integrated. Conductances always decay exactly
+    (g <- g e^(-h/tau)); the integrator sees the exact conductance at its stage times."""
+
+    method: Literal["rk4", "rk2", "euler"] = Field(
+        "rk4", description="rk4: classical Runge-Kutta; rk2: Heun (explicit trapezoid, EDLUT RK2); "
+        "euler: forward Euler"
+    )
+    dt_ms: PositiveFloat | None = Field(
+        None, description="integration step (ms); a multiple of the network dt_ms that divides 2 ms. "
+        "None = the network dt_ms. Spikes are emitted, and input arriving between two steps takes "
+        "effect (with its exactly decayed conductance), at the step boundaries"
+    )
+    bifixed_substeps: int = Field(
+        1, ge=1, description="EDLUT Bifixed: a step that starts with V above (E_L + V_thr)/2 (or whose "
+        "one-step estimate ends above it) is integrated as this many equal sub-steps (1 = off)"
+    )
+
+
+class LIFNeuron(Strict):
+    """Conductance-based leaky integrate-and-fire neuron (docs/models.md)."""
+
+    kind: Literal["lif_cond"] = "lif_cond"
+    C_m_pF: PositiveFloat = Field(description="membrane capacitance")
+    g_L_nS: PositiveFloat = Field(description="leak conductance")
+    E_L_mV: float = Field(description="resting (and reset) potential")
+    E_AMPA_mV: float = Field(0.0, description="excitatory reversal potential (AMPA and NMDA)")
+    E_GABA_mV: float = Field(-80.0, description="inhibitory reversal potential")
+    tau_AMPA_ms: PositiveFloat = Field(description="AMPA conductance decay time constant")
+    tau_NMDA_ms: PositiveFloat = Field(14.0, description="NMDA conductance decay time constant")
+    tau_GABA_ms: PositiveFloat = Field(10.0, description="GABA conductance decay time constant")
+    V_thr_mV: float = Field(description="firing threshold")
+    t_ref_ms: NonNegFloat = Field(description="refractory period (V held at E_L)")
+    clamp_at_rest: bool = Field(
+        False, description="clamp V >= E_L (EDLUT models 1_1 used for GC and PC do this)"
+    )
+    integration: Integration = Field(
+        default_factory=Integration,
+        description="integration method and step (default: RK4 at the network dt_ms)",
+    )
+
+    @model_validator(mode="after")
+    def _threshold_above_rest(self) -> LIFNeuron:
+        if self.V_thr_mV <= self.E_L_mV:
+            raise ValueError(f"V_thr_mV ({self.V_thr_mV}) must be above E_L_mV ({self.E_L_mV})")
+        return self
+
+
+class InputFiber(Strict):
+    """A fibre whose spikes are produced by an encoder (mossy or climbing fibre), not integrated."""
+
+    kind: Literal["input"] = "input"
+
+
+Neuron = Annotated[LIFNeuron | InputFiber, Field(discriminator="kind")]
+
+
+class Population(Strict):
+    """A group of identical neurons, optionally split into per-joint microcomplexes."""
+
+    size: int = Field(gt=0, description="number of neurons")
+    neuron: Neuron
+    microcomplexes: int = Field(1, gt=0, description="equal blocks (one per joint); must divide size")
+    description: str = ""
+
+    @model_validator(mode="after")
+    def _blocks_divide(self) -> Population:
+        if self.size % self.microcomplexes:
+            raise ValueError(
+                f"microcomplexes ({self.microcomplexes}) must divide the population size ({self.size})"
+            )
+        return self
+
+
+class AllToAll(Strict):
+    """Every pre neuron reaches every post neuron: n_pre * n_post synapses."""
+
+    kind: Literal["all_to_all"] = "all_to_all"
+
+
+class OneToOne(Strict):
+    """Pre neuron i reaches post neuron i: n synapses (sizes must be equal)."""
+
+    kind: Literal["one_to_one"] = "one_to_one"
+
+
+class JointCombinations(Strict):
+    """Granular-layer state coding (facts §1): per joint, the pre population holds ``signals``
+    subgroups of ``fibers_per_signal`` fibres; each post neuron takes one fibre from every subgroup
+    of its joint, and the post population enumerates all fibers_per_signal**signals combinations.
+    """
+
+    kind: Literal["joint_combinations"] = "joint_combinations"
+    joints: int = Field(gt=0)
+    signals: int = Field(gt=0)
+    fibers_per_signal: int = Field(gt=0)
+
+
+Rule = Annotated[AllToAll | OneToOne | JointCombinations, Field(discriminator="kind")]
+
+
+class KernelSTDP(Strict):
+    """PF-PC plasticity (docs/models.md).
+
+    LTP: +ltp_nS per presynaptic spike. LTD: at each teacher (CF) spike, ltd_nS * k(t_CF - t_PF)
+    for every buffered PF spike, with k = 0 before the onset and k = (t'/tau) e^(1 - t'/tau),
+    t' = t - onset, tau = peak - onset, so k(peak) = 1.
+    """
+
+    kind: Literal["kernel_stdp"] = "kernel_stdp"
+    ltp_nS: NonNegFloat = Field(0.002, description="alpha: increment per PF spike")
+    ltd_nS: float = Field(-0.0008, le=0, description="beta: scale of the decrement at a CF spike")
+    kernel_peak_ms: PositiveFloat = Field(150.0, description="tau_LTD: time of the kernel maximum")
+    kernel_onset_ms: NonNegFloat = Field(120.0, description="d_k: kernel is zero before this")
+    kernel_cutoff: float = Field(0.01, gt=0, lt=1, description="kernel values below this are dropped")
+    teacher: str = Field(description="name of the projection whose spikes trigger LTD (CF->PC)")
+
+    @model_validator(mode="after")
+    def _peak_after_onset(self) -> KernelSTDP:
+        if self.kernel_peak_ms <= self.kernel_onset_ms:
+            raise ValueError(
+                f"kernel_peak_ms ({self.kernel_peak_ms}) must be greater than "
+                f"kernel_onset_ms ({self.kernel_onset_ms})"
+            )
+        return self
+
+
+class Projection(Strict):
+    """Synapses from one population to another (one row of a network table)."""
+
+    pre: str
+    post: str
+    rule: Rule
+    receptor: Literal["ampa", "nmda", "gaba"]
+    synapses: int = Field(gt=0, description="declared synapse count; must match the rule")
+    weight_nS: NonNegFloat = Field(description="initial weight")
+    weight_range_nS: tuple[NonNegFloat, NonNegFloat] | None = Field(
+        None, description="[min, max] for plastic synapses"
+    )
+    delay_ms: PositiveFloat = Field(1.0, description="synaptic delay")
+    plasticity: KernelSTDP | None = None
+    teaching: bool = Field(False, description="carries a teaching signal only (no current)")
+
+    @model_validator(mode="after")
+    def _weights_in_range(self) -> Projection:
+        if self.weight_range_nS is not None:
+            lo, hi = self.weight_range_nS
+            if lo > hi:
+                raise ValueError(f"weight_range_nS min ({lo}) is greater than max ({hi})")
+            if not lo <= self.weight_nS <= hi:
+                raise ValueError(f"initial weight_nS ({self.weight_nS}) is outside weight_range_nS {[lo, hi]}")
+        if self.plasticity is not None and self.weight_range_nS is None:
+            raise ValueError("a plastic projection needs weight_range_nS")
+        return self
+
+
+class NetworkIO(Strict):
+    """Which populations the encoders drive and the decoder reads."""
+
+    mossy: str = "mf"
+    climbing: str = "cf"
+    output: str = "dcn"
+    purkinje: list[str] = Field(default_factory=lambda: ["pc"])
+    granule: str = "gc"
+
+
+class NetworkConfig(Strict):
+    """A whole cerebellar network: named populations and projections."""
+
+    name: str
+    dt_ms: PositiveFloat = Field(0.5, description="neuron integration step (divides 2 ms and the delays)")
+    neurons: dict[str, LIFNeuron] = Field(
+        default_factory=dict, description="named parameter sets that populations refer to"
+    )
+    populations: dict[str, Population]
+    projections: dict[str, Projection]
+    io: NetworkIO = NetworkIO()
+
+    @model_validator(mode="after")
+    def _consistent(self) -> NetworkConfig:
+        problems: list[str] = []
+        pops = self.populations
+        for name, p in self.projections.items():
+            where = f"projections.{name}"
+            missing = [end for end in (p.pre, p.post) if end not in pops]
+            if missing:
+                problems.append(f"{where}: unknown population {', '.join(map(repr, missing))}")
+                continue
+            n_pre, n_post = pops[p.pre].size, pops[p.post].size
+            expected = _rule_count(p.rule, n_pre, n_post, where, problems)
+            if expected is not None and expected != p.synapses:
+                problems.append(
+                    f"{where}.synapses: declared {p.synapses:,} but rule {p.rule.kind} gives "
+                    f"{expected:,} for {n_pre:,} {p.pre} -> {n_post:,} {p.post}"
+                )
+            if abs(p.delay_ms / self.dt_ms - round(p.delay_ms / self.dt_ms)) > 1e-9:
+                problems.append(f"{where}.delay_ms: {p.delay_ms} is not a multiple of dt_ms {self.dt_ms}")
+            if p.plasticity is not None:
+                teacher = self.projections.get(p.plasticity.teacher)
+                if teacher is None:
+                    problems.append(f"{where}.plasticity.teacher: unknown projection {p.plasticity.teacher!r}")
+                elif teacher.post != p.post:
+                    problems.append(
+                        f"{where}.plasticity.teacher: {p.plasticity.teacher!r} targets {teacher.post!r}, "
+                        f"not {p.post!r}"
+                    )
+        io = self.io
+        for field, name in [("mossy", io.mossy), ("climbing", io.climbing), ("output", io.output),
+                            ("granule", io.granule), *[("purkinje", n) for n in io.purkinje]]:
+            if name not in pops:
+                problems.append(f"io.{field}: unknown population {name!r}")
+        if 2.0 / self.dt_ms != int(2.0 / self.dt_ms):
+            problems.append(f"dt_ms: {self.dt_ms} does not divide the 2 ms control step")
+        if problems:
+            raise ValueError("; ".join(problems))
+        return self
+
+    def fingerprint(self) -> str:
+        """Hash of what shapes the state arrays (sizes, rules, receptors), not of weights or kernels,
+        so a learned state can be reloaded under a different learning-rule setting."""
+        shape = {
+            "dt_ms": self.dt_ms,
+            "pops": {k: [p.size, p.neuron.kind] for k, p in self.populations.items()},
+            "proj": {
+                k: [p.pre, p.post, p.rule.model_dump(), p.receptor, p.synapses, p.plasticity is not None]
+                for k, p in self.projections.items()
+            },
+        }
+        return hashlib.sha256(json.dumps(shape, sort_keys=True).encode()).hexdigest()[:16]
+
+    @property
+    def n_neurons(self) -> int:
+        return sum(p.size for p in self.populations.values())
+
+    @property
+    def n_synapses(self) -> int:
+        return sum(p.synapses for p in self.projections.values())
+
+    @property
+    def n_plastic(self) -> int:
+        return sum(p.synapses for p in self.projections.values() if p.plasticity is not None)
+
+
+def _rule_count(rule, n_pre: int, n_post: int, where: str, problems: list[str]) -> int | None:
+    if isinstance(rule, AllToAll):
+        return n_pre * n_post
+    if isinstance(rule, OneToOne):
+        if n_pre != n_post:
+            problems.append(f"{where}.rule: one_to_one needs equal sizes, got {n_pre} -> {n_post}")
+            return None
+        return n_pre
+    r: JointCombinations = rule
+    want_pre = r.joints * r.signals * r.fibers_per_signal
+    want_post = r.joints * r.fibers_per_signal**r.signals
+    if n_pre != want_pre or n_post != want_post:
+        problems.append(
+            f"{where}.rule: joint_combinations({r.joints} joints, {r.signals} signals, "
+            f"{r.fibers_per_signal} fibres) needs {want_pre} pre and {want_post} post neurons, "
+            f"got {n_pre} and {n_post}"
+        )
+        return None
+    return n_post * r.signals

@@ -1,0 +1,149 @@
+"""Thesis Fig. 2.6 / 2.7: the learning process at an initial, intermediate and final stage, drawn
+from a run's MCAP (time-windowed reads through the file's index)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.colors import PowerNorm  # noqa: E402
+
+from cerebx.recording.reader import read_messages  # noqa: E402
+from cerebx.report.plot import panel_letter, save  # noqa: E402
+
+# thesis stages for a 500-trial run: t1 = 18-20 s, t2 = 318-320 s, t3 = 998-1000 s
+STAGE_FRACTIONS = (0.02, 0.32, 1.0)
+
+
+def stage_trials(n_trials: int) -> list[int]:
+    return sorted({max(0, min(n_trials - 1, int(round(f * n_trials)) - 1)) for f in STAGE_FRACTIONS})
+
+
+ALL_TOPICS = ("/joint_states/actual", "/joint_states/desired", "/spikes/dcn", "/control")
+
+
+def _window(run_dir: Path, t0: float, t1: float, topics: tuple[str, ...] = ALL_TOPICS) -> dict[str, Any]:
+    """Joint states, torques, DCN spikes and end-effector positions between t0 and t1 (s)."""
+    out: dict[str, list] = {"t": [], "q": [], "q_des": [], "tau": [], "spk_t": [], "spk_i": [], "ee": [],
+                            "ee_des": []}
+    lo, hi = int(t0 * 1e9), int(t1 * 1e9)
+    for topic, t, msg in read_messages(run_dir, list(topics), start_ns=lo, end_ns=hi):
+        if topic == "/joint_states/actual":
+            out["t"].append(t / 1e9)
+            out["q"].append([j["position"] for j in msg["joints"]])
+            out["tau"].append([j["effort"] for j in msg["joints"]])
+        elif topic == "/joint_states/desired":
+            out["q_des"].append([j["position"] for j in msg["joints"]])
+        elif topic == "/spikes/dcn":
+            out["spk_t"] += [t / 1e9] * len(msg["indices"])
+            out["spk_i"] += msg["indices"]
+        elif "ee" in msg:
+            out["ee"].append(msg["ee"])
+            if "ee_des" in msg:
+                out["ee_des"].append(msg["ee_des"])
+    return {k: np.asarray(v) for k, v in out.items()}
+
+
+def density(ax, x: np.ndarray, y: np.ndarray, bins: int = 60, cmap: str = "Blues", alpha: float = 1.0) -> None:
+    """2-D histogram of (x, y) as one raster image, square-root colour scale, empty bins blank."""
+    if not len(x):
+        return
+    h, xe, ye = np.histogram2d(x, y, bins=bins)
+    ax.imshow(np.ma.masked_equal(h.T, 0), origin="lower", extent=(xe[0], xe[-1], ye[0], ye[-1]), cmap=cmap,
+              norm=PowerNorm(0.5), alpha=alpha, aspect="auto", interpolation="nearest")
+
+
+def stages_figure(run_dir: Path, summary: dict, out: Path) -> Path:
+    """Thesis Fig. 2.6 / 2.7 a-f: DCN spikes, torques, joint and end-effector paths at three stages."""
+    n = summary.get("trials_completed") or 0
+    if n < 1:
+        raise ValueError(f"{run_dir}: no completed trial for the stage figure")
+    period = summary["sim_seconds"] / n
+    trials = stage_trials(n)
+    fig, axes = plt.subplots(4, len(trials), figsize=(4.2 * len(trials), 11), squeeze=False)
+    for c, k in enumerate(trials):
+        t0, t1 = k * period, (k + 1) * period
+        w = _window(run_dir, t0, t1)
+        ax = axes[0, c]
+        if w["spk_t"].size:
+            ax.plot(w["spk_t"], w["spk_i"], "k.", ms=0.8, mew=0)
+        ax.set_title(f"trial {k} ({t0:.0f}-{t1:.0f} s)")
+        ax.set_ylabel("DCN neuron index")
+        panel_letter(ax, "abc"[c])
+        ax = axes[1, c]
+        if w["tau"].size:
+            for j in range(w["tau"].shape[1]):
+                ax.plot(w["t"], w["tau"][:, j], lw=0.8, label=f"joint {j + 1}")
+            ax.legend(fontsize=6, ncol=3, loc="lower left")
+        ax.set_ylabel("torque (N·m)")
+        ax = axes[2, c]
+        if w["q"].size:
+            for j in range(w["q"].shape[1]):
+                ax.plot(w["t"], w["q_des"][:, j], "k--", lw=0.7)
+                ax.plot(w["t"], w["q"][:, j], lw=1.0)
+        ax.set_ylabel("joints (rad): desired -- / actual")
+        ax.set_xlabel("t (s)")
+        ax = axes[3, c]
+        hist = (_window(run_dir, max(0.0, t0 - 10 * period), t0, ("/control",))["ee"] if k >= 1
+                else np.zeros((0, 3)))
+        if hist.size:
+            density(ax, hist[:, 0], hist[:, 1])
+        if w["ee_des"].size:
+            ax.plot(w["ee_des"][:, 0], w["ee_des"][:, 1], "k--", lw=1, label="desired")
+        if w["ee"].size:
+            ax.plot(w["ee"][:, 0], w["ee"][:, 1], "C3", lw=1, label="actual")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        ax.legend(fontsize=7, loc="upper right")
+        panel_letter(ax, "def"[c])
+    fig.suptitle(f"{summary['task']} / {summary['controller']}: initial, intermediate and final stage "
+                 "(end-effector: previous 10 trials as density)", fontsize=11)
+    fig.tight_layout()
+    return save(fig, out)
+
+
+def _baseline_label(b: dict) -> str:
+    return (b.get("presets") or {}).get("controller", b["controller"])
+
+
+def mae_per_joint_axes(ax, summary: dict, baselines: list[dict], labels: list[str] | None = None,
+                       windows: list[tuple[int, int]] | None = None) -> None:
+    """MAE per trial of each joint and their mean, each baseline's mean MAE over its trials as a line,
+    and the table windows shaded."""
+    per_joint = np.asarray(summary.get("mae_per_joint_per_trial") or [])
+    if per_joint.size:
+        thin = len(per_joint) > 300
+        for j in range(per_joint.shape[1]):
+            ax.plot(per_joint[:, j], lw=0.5 if thin else 0.7, alpha=0.45 if thin else 0.7, label=f"joint {j + 1}")
+        ax.plot(per_joint.mean(1), "k", lw=1.6, label="mean of joints")
+    for i, b in enumerate(baselines):
+        name = labels[i] if labels else _baseline_label(b)
+        level = float(np.mean(b.get("mae_per_trial") or [b["final_mae"]]))
+        ax.axhline(level, ls="--", lw=1.2, color=f"C{(i + 6) % 10}", label=f"{name} baseline")
+    for i, (a, b) in enumerate(windows or []):
+        ax.axvspan(a - 0.5, b - 0.5, color="0.8" if i % 2 else "0.88", alpha=0.6, lw=0)
+        ax.annotate(f"{a}–{b}", ((a + b - 1) / 2, 1), xycoords=("data", "axes fraction"), xytext=(0, -10),
+                    textcoords="offset points", ha="center", fontsize=7, color="0.3")
+    ax.set_yscale("log")
+    ax.set_xlabel("trial")
+    ax.set_ylabel("position MAE (rad)")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, ncol=2, loc="lower left")
+
+
+def mae_per_joint_figure(summary: dict, baselines: list[dict], out: Path, labels: list[str] | None = None,
+                         windows: list[tuple[int, int]] | None = None) -> Path:
+    """Thesis Fig. 2.6 g / 2.7 g: MAE per trial of each joint and their mean, beside baselines."""
+    fig, ax = plt.subplots(figsize=(7.5, 4))
+    mae_per_joint_axes(ax, summary, baselines, labels, windows)
+    ax.set_title(f"{summary['task']} / {summary['controller']}: MAE per joint"
+                 + (" (table windows shaded)" if windows else ""))
+    panel_letter(ax, "g")
+    fig.tight_layout()
+    return save(fig, out)
