@@ -4,13 +4,14 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
+import mujoco
 import numpy as np
 import pytest
 
 from cerebx.controllers.base import ControlInput, SensorMsg
 from cerebx.controllers.position import PositionServo
 from cerebx.plants.base import PlantEvent
-from cerebx.plants.baxter import BaxterArm
+from cerebx.plants.baxter import JOINTS, BaxterArm, baxter_model, kinematic_model
 from cerebx.schema.controller import PositionController
 from cerebx.schema.plant import BaxterConfig
 
@@ -47,6 +48,30 @@ def test_arm_mass_matches_urdf():
     assert plant.model.body_subtreemass[plant.model.body("left_upper_shoulder").id] == pytest.approx(
         19.7108, abs=1e-3
     )
+
+
+@pytest.mark.parametrize(
+    "overrides, pendulum, counts, mass",
+    [
+        ({}, True, (12, 9, 1), 19.710821),  # + the idle pendulum bob (1 mg)
+        ({}, False, (11, 6, 1), 19.71082),
+        ({"sea": {"enabled": True}}, True, (18, 15, 7), 19.716821),  # + six 1 g rotors and their tendons
+        ({"gripper_mass_kg": 0.36, "gravity_compensation": True}, False, (12, 6, 1), 20.07082),
+    ],
+    ids=["default", "no_pendulum", "sea", "gripper_gravcomp"],
+)
+def test_model_layout_per_option(overrides, pendulum, counts, mass):
+    """What the config adds to baxter.xml: bodies, degrees of freedom, tendons and total mass; the six
+    controlled joints come first and each has a motor (on its rotor with SEA); w2 is gone."""
+    m = baxter_model(BaxterConfig(**overrides), pendulum)
+    assert (m.nbody, m.nv, m.ntendon) == counts
+    assert m.body_subtreemass[0] == pytest.approx(mass, abs=1e-9)
+    assert [m.joint(i).name for i in range(6)] == list(JOINTS) and m.nu == 6
+    targets = [m.joint(m.actuator_trnid[a, 0]).name for a in range(6)]
+    assert targets == [f"rotor_{j}" if "sea" in overrides else j for j in JOINTS]
+    assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "w2") == -1
+    assert (m.body_gravcomp[1:] > 0).sum() == (9 if overrides.get("gravity_compensation") else 0)
+    assert kinematic_model(w2=True).nq == 7 and kinematic_model().nq == 6
 
 
 def test_holding_torques_match_facts_table():
@@ -161,7 +186,7 @@ def test_finger_push_is_a_half_sine_at_the_end_effector():
     plant.handle_event(PlantEvent(0.0, "finger_push", {"force_N": (0.0, 4.0, 0.0), "duration_ms": 500.0}))
     peak = []
     for _ in range(250):  # 500 ms
-        peak.append(plant.data.xfrc_applied[plant._hand, 1])
+        peak.append(plant.data.xfrc_applied[plant.model.body("left_hand").id, 1])
         hold(plant, 1, kp=20.0, kd=2.0)
     peak = np.array(peak)
     assert peak[0] < 0.1 and peak.max() == pytest.approx(4.0, abs=0.01) and 120 <= peak.argmax() <= 130
@@ -171,7 +196,7 @@ def test_finger_push_is_a_half_sine_at_the_end_effector():
 
 
 def test_grab_drags_through_a_soft_spring_then_lets_go():
-    from cerebx.plants.baxter import grab_anchor
+    from cerebx.plants.interaction import grab_anchor
 
     plant = make(gravity_compensation=True)
     ee0 = plant.end_effector()
@@ -179,14 +204,14 @@ def test_grab_drags_through_a_soft_spring_then_lets_go():
     plant.handle_event(PlantEvent(0.0, "grab", {"stiffness_N_per_m": k, "displacement_m": tuple(disp),
                                                 "drag_ms": 400.0, "hold_ms": 400.0}))
     hold(plant, 300, kp=20.0, kd=2.0)  # 600 ms: dragged up, the spring pulls with k (anchor - ee)
-    anchor = plant.model.site_pos[plant._band_anchor]
+    anchor = plant.hand_interactions.band.anchor_m
     np.testing.assert_allclose(anchor, grab_anchor(0.6, ee0, disp, 0.4), atol=1e-9)
     np.testing.assert_allclose(anchor, ee0 + disp, atol=1e-9)
     ee = plant.end_effector()
     assert ee[2] - ee0[2] > 0.01  # a soft joint servo is dragged along
-    assert plant.model.tendon_stiffness[plant._band] == k
+    assert plant.hand_interactions.band.stiffness_N_per_m == k
     hold(plant, 150, kp=20.0, kd=2.0)  # past 800 ms: let go
-    assert plant.model.tendon_stiffness[plant._band] == 0.0
+    assert plant.hand_interactions.band.stiffness_N_per_m == 0.0
     hold(plant, 1500)  # nothing pulls any more: the stiff servo brings the hand back
     np.testing.assert_allclose(plant.end_effector(), ee0, atol=1e-3)
 

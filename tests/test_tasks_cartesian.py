@@ -4,12 +4,11 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-import mujoco
 import numpy as np
 import pytest
 
 from cerebx import registry
-from cerebx.plants.baxter import JOINT_RANGE, W2_RANGE, kinematic_mjcf
+from cerebx.plants.baxter import JOINT_RANGE, W2_RANGE, kinematic_model
 from cerebx.registry import load_plugins
 from cerebx.schema import task as T
 from cerebx.tasks import cartesian
@@ -42,14 +41,14 @@ def tasks(cache):
 
 @pytest.fixture(scope="module")
 def fk():
-    ik = SiteIK(mujoco.MjModel.from_xml_string(kinematic_mjcf()), "end_effector", 6, LO, HI)
+    ik = SiteIK(kinematic_model(), "end_effector", 6, LO, HI)
     return ik.fk
 
 
 @pytest.fixture(scope="module")
 def fk7():
     lo, hi = np.append(LO, W2_RANGE[0]), np.append(HI, W2_RANGE[1])
-    return SiteIK(mujoco.MjModel.from_xml_string(kinematic_mjcf(w2=True)), "end_effector", 7, lo, hi).fk
+    return SiteIK(kinematic_model(w2=True), "end_effector", 7, lo, hi).fk
 
 
 @pytest.mark.parametrize("kind", list(CONFIGS))

@@ -8,7 +8,7 @@ s0..w1: the end-effector lies on the w2 axis, so dropping w2 keeps the position 
 the hand about that axis only. The redundancy is resolved towards the home pose (w2 = 0), a
 *constructed* choice (MoveIt's is not recorded) that reproduces the original paths' joint envelopes
 to within 0.03 rad. IK runs once per task definition and is cached on disk under
-``ctx.cache_dir`` keyed by a hash of the task config and the arm's kinematic MJCF.
+``ctx.cache_dir`` keyed by a hash of the task config and the arm's MJCF file.
 """
 
 from __future__ import annotations
@@ -19,10 +19,9 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import mujoco
 import numpy as np
 
-from cerebx.plants.baxter import JOINT_RANGE, W2_RANGE, kinematic_mjcf
+from cerebx.plants.baxter import JOINT_RANGE, MJCF, W2_RANGE, kinematic_model
 from cerebx.tasks.base import Task, TrialReference
 from cerebx.tasks.ik import SiteIK
 
@@ -124,7 +123,7 @@ def periodic_derivative(q: np.ndarray, dt: float) -> np.ndarray:
 
 def _arm_ik() -> SiteIK:
     """IK of the end-effector on the 7-joint chain (s0..w1 and w2)."""
-    model = mujoco.MjModel.from_xml_string(kinematic_mjcf(w2=True))
+    model = kinematic_model(w2=True)
     lo = np.array([r[0] for r in JOINT_RANGE] + [W2_RANGE[0]])
     hi = np.array([r[1] for r in JOINT_RANGE] + [W2_RANGE[1]])
     return SiteIK(model, "end_effector", 7, lo, hi)
@@ -175,7 +174,7 @@ def solve_reaching(cfg: Any) -> dict[str, np.ndarray]:
 
 
 def cache_key(cfg: Any) -> str:
-    text = json.dumps(cfg.model_dump(mode="json"), sort_keys=True) + kinematic_mjcf(w2=True) + IK_VERSION
+    text = json.dumps(cfg.model_dump(mode="json"), sort_keys=True) + MJCF.read_text() + IK_VERSION
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 
