@@ -1,7 +1,7 @@
 """numba kernels of LWPR (Vijayakumar, D'Souza & Schaal 2005; update order of the reference
-library, facts ``luque2011_capolei2020.md`` §3). One output dimension = one sub-model; the receptive
-fields (RFs) of all outputs live in the preallocated arrays of a :class:`Store`; RF ``k`` of output
-``d`` is row ``[d, k]``:
+library, facts ``luque2011_capolei2020.md`` §3). One output dimension = one sub-model. A whole model
+lives in one flat float64 buffer (:func:`regions` gives the offsets); RF ``k`` of output ``d`` is row
+``[d, k]`` of the views of its :class:`Store`:
 
 - ``mat[d, k, f, :, :]`` (n_in x n_in): ``M`` (upper triangular, D = M^T M), ``D``, ``ALPHA`` (learning
   rates of M), and per PLS direction ``j`` (row ``j``): ``U`` regression axes, ``P`` projection axes,
@@ -12,24 +12,26 @@ fields (RFs) of all outputs live in the preallocated arrays of a :class:`Store`;
 - ``sca[d, k, f]``: ``BETA0``, ``SUME2`` (sum w e^2), ``SSP``, ``TRUST`` (0/1), ``NREG`` (directions in use);
 - ``count[d, f]``: ``N_RF`` (RFs in use), ``N_CREATED``, ``N_PRUNED``, ``N_SEEN`` (training pairs).
 
-``cfg`` holds the hyper-parameters (``HP_*``) followed by ``norm_in`` (n_in) and ``norm_out`` (n_out);
-``work`` (``work_shape``) is scratch owned by the caller.
+Before them in the buffer: ``cfg`` (``HP_*``: sizes and hyper-parameters, then ``norm_in``, ``norm_out``),
+``count`` and the scratch of one update (:class:`Work`).
 
-Speed: the entry points take the arrays one by one (a call from Python costs about 45 ns per array,
-as much per element of a plain tuple and twice that for a named tuple) and pass them on as named
-tuples of *borrowed* views (:func:`_borrow`) to helpers that numba inlines. numba counts references
-to every array value a helper binds with atomic operations; on views without a reference count
-these fold away, on owned arrays they cost more than the arithmetic of an RF update.
+Speed: a call from Python costs about 100 ns per array argument (numba wraps each in a new reference-
+counted object), hence one buffer. Inside, the kernels pass named tuples of views without a reference
+count (:func:`_view`, :func:`_borrow`) to helpers that numba inlines: numba counts references to
+every array value a helper binds with atomic operations, which fold away on such views but on owned
+arrays cost more than the arithmetic of an RF update.
 The meta learning of the learning rates (IDBD) of the reference library is not implemented.
 """
 
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import config, njit, types
+from numba.core import cgutils
 from numba.extending import intrinsic
 
 M_, D_, ALPHA, U_, P_, SXY, SZ = 0, 1, 2, 3, 4, 5, 6
@@ -41,10 +43,11 @@ N_SCA = 5
 N_RF, N_CREATED, N_PRUNED, N_SEEN = 0, 1, 2, 3
 N_COUNT = 4
 
-HP_W_GEN, HP_W_PRUNE, HP_INIT_LAMBDA, HP_FINAL_LAMBDA, HP_TAU_LAMBDA = 0, 1, 2, 3, 4
-HP_PENALTY, HP_DIAG_ONLY, HP_UPDATE_D, HP_ADD_THRESHOLD, HP_INIT_S2, HP_BISQUARE = 5, 6, 7, 8, 9, 10
-HP_CUTOFF, HP_INIT_D, HP_INIT_ALPHA, HP_Q_UPDATE, HP_Q_PREDICT = 11, 12, 13, 14, 15
-N_HP = 16
+H_N_IN, H_N_OUT, H_CAPACITY = 0, 1, 2
+HP_W_GEN, HP_W_PRUNE, HP_INIT_LAMBDA, HP_FINAL_LAMBDA, HP_TAU_LAMBDA = 3, 4, 5, 6, 7
+HP_PENALTY, HP_DIAG_ONLY, HP_UPDATE_D, HP_ADD_THRESHOLD, HP_INIT_S2, HP_BISQUARE = 8, 9, 10, 11, 12, 13
+HP_CUTOFF, HP_INIT_D, HP_INIT_ALPHA, HP_Q_UPDATE, HP_Q_PREDICT = 14, 15, 16, 17, 18
+N_HP = 19
 
 OK, FULL, BAD_X, BAD_Y = 0, 1, 2, 3
 
@@ -86,9 +89,17 @@ class Work(NamedTuple):
     dJdM: np.ndarray
 
 
-def work_shape(n_in: int) -> tuple[int, int]:
-    """Shape of the scratch array the entry points take: 7 vectors and 2 matrices of n_in."""
-    return 7 + 2 * n_in, n_in
+@njit(cache=True)
+def regions(n_in, n_out, capacity):
+    """Offsets in the model buffer of norm_in, norm_out, count, work, mat, vec, sca, and its size."""
+    o_norm_in = N_HP
+    o_norm_out = o_norm_in + n_in
+    o_count = o_norm_out + n_out
+    o_work = o_count + n_out * N_COUNT
+    o_mat = o_work + (7 + 2 * n_in) * n_in
+    o_vec = o_mat + n_out * capacity * N_MAT * n_in * n_in
+    o_sca = o_vec + n_out * capacity * N_VEC * n_in
+    return o_norm_in, o_norm_out, o_count, o_work, o_mat, o_vec, o_sca, o_sca + n_out * capacity * N_SCA
 
 
 def far_distance(w_floor: float, bisquare: bool) -> float:
@@ -115,15 +126,39 @@ def _borrow(typingctx, arr):
     return arr(arr), codegen
 
 
-@njit(**_INLINE)
-def _store(mat, vec, sca, count):
-    return Store(_borrow(mat), _borrow(vec), _borrow(sca), _borrow(count))
+@intrinsic
+def _view(typingctx, buf, offset, shape):
+    """C-contiguous view of ``buf[offset:]`` with the given shape, without a reference count."""
+    ndim = len(shape)
+    view_t = types.Array(buf.dtype, ndim, "C")
+
+    def codegen(context, builder, sig, args):
+        src = context.make_array(buf)(context, builder, value=args[0])
+        dims = [context.cast(builder, v, t, types.intp)
+                for v, t in zip(cgutils.unpack_tuple(builder, args[2], ndim), shape.types)]
+        itemsize = context.get_constant(types.intp, context.get_abi_sizeof(context.get_data_type(buf.dtype)))
+        strides, step = [], itemsize
+        for dim in reversed(dims):
+            strides.insert(0, step)
+            step = builder.mul(step, dim)
+        data = builder.gep(src.data, [context.cast(builder, args[1], sig.args[1], types.intp)])
+        view = context.make_array(view_t)(context, builder)
+        context.populate_array(view, data=data, shape=dims, strides=strides, itemsize=itemsize, meminfo=None)
+        return view._getvalue()
+
+    return view_t(buf, offset, shape), codegen
 
 
 @njit(**_INLINE)
-def _work(work):
-    buf, n = _borrow(work), work.shape[1]
-    return Work(buf[0], buf[1], buf[2], buf[3], buf[4], buf[5], buf[6], buf[7:7 + n], buf[7 + n:])
+def _unpack(buf):
+    """Views of a model buffer: cfg, the Store and the Work."""
+    n, n_out, cap = int(buf[H_N_IN]), int(buf[H_N_OUT]), int(buf[H_CAPACITY])
+    _, _, o_count, o_work, o_mat, o_vec, o_sca, _ = regions(n, n_out, cap)
+    st = Store(_view(buf, o_mat, (n_out, cap, N_MAT, n, n)), _view(buf, o_vec, (n_out, cap, N_VEC, n)),
+               _view(buf, o_sca, (n_out, cap, N_SCA)), _view(buf, o_count, (n_out, N_COUNT)))
+    w = _view(buf, o_work, (7 + 2 * n, n))
+    wk = Work(w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7:7 + n], w[7 + n:])
+    return _view(buf, 0, (o_count,)), st, wk
 
 
 @njit(**_INLINE)
@@ -137,24 +172,25 @@ def _sub(st, d):
 
 
 @njit(**_INLINE)
-def _has_room(count, capacity):
-    for d in range(count.shape[0]):
-        if count[d, N_RF] >= capacity:
+def _has_room(st):
+    for d in range(st.count.shape[0]):
+        if st.count[d, N_RF] >= st.mat.shape[1]:
             return False
     return True
 
 
 @njit(**_INLINE)
 def _distance(rf, x, dx):
-    """q = (x - c)^T D (x - c); fills dx = x - c."""
+    """q = (x - c)^T D (x - c); fills dx = x - c. (One loop nest with the sum in it: LLVM does not vectorize
+    it, which for n_in of a few saves the vector loop's entry checks, run for every RF and sample.)"""
     n = x.shape[0]
-    for i in range(n):
-        dx[i] = x[i] - rf.vec[C_, i]
+    c, D = rf.vec[C_], rf.mat[D_]
     q = 0.0
     for i in range(n):
+        dx[i] = x[i] - c[i]
         acc = 0.0
         for j in range(n):
-            acc += rf.mat[D_, i, j] * dx[j]
+            acc += D[i, j] * (x[j] - c[j])
         q += dx[i] * acc
     return q
 
@@ -409,7 +445,7 @@ def _update_output(sub, cfg, wk, y):
     weighted prediction of its trustworthy RFs, made with their updated local models."""
     x = wk.xn
     n = x.shape[0]
-    n_rf = sub.count[N_RF]
+    n_rf = int(sub.count[N_RF])
     bisquare = cfg[HP_BISQUARE] != 0.0
     q_far = cfg[HP_Q_UPDATE]
     w_max, w_sec, i_max, i_sec = 0.0, 0.0, -1, -1
@@ -433,7 +469,7 @@ def _update_output(sub, cfg, wk, y):
             yp_sum += w * yp
             w_sum += w
     y_pred = yp_sum / w_sum if w_sum > 0.0 else 0.0
-    sub.count[N_SEEN] += 1
+    sub.count[N_SEEN] += 1.0
     if w_max <= cfg[HP_W_GEN]:
         new = _rf(sub, n_rf)
         if w_max > 0.1 * cfg[HP_W_GEN] and sub.sca[i_max, TRUST] != 0.0:
@@ -441,7 +477,7 @@ def _update_output(sub, cfg, wk, y):
         else:
             _init_rf(new, None, x, y, cfg)
         sub.count[N_RF] = n_rf + 1
-        sub.count[N_CREATED] += 1
+        sub.count[N_CREATED] += 1.0
     elif w_sec > cfg[HP_W_PRUNE]:
         tr_max, tr_sec = 0.0, 0.0
         for i in range(n):
@@ -454,7 +490,7 @@ def _update_output(sub, cfg, wk, y):
             sub.vec[gone] = sub.vec[last]
             sub.sca[gone] = sub.sca[last]
         sub.count[N_RF] = last
-        sub.count[N_PRUNED] += 1
+        sub.count[N_PRUNED] += 1.0
     return y_pred
 
 
@@ -470,29 +506,30 @@ def _update_sample(st, cfg, wk, x, y, out):
 
 
 @njit(**_JIT)
-def update(mat, vec, sca, count, cfg, work, x, y, out):
-    """One training pair (x, y in user units); out gets the prediction of each output. Returns FULL,
-    with nothing changed, if some output has no free RF slot, BAD_X / BAD_Y for wrong lengths, else OK."""
-    if x.shape[0] != mat.shape[3]:
+def update(buf, x, y, out):
+    """One training pair (x, y in user units) for the model in ``buf``; out gets the prediction of each
+    output. Returns FULL, with nothing changed, if some output has no free RF slot, BAD_X / BAD_Y for
+    wrong lengths, else OK."""
+    cfg, st, wk = _unpack(buf)
+    if x.shape[0] != st.mat.shape[3]:
         return BAD_X
-    if y.shape[0] != mat.shape[0]:
+    if y.shape[0] != st.mat.shape[0]:
         return BAD_Y
-    if not _has_room(count, mat.shape[1]):
+    if not _has_room(st):
         return FULL
-    _update_sample(_store(mat, vec, sca, count), _borrow(cfg), _work(work), _borrow(x), _borrow(y), _borrow(out))
+    _update_sample(st, cfg, wk, _borrow(x), _borrow(y), _borrow(out))
     return OK
 
 
 @njit(**_JIT)
-def update_many(mat, vec, sca, count, cfg, work, X, Y, out, start):
+def update_many(buf, X, Y, out, start):
     """Training pairs X[t], Y[t] from row ``start`` on, in order; out[t] gets the predictions. Stops
-    before a row when some output has no free RF slot; returns the next row to learn."""
-    st, cf, wk = _store(mat, vec, sca, count), _borrow(cfg), _work(work)
-    Xb, Yb, ob = _borrow(X), _borrow(Y), _borrow(out)
+    before a row when some output has no free RF slot; returns the next row to learn. (Calls ``update``
+    compiled, on views without reference counts: tens of ns per row, and one inlined copy to compile.)"""
+    bb, Xb, Yb, ob = _borrow(buf), _borrow(X), _borrow(Y), _borrow(out)
     for t in range(start, X.shape[0]):
-        if not _has_room(st.count, mat.shape[1]):
+        if update(bb, Xb[t], Yb[t], ob[t]) == FULL:
             return t
-        _update_sample(st, cf, wk, Xb[t], Yb[t], ob[t])
     return X.shape[0]
 
 
@@ -506,7 +543,7 @@ def _predict_output(sub, cfg, wk, act):
     bisquare = cfg[HP_BISQUARE] != 0.0
     cutoff, q_far = cfg[HP_CUTOFF], cfg[HP_Q_PREDICT]
     yp, ws = 0.0, 0.0
-    for k in range(sub.count[N_RF]):
+    for k in range(int(sub.count[N_RF])):
         if keep:
             act[k] = 0.0
         rf = _rf(sub, k)
@@ -543,33 +580,59 @@ def _predict_sample(st, cfg, wk, x, out, act):
 
 
 @njit(**_JIT)
-def predict(mat, vec, sca, count, cfg, work, x, out, act):
+def predict(buf, x, out, act):
     """Prediction at x (user units) into out; act[d, k] as in ``_predict_output`` if act has columns.
     Returns BAD_X for a wrong input length, else OK."""
-    if x.shape[0] != mat.shape[3]:
+    cfg, st, wk = _unpack(buf)
+    if x.shape[0] != st.mat.shape[3]:
         return BAD_X
-    _predict_sample(_store(mat, vec, sca, count), _borrow(cfg), _work(work), _borrow(x), _borrow(out), _borrow(act))
+    _predict_sample(st, cfg, wk, _borrow(x), _borrow(out), _borrow(act))
     return OK
 
 
 @njit(**_JIT)
-def predict_many(mat, vec, sca, count, cfg, work, X, out, act):
+def predict_many(buf, X, out, act):
     """Predictions at every row of X into the rows of out (``act`` with no columns)."""
-    st, cf, wk = _store(mat, vec, sca, count), _borrow(cfg), _work(work)
-    Xb, ob, ab = _borrow(X), _borrow(out), _borrow(act)
+    bb, Xb, ob, ab = _borrow(buf), _borrow(X), _borrow(out), _borrow(act)
     for t in range(X.shape[0]):
-        _predict_sample(st, cf, wk, Xb[t], ob[t], ab)
+        predict(bb, Xb[t], ob[t], ab)
 
 
 @njit(**_JIT)
-def activations(mat, vec, sca, count, cfg, work, x, act):
+def activations(buf, x, act):
     """Raw kernel weight of every RF at x (user units), trustworthy or not: act[d, k]."""
-    st, wk = _store(mat, vec, sca, count), _work(work)
+    cfg, st, wk = _unpack(buf)
     n = x.shape[0]
     for i in range(n):
         wk.xn[i] = x[i] / cfg[N_HP + i]
     bisquare = cfg[HP_BISQUARE] != 0.0
-    for d in range(count.shape[0]):
+    for d in range(st.count.shape[0]):
         sub = _sub(st, d)
-        for k in range(count[d, N_RF]):
+        for k in range(int(sub.count[N_RF])):
             act[d, k] = _weight(_distance(_rf(sub, k), wk.xn, wk.dx), bisquare)[0]
+
+
+@contextmanager
+def _scalar_loops():
+    """LLVM's loop and SLP vectorizers off (numba reads these settings whenever it optimizes code)."""
+    saved = config.LOOP_VECTORIZE, config.SLP_VECTORIZE
+    config.LOOP_VECTORIZE = config.SLP_VECTORIZE = False
+    try:
+        yield
+    finally:
+        config.LOOP_VECTORIZE, config.SLP_VECTORIZE = saved
+
+
+def compile_kernels() -> None:
+    """Compile the entry points for float64 C-contiguous arrays (or load them from numba's cache) without
+    LLVM's vectorizers: the loops here run n_in (a few) times, and the entry checks of their vector
+    versions cost about a fifth of an update. Other argument types compile, vectorized, on first use."""
+    if update.signatures:
+        return
+    f1, f2 = types.float64[::1], types.float64[:, ::1]
+    with _scalar_loops():
+        update.compile((f1, f1, f1, f1))
+        update_many.compile((f1, f2, f2, f2, types.int64))
+        predict.compile((f1, f1, f1, f2))
+        predict_many.compile((f1, f2, f2, f2))
+        activations.compile((f1, f1, f2))

@@ -29,9 +29,11 @@ def _rows(a: Any, width: int) -> np.ndarray:
     return a.reshape(len(a), -1) if a.ndim > 1 or width != 1 else a[:, None]
 
 
-def _hyper(p: LWPRParams) -> np.ndarray:
+def _head(p: LWPRParams, n_in: int, n_out: int) -> np.ndarray:
+    """Sizes and hyper-parameters: the first ``N_HP`` values of a model buffer (capacity set by ``_buffer``)."""
     hp = np.zeros(K.N_HP)
     bisquare = p.kernel == "bisquare"
+    hp[K.H_N_IN], hp[K.H_N_OUT] = n_in, n_out
     hp[K.HP_W_GEN] = p.w_gen
     hp[K.HP_W_PRUNE] = p.w_prune
     hp[K.HP_INIT_LAMBDA] = p.init_lambda
@@ -52,9 +54,19 @@ def _hyper(p: LWPRParams) -> np.ndarray:
     return hp
 
 
-def _empty_store(n_in: int, n_out: int, capacity: int) -> K.Store:
-    return K.Store(np.zeros((n_out, capacity, K.N_MAT, n_in, n_in)), np.zeros((n_out, capacity, K.N_VEC, n_in)),
-                   np.zeros((n_out, capacity, K.N_SCA)), np.zeros((n_out, K.N_COUNT), np.int64))
+def _buffer(head: np.ndarray, norm_in: np.ndarray, norm_out: np.ndarray, capacity: int) -> tuple[np.ndarray, K.Store]:
+    """A zeroed model buffer holding ``capacity`` RF slots per output, and numpy views of its RF arrays."""
+    n_in, n_out = len(norm_in), len(norm_out)
+    o_in, o_out, o_count, _, o_mat, o_vec, o_sca, size = K.regions(n_in, n_out, capacity)
+    buf = np.zeros(size)
+    buf[: K.N_HP] = head
+    buf[K.H_CAPACITY] = capacity
+    buf[o_in:o_out], buf[o_out:o_count] = norm_in, norm_out
+    store = K.Store(buf[o_mat:o_vec].reshape(n_out, capacity, K.N_MAT, n_in, n_in),
+                    buf[o_vec:o_sca].reshape(n_out, capacity, K.N_VEC, n_in),
+                    buf[o_sca:size].reshape(n_out, capacity, K.N_SCA),
+                    buf[o_count:o_count + n_out * K.N_COUNT].reshape(n_out, K.N_COUNT))
+    return buf, store
 
 
 class LWPR:
@@ -71,18 +83,17 @@ class LWPR:
         self.params, self.n_in, self.n_out = p, n_in, n_out
         self.norm_in = _per_dim(p.norm_in, n_in, "norm_in")
         self.norm_out = _per_dim(p.norm_out, n_out, "norm_out")
-        self._cfg = np.concatenate([_hyper(p), self.norm_in, self.norm_out])
-        self._store = _empty_store(n_in, n_out, p.initial_capacity)
-        self._work = np.empty(K.work_shape(n_in))
+        K.compile_kernels()
+        self._head = _head(p, n_in, n_out)
+        self._buf, self._store = _buffer(self._head, self.norm_in, self.norm_out, p.initial_capacity)
         self._no_act = np.empty((n_out, 0))
 
     def _grow(self) -> None:
+        """Move the model to a buffer with twice the RF slots per output."""
         old = self._store
-        new = _empty_store(self.n_in, self.n_out, 2 * old.mat.shape[1])
-        for a, b in zip(old[:3], new[:3]):
+        self._buf, self._store = _buffer(self._head, self.norm_in, self.norm_out, 2 * old.mat.shape[1])
+        for a, b in zip(old, self._store):
             b[:, : a.shape[1]] = a
-        new.count[:] = old.count
-        self._store = new
 
     def _check(self, status: int, x: np.ndarray, y: np.ndarray | None = None) -> None:
         if status == K.BAD_X:
@@ -97,10 +108,10 @@ class LWPR:
         if type(y) is not np.ndarray or y.ndim != 1:
             y = _vector(y)
         out = np.empty(self.n_out)
-        status = K.update(*self._store, self._cfg, self._work, x, y, out)
+        status = K.update(self._buf, x, y, out)
         while status == K.FULL:
             self._grow()
-            status = K.update(*self._store, self._cfg, self._work, x, y, out)
+            status = K.update(self._buf, x, y, out)
         if status:
             self._check(status, x, y)
         return out
@@ -118,7 +129,7 @@ class LWPR:
         out = np.empty((len(X), self.n_out))
         t = 0
         while t < len(X):
-            t = K.update_many(*self._store, self._cfg, self._work, X, Y, out, t)
+            t = K.update_many(self._buf, X, Y, out, t)
             if t < len(X):
                 self._grow()
         return out
@@ -128,7 +139,7 @@ class LWPR:
         if type(x) is not np.ndarray or x.ndim != 1:
             x = _vector(x)
         out = np.empty(self.n_out)
-        if K.predict(*self._store, self._cfg, self._work, x, out, self._no_act):
+        if K.predict(self._buf, x, out, self._no_act):
             self._check(K.BAD_X, x)
         return out
 
@@ -138,7 +149,7 @@ class LWPR:
         if X.shape[1] != self.n_in:
             self._check(K.BAD_X, X[0])
         out = np.empty((len(X), self.n_out))
-        K.predict_many(*self._store, self._cfg, self._work, X, out, self._no_act)
+        K.predict_many(self._buf, X, out, self._no_act)
         return out
 
     def predict_with_activations(self, x: Any) -> tuple[np.ndarray, list[np.ndarray]]:
@@ -146,7 +157,7 @@ class LWPR:
         x = _vector(x)
         out = np.empty(self.n_out)
         act = np.zeros((self.n_out, max(1, int(self._store.count[:, K.N_RF].max()))))
-        if K.predict(*self._store, self._cfg, self._work, x, out, act):
+        if K.predict(self._buf, x, out, act):
             self._check(K.BAD_X, x)
         return out, [act[d, :n] for d, n in enumerate(self.n_receptive_fields)]
 
@@ -156,7 +167,7 @@ class LWPR:
         if x.shape[0] != self.n_in:
             self._check(K.BAD_X, x)
         act = np.zeros((self.n_out, max(1, int(self._store.count[:, K.N_RF].max()))))
-        K.activations(*self._store, self._cfg, self._work, x, act)
+        K.activations(self._buf, x, act)
         return [act[d, :n] for d, n in enumerate(self.n_receptive_fields)]
 
     @property
@@ -180,7 +191,7 @@ class LWPR:
         for d, n in enumerate(self.n_receptive_fields):
             out.update({f"lwpr{d}_mat": st.mat[d, :n].copy(), f"lwpr{d}_vec": st.vec[d, :n].copy(),
                         f"lwpr{d}_sca": st.sca[d, :n].copy(),
-                        f"lwpr{d}_counts": st.count[d, [K.N_CREATED, K.N_PRUNED]].copy()})
+                        f"lwpr{d}_counts": st.count[d, [K.N_CREATED, K.N_PRUNED]].astype(np.int64)})
         return out
 
     def load(self, state: dict[str, np.ndarray]) -> None:
@@ -188,8 +199,8 @@ class LWPR:
         for mat in mats:
             if mat.shape[1:] != self._store.mat.shape[2:]:
                 raise ValueError(f"LWPR state: {mat.shape[2]} inputs saved, this model has {self.n_in}")
-        n_max = max(len(m) for m in mats)
-        st = _empty_store(self.n_in, self.n_out, max(self.params.initial_capacity, 2 * n_max))
+        capacity = max(self.params.initial_capacity, 2 * max(len(m) for m in mats))
+        self._buf, st = _buffer(self._head, self.norm_in, self.norm_out, capacity)
         for d, mat in enumerate(mats):
             n = len(mat)
             st.mat[d, :n], st.vec[d, :n], st.sca[d, :n] = mat, state[f"lwpr{d}_vec"], state[f"lwpr{d}_sca"]
