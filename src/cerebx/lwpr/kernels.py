@@ -19,7 +19,8 @@ Speed: a call from Python costs about 100 ns per array argument (numba wraps eac
 counted object), hence one buffer. Inside, the kernels pass named tuples of views without a reference
 count (:func:`_view`, :func:`_borrow`) to helpers that numba inlines: numba counts references to
 every array value a helper binds with atomic operations, which fold away on such views but on owned
-arrays cost more than the arithmetic of an RF update.
+arrays cost more than the arithmetic of an RF update. RFs too far from x for their activation to
+matter skip the exponential; :func:`compile_kernels` compiles without LLVM's vectorizers.
 The meta learning of the learning rates (IDBD) of the reference library is not implemented.
 """
 
@@ -57,8 +58,8 @@ _INLINE = dict(_JIT, inline="always")
 
 
 class Store(NamedTuple):
-    """The RFs of every output (``mat``, ``vec``, ``sca``, ``count`` as in the module docstring); indexed
-    by output, the same four arrays of one sub-model."""
+    """The RFs of every output (``mat``, ``vec``, ``sca``, ``count`` as in the module docstring; counts are
+    stored as floats); indexed by output, the same four arrays of one sub-model."""
 
     mat: np.ndarray
     vec: np.ndarray

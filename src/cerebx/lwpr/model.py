@@ -1,6 +1,6 @@
 """``LWPR``: incremental locally weighted projection regression with one sub-model per output.
-The numeric work is in ``kernels.py``; this class owns the arrays and doubles them when an output runs
-out of RF slots. ``update`` and ``predict`` are one kernel call each, for every output at once."""
+The numeric work is in ``kernels.py``; this class owns the model buffer and doubles its RF slots when an
+output runs out of them. ``update`` and ``predict`` are one kernel call each, for every output at once."""
 
 from __future__ import annotations
 
