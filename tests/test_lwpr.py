@@ -91,3 +91,43 @@ def test_normalisation_and_bad_input():
         LWPR(2, 1, norm_in=(1.0, 2.0, 3.0))
     with pytest.raises(ValueError):
         LWPRParams(w_gen=1.5)
+
+
+def test_update_many_and_predict_many_equal_the_per_sample_calls():
+    """One kernel call for a whole stream learns bit for bit what ``update`` learns sample by sample,
+    also when the RF storage has to grow on the way (initial capacity 2)."""
+    rng = np.random.default_rng(5)
+    xs = rng.uniform(-1, 1, (2000, 2))
+    ys = np.stack([cross(xs), -cross(xs)], axis=1) + rng.uniform(-0.05, 0.05, (2000, 2))
+    one, many = (LWPR(2, 2, init_D=50.0, init_alpha=250.0, w_gen=0.2, initial_capacity=2) for _ in range(2))
+    yp_one = np.array([one.update(x, y) for x, y in zip(xs, ys)])
+    yp_many = many.update_many(xs, ys)
+    assert many.n_receptive_fields == one.n_receptive_fields and one.n_receptive_fields[0] > 8
+    np.testing.assert_array_equal(yp_many, yp_one)
+    test = rng.uniform(-1, 1, (50, 2))
+    np.testing.assert_array_equal(many.predict_many(test), np.array([one.predict(x) for x in test]))
+    assert one.n_updates == many.n_updates == 2000
+
+
+def test_state_round_trip_predicts_the_same():
+    rng = np.random.default_rng(6)
+    model = LWPR(2, 1, init_D=50.0, w_gen=0.2)
+    model.update_many(rng.uniform(-1, 1, (500, 2)), rng.uniform(0, 1, (500, 1)))
+    copy = LWPR(2, 1, init_D=50.0, w_gen=0.2)
+    copy.load(model.state())
+    test = rng.uniform(-1, 1, (20, 2))
+    np.testing.assert_array_equal(copy.predict_many(test), model.predict_many(test))
+    assert copy.n_created == model.n_created
+
+
+def test_far_distance_bounds_the_skipped_activations():
+    """RFs farther than far_distance(w) are skipped without evaluating the kernel: their activation must
+    lie below w (Gaussian exp(-q/2), BiSquare (1 - q/4)^2)."""
+    from cerebx.lwpr.kernels import far_distance
+
+    for w in (0.001, 0.02, 0.5):
+        q = far_distance(w, bisquare=False)
+        assert q == pytest.approx(-2 * np.log(w), rel=1e-8) and np.exp(-q / 2) < w
+        q = far_distance(w, bisquare=True)
+        assert q == pytest.approx(4 * (1 - np.sqrt(w)), rel=1e-8) and (1 - q / 4) ** 2 < w
+    assert far_distance(0.0, bisquare=False) == np.inf

@@ -51,13 +51,14 @@ def main(argv: list[str]) -> dict[str, Any]:
     ap.add_argument("--warmup", type=float, default=1.0, help="simulated seconds before timing starts")
     ap.add_argument("--networks", default=",".join(DEFAULT_NETWORKS), help="comma-separated network presets")
     ap.add_argument("--serial", action="store_true", help="one thread in the network kernels")
-    ap.add_argument("--lwpr", action="store_true", help="only the LWPR cross benchmark (updates per second)")
+    ap.add_argument("--lwpr", action="store_true", help="only LWPR on the reference library's 2-D cross and 1-D "
+                    "examples (updates, predictions per second, nMSE, receptive fields)")
     ap.add_argument("--one", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.lwpr:
         from cerebx.lwpr.bench import bench_lwpr
 
-        return {"lwpr_cross": bench_lwpr()}
+        return {"lwpr": bench_lwpr()}
     if args.one:
         return _one_network(args.one, args.seconds, args.warmup, not args.serial)
     import os

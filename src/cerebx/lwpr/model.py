@@ -1,5 +1,6 @@
 """``LWPR``: incremental locally weighted projection regression with one sub-model per output.
-The numeric work is in ``kernels.py``; this class owns the flat arrays and grows them by doubling."""
+The numeric work is in ``kernels.py``; this class owns the model buffer and doubles its RF slots when an
+output runs out of them. ``update`` and ``predict`` are one kernel call each, for every output at once."""
 
 from __future__ import annotations
 
@@ -18,31 +19,60 @@ def _per_dim(value: float | tuple[float, ...], n: int, name: str) -> np.ndarray:
     return arr
 
 
-class _SubModel:
-    """The receptive fields of one output dimension."""
+def _vector(v: Any) -> np.ndarray:
+    return np.asarray(v, float).reshape(-1)
 
-    def __init__(self, n_in: int, capacity: int) -> None:
-        self.mat = np.zeros((capacity, K.N_MAT, n_in, n_in))
-        self.vec = np.zeros((capacity, K.N_VEC, n_in))
-        self.sca = np.zeros((capacity, K.N_SCA))
-        self.n_rf = 0
-        self.n_created = 0
-        self.n_pruned = 0
 
-    def ensure_free_slot(self) -> None:
-        if self.n_rf < self.mat.shape[0]:
-            return
-        cap = 2 * self.mat.shape[0]
-        for name in ("mat", "vec", "sca"):
-            old = getattr(self, name)
-            new = np.zeros((cap, *old.shape[1:]))
-            new[: old.shape[0]] = old
-            setattr(self, name, new)
+def _rows(a: Any, width: int) -> np.ndarray:
+    """Samples as C-contiguous rows; a 1-D array is one value per sample when width is 1."""
+    a = np.ascontiguousarray(a, float)
+    return a.reshape(len(a), -1) if a.ndim > 1 or width != 1 else a[:, None]
+
+
+def _head(p: LWPRParams, n_in: int, n_out: int) -> np.ndarray:
+    """Sizes and hyper-parameters: the first ``N_HP`` values of a model buffer (capacity set by ``_buffer``)."""
+    hp = np.zeros(K.N_HP)
+    bisquare = p.kernel == "bisquare"
+    hp[K.H_N_IN], hp[K.H_N_OUT] = n_in, n_out
+    hp[K.HP_W_GEN] = p.w_gen
+    hp[K.HP_W_PRUNE] = p.w_prune
+    hp[K.HP_INIT_LAMBDA] = p.init_lambda
+    hp[K.HP_FINAL_LAMBDA] = p.final_lambda
+    hp[K.HP_TAU_LAMBDA] = p.tau_lambda
+    hp[K.HP_PENALTY] = p.penalty
+    hp[K.HP_DIAG_ONLY] = float(p.diag_only)
+    hp[K.HP_UPDATE_D] = float(p.update_D)
+    hp[K.HP_ADD_THRESHOLD] = p.add_threshold
+    hp[K.HP_INIT_S2] = p.init_S2
+    hp[K.HP_BISQUARE] = float(bisquare)
+    hp[K.HP_CUTOFF] = p.cutoff
+    hp[K.HP_INIT_D] = p.init_D
+    hp[K.HP_INIT_ALPHA] = p.init_alpha
+    # below these activations no RF is updated, created from or pruned, nor joins a prediction
+    hp[K.HP_Q_UPDATE] = K.far_distance(min(0.001, 0.1 * p.w_gen, p.w_prune), bisquare)
+    hp[K.HP_Q_PREDICT] = K.far_distance(p.cutoff, bisquare)
+    return hp
+
+
+def _buffer(head: np.ndarray, norm_in: np.ndarray, norm_out: np.ndarray, capacity: int) -> tuple[np.ndarray, K.Store]:
+    """A zeroed model buffer holding ``capacity`` RF slots per output, and numpy views of its RF arrays."""
+    n_in, n_out = len(norm_in), len(norm_out)
+    o_in, o_out, o_count, _, o_mat, o_vec, o_sca, size = K.regions(n_in, n_out, capacity)
+    buf = np.zeros(size)
+    buf[: K.N_HP] = head
+    buf[K.H_CAPACITY] = capacity
+    buf[o_in:o_out], buf[o_out:o_count] = norm_in, norm_out
+    store = K.Store(buf[o_mat:o_vec].reshape(n_out, capacity, K.N_MAT, n_in, n_in),
+                    buf[o_vec:o_sca].reshape(n_out, capacity, K.N_VEC, n_in),
+                    buf[o_sca:size].reshape(n_out, capacity, K.N_SCA),
+                    buf[o_count:o_count + n_out * K.N_COUNT].reshape(n_out, K.N_COUNT))
+    return buf, store
 
 
 class LWPR:
     """``LWPR(n_in, n_out, **params)``; ``update(x, y)`` trains on one pair and returns the prediction
-    made before this pair changed the model; ``predict(x)``; ``activations(x)`` per output."""
+    of the RFs it updated; ``update_many(X, Y)`` does the same for a whole stream in one call;
+    ``predict(x)``, ``predict_many(X)``; ``activations(x)`` per output."""
 
     def __init__(self, n_in: int, n_out: int = 1, params: LWPRParams | None = None, **overrides: Any) -> None:
         if n_in < 1 or n_out < 1:
@@ -53,110 +83,137 @@ class LWPR:
         self.params, self.n_in, self.n_out = p, n_in, n_out
         self.norm_in = _per_dim(p.norm_in, n_in, "norm_in")
         self.norm_out = _per_dim(p.norm_out, n_out, "norm_out")
-        self.init_D = p.init_D * np.eye(n_in)
-        self.init_M = np.sqrt(p.init_D) * np.eye(n_in)
-        self.init_alpha = np.full((n_in, n_in), p.init_alpha)
-        self.hp = np.zeros(K.N_HP)
-        self.hp[K.HP_W_GEN] = p.w_gen
-        self.hp[K.HP_W_PRUNE] = p.w_prune
-        self.hp[K.HP_INIT_LAMBDA] = p.init_lambda
-        self.hp[K.HP_FINAL_LAMBDA] = p.final_lambda
-        self.hp[K.HP_TAU_LAMBDA] = p.tau_lambda
-        self.hp[K.HP_PENALTY] = p.penalty
-        self.hp[K.HP_DIAG_ONLY] = float(p.diag_only)
-        self.hp[K.HP_UPDATE_D] = float(p.update_D)
-        self.hp[K.HP_ADD_THRESHOLD] = p.add_threshold
-        self.hp[K.HP_INIT_S2] = p.init_S2
-        self.hp[K.HP_BISQUARE] = float(p.kernel == "bisquare")
-        self.hp[K.HP_CUTOFF] = p.cutoff
-        self.subs = [_SubModel(n_in, p.initial_capacity) for _ in range(n_out)]
-        self.n_updates = 0
+        K.compile_kernels()
+        self._head = _head(p, n_in, n_out)
+        self._buf, self._store = _buffer(self._head, self.norm_in, self.norm_out, p.initial_capacity)
+        self._no_act = np.empty((n_out, 0))
 
-    def _x(self, x: Any) -> np.ndarray:
-        xa = np.asarray(x, float).reshape(-1)
-        if xa.shape[0] != self.n_in:
-            raise ValueError(f"LWPR: input needs {self.n_in} values, got {xa.shape[0]}")
-        return xa / self.norm_in
+    def _grow(self) -> None:
+        """Move the model to a buffer with twice the RF slots per output."""
+        old = self._store
+        self._buf, self._store = _buffer(self._head, self.norm_in, self.norm_out, 2 * old.mat.shape[1])
+        for a, b in zip(old, self._store):
+            b[:, : a.shape[1]] = a
+
+    def _check(self, status: int, x: np.ndarray, y: np.ndarray | None = None) -> None:
+        if status == K.BAD_X:
+            raise ValueError(f"LWPR: input needs {self.n_in} values, got {x.shape[0]}")
+        if status == K.BAD_Y and y is not None:
+            raise ValueError(f"LWPR: target needs {self.n_out} values, got {y.shape[0]}")
 
     def update(self, x: Any, y: Any) -> np.ndarray:
-        xn = self._x(x)
-        yn = np.asarray(y, float).reshape(-1) / self.norm_out
-        if yn.shape[0] != self.n_out:
-            raise ValueError(f"LWPR: target needs {self.n_out} values, got {yn.shape[0]}")
+        """Train on one pair; returns the prediction at x of the RFs this pair updated (trustworthy ones)."""
+        if type(x) is not np.ndarray or x.ndim != 1:
+            x = _vector(x)
+        if type(y) is not np.ndarray or y.ndim != 1:
+            y = _vector(y)
         out = np.empty(self.n_out)
-        for d, sub in enumerate(self.subs):
-            sub.ensure_free_slot()
-            before = sub.n_rf
-            out[d], sub.n_rf, _ = K.update(sub.mat, sub.vec, sub.sca, sub.n_rf, xn, yn[d],
-                                           self.init_M, self.init_D, self.init_alpha, self.hp)
-            sub.n_created += sub.n_rf > before
-            sub.n_pruned += sub.n_rf < before
-        self.n_updates += 1
-        return out * self.norm_out
+        status = K.update(self._buf, x, y, out)
+        while status == K.FULL:
+            self._grow()
+            status = K.update(self._buf, x, y, out)
+        if status:
+            self._check(status, x, y)
+        return out
+
+    def update_many(self, X: Any, Y: Any) -> np.ndarray:
+        """Train on the rows of X and Y in order (as ``update`` row by row, in one kernel call); returns
+        the (rows, n_out) predictions ``update`` would have returned."""
+        X, Y = _rows(X, self.n_in), _rows(Y, self.n_out)
+        if len(Y) != len(X):
+            raise ValueError(f"LWPR: {len(X)} inputs but {len(Y)} targets")
+        if X.shape[1] != self.n_in:
+            self._check(K.BAD_X, X[0])
+        if Y.shape[1] != self.n_out:
+            self._check(K.BAD_Y, X[0], Y[0])
+        out = np.empty((len(X), self.n_out))
+        t = 0
+        while t < len(X):
+            t = K.update_many(self._buf, X, Y, out, t)
+            if t < len(X):
+                self._grow()
+        return out
 
     def predict(self, x: Any) -> np.ndarray:
-        return self.predict_with_activations(x)[0]
+        """Weighted prediction of the trustworthy RFs above the activation cutoff, per output."""
+        if type(x) is not np.ndarray or x.ndim != 1:
+            x = _vector(x)
+        out = np.empty(self.n_out)
+        if K.predict(self._buf, x, out, self._no_act):
+            self._check(K.BAD_X, x)
+        return out
+
+    def predict_many(self, X: Any) -> np.ndarray:
+        """``predict`` at every row of X: (rows, n_out)."""
+        X = _rows(X, self.n_in)
+        if X.shape[1] != self.n_in:
+            self._check(K.BAD_X, X[0])
+        out = np.empty((len(X), self.n_out))
+        K.predict_many(self._buf, X, out, self._no_act)
+        return out
 
     def predict_with_activations(self, x: Any) -> tuple[np.ndarray, list[np.ndarray]]:
         """Prediction and, per output, the activation of every RF that took part (0 for the others)."""
-        xn = self._x(x)
+        x = _vector(x)
         out = np.empty(self.n_out)
-        acts = []
-        bisquare = bool(self.hp[K.HP_BISQUARE])
-        for d, sub in enumerate(self.subs):
-            act = np.empty(sub.n_rf)
-            out[d] = K.predict(sub.mat, sub.vec, sub.sca, sub.n_rf, xn, self.params.cutoff, bisquare, act)
-            acts.append(act)
-        return out * self.norm_out, acts
+        act = np.zeros((self.n_out, max(1, int(self._store.count[:, K.N_RF].max()))))
+        if K.predict(self._buf, x, out, act):
+            self._check(K.BAD_X, x)
+        return out, [act[d, :n] for d, n in enumerate(self.n_receptive_fields)]
 
     def activations(self, x: Any) -> list[np.ndarray]:
         """Kernel weight of every RF at x, per output (trustworthy or not)."""
-        xn = self._x(x)
-        acts = []
-        for sub in self.subs:
-            act = np.empty(sub.n_rf)
-            K.activations(sub.mat, sub.vec, sub.n_rf, xn, bool(self.hp[K.HP_BISQUARE]), act)
-            acts.append(act)
-        return acts
+        x = _vector(x)
+        if x.shape[0] != self.n_in:
+            self._check(K.BAD_X, x)
+        act = np.zeros((self.n_out, max(1, int(self._store.count[:, K.N_RF].max()))))
+        K.activations(self._buf, x, act)
+        return [act[d, :n] for d, n in enumerate(self.n_receptive_fields)]
 
     @property
     def n_receptive_fields(self) -> list[int]:
         """RFs per output dimension."""
-        return [sub.n_rf for sub in self.subs]
+        return [int(n) for n in self._store.count[:, K.N_RF]]
 
     @property
     def n_created(self) -> list[int]:
         """RFs created so far per output dimension (pruned ones included)."""
-        return [sub.n_created for sub in self.subs]
+        return [int(n) for n in self._store.count[:, K.N_CREATED]]
+
+    @property
+    def n_updates(self) -> int:
+        """Training pairs seen since construction."""
+        return int(self._store.count[0, K.N_SEEN])
 
     def state(self) -> dict[str, np.ndarray]:
         """The learned arrays (for saving); :meth:`load` restores them."""
-        out: dict[str, np.ndarray] = {}
-        for d, sub in enumerate(self.subs):
-            n = sub.n_rf
-            out.update({f"lwpr{d}_mat": sub.mat[:n], f"lwpr{d}_vec": sub.vec[:n], f"lwpr{d}_sca": sub.sca[:n],
-                        f"lwpr{d}_counts": np.array([sub.n_created, sub.n_pruned])})
+        st, out = self._store, {}
+        for d, n in enumerate(self.n_receptive_fields):
+            out.update({f"lwpr{d}_mat": st.mat[d, :n].copy(), f"lwpr{d}_vec": st.vec[d, :n].copy(),
+                        f"lwpr{d}_sca": st.sca[d, :n].copy(),
+                        f"lwpr{d}_counts": st.count[d, [K.N_CREATED, K.N_PRUNED]].astype(np.int64)})
         return out
 
     def load(self, state: dict[str, np.ndarray]) -> None:
-        for d, sub in enumerate(self.subs):
-            mat = state[f"lwpr{d}_mat"]
-            if mat.shape[1:] != sub.mat.shape[1:]:
+        mats = [np.asarray(state[f"lwpr{d}_mat"]) for d in range(self.n_out)]
+        for mat in mats:
+            if mat.shape[1:] != self._store.mat.shape[2:]:
                 raise ValueError(f"LWPR state: {mat.shape[2]} inputs saved, this model has {self.n_in}")
-            n = mat.shape[0]
-            cap = max(self.params.initial_capacity, 2 * n)
-            sub.mat, sub.vec, sub.sca = (np.zeros((cap, *a.shape[1:])) for a in (sub.mat, sub.vec, sub.sca))
-            sub.mat[:n], sub.vec[:n], sub.sca[:n] = mat, state[f"lwpr{d}_vec"], state[f"lwpr{d}_sca"]
-            sub.n_rf = n
-            sub.n_created, sub.n_pruned = (int(v) for v in state[f"lwpr{d}_counts"])
+        capacity = max(self.params.initial_capacity, 2 * max(len(m) for m in mats))
+        self._buf, st = _buffer(self._head, self.norm_in, self.norm_out, capacity)
+        for d, mat in enumerate(mats):
+            n = len(mat)
+            st.mat[d, :n], st.vec[d, :n], st.sca[d, :n] = mat, state[f"lwpr{d}_vec"], state[f"lwpr{d}_sca"]
+            st.count[d, K.N_RF] = n
+            st.count[d, [K.N_CREATED, K.N_PRUNED]] = state[f"lwpr{d}_counts"]
+        self._store = st
 
     def distance_metric(self, out: int, rf: int) -> np.ndarray:
         """D of RF ``rf`` of output ``out`` (in normalised input units)."""
-        sub = self.subs[out]
-        if not 0 <= rf < sub.n_rf:
-            raise IndexError(f"LWPR: output {out} has {sub.n_rf} RFs, no RF {rf}")
-        return sub.mat[rf, K.D_].copy()
+        n = self.n_receptive_fields[out]
+        if not 0 <= rf < n:
+            raise IndexError(f"LWPR: output {out} has {n} RFs, no RF {rf}")
+        return self._store.mat[out, rf, K.D_].copy()
 
     def centres(self, out: int = 0) -> np.ndarray:
-        sub = self.subs[out]
-        return sub.vec[: sub.n_rf, K.C_].copy() * self.norm_in
+        return self._store.vec[out, : self.n_receptive_fields[out], K.C_].copy() * self.norm_in
