@@ -1,5 +1,5 @@
-"""Locally Weighted Projection Regression, written for cerebx (the granular layer of the Capolei 2020
-cerebellar modules)."""
+"""Locally Weighted Projection Regression, written for cerebx (e.g. as the granular layer of cerebellar
+modules whose input is continuous)."""
 
 from cerebx.lwpr.model import LWPR
 from cerebx.lwpr.schema import LWPRParams

@@ -1,5 +1,5 @@
 """Speed and accuracy of LWPR on the reference library's own examples (Klanke & Vijayakumar, LWPR v1.2;
-facts ``luque2011_capolei2020.md`` §3.2): the 2-D cross of ``example_c/cross.c`` and the 1-D function of
+docs/provenance.md, LWPR): the 2-D cross of ``example_c/cross.c`` and the 1-D function of
 ``matlab/test_lwpr_1D.m``, each with that example's parameters, noise and number of samples."""
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """Parameters of an LWPR model. Defaults are those of the reference library (Klanke & Vijayakumar,
-LWPR v1.2, ``lwpr_init_model``; facts ``luque2011_capolei2020.md`` §3.1)."""
+LWPR v1.2, ``lwpr_init_model``; docs/provenance.md, LWPR)."""
 
 from __future__ import annotations
 

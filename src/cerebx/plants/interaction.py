@@ -1,5 +1,5 @@
 """Things that act on a MuJoCo arm's hand: a payload (a point mass, or a bob on a rod: a conical
-pendulum), an elastic band, force pulses, a finger push and a grab (thesis §2.3.1, Fig. 2.10).
+pendulum), an elastic band, force pulses, a finger push and a grab.
 
 They need a few model elements, which :func:`add_to_spec` adds to the arm's ``mujoco.MjSpec`` before it
 is compiled; :class:`HandInteractions` then binds them to the compiled model and data. Each is an
