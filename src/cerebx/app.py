@@ -1,6 +1,11 @@
-"""The Hydra application behind ``cerebx run``: output folders, multirun, launchers, --cfg."""
+"""The Hydra application behind ``cerebx run``: output folders, multirun, launchers, --cfg.
 
-from __future__ import annotations
+Importing this module first sets the job's numba settings (``jobenv.configure``): a launcher's job process
+(joblib, SLURM) imports it to find ``run_app``, before anything has imported numba."""
+
+from cerebx import jobenv
+
+jobenv.configure()
 
 import logging
 import sys
@@ -14,20 +19,17 @@ from omegaconf import DictConfig
 from cerebx import runfiles
 from cerebx.config import to_plain, user_choices
 from cerebx.errors import ConfigError
+from cerebx.loop import resume
+from cerebx.loop.runner import run_experiment
+from cerebx.recording.console import print_summary
 from cerebx.schema.experiment import validate
 
 log = logging.getLogger("cerebx")
 
+
 @hydra.main(config_path="conf", config_name="config", version_base="1.3")
 def run_app(cfg: DictConfig) -> float | None:
-    from cerebx import jobenv
-
-    jobenv.configure()  # before numba is imported: launchers' jobs do not inherit the Makefile's env
     log.info("job: %s", jobenv.describe())
-    from cerebx.loop import resume
-    from cerebx.loop.runner import run_experiment
-    from cerebx.report.console import print_summary
-
     hc = HydraConfig.get()
     run_dir = Path(hc.runtime.output_dir)
     in_sweep = hc.mode == RunMode.MULTIRUN  # a sweep's job fails alone: the next job still runs

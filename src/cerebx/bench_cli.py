@@ -8,25 +8,27 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import time
 from typing import Any
 
+from cerebx.bench import bench_network, peak_rss_mb
+from cerebx.config import load
+from cerebx.loop.timing import closed_loop_rt
+from cerebx.lwpr.bench import bench_lwpr
+
 DEFAULT_NETWORKS = ("full", "multikernel")
 
 
-def _one_network(name: str, seconds: float, warmup: float, parallel: bool) -> dict[str, Any]:
-    """Network alone, then the closed loop with the MuJoCo Baxter (circle task, plasticity on)."""
-    t0 = time.perf_counter()
-    from cerebx.bench import bench_network, peak_rss_mb
-    from cerebx.config import load
-    from cerebx.loop.timing import closed_loop_rt
-
-    import_s = time.perf_counter() - t0
+def _one_network(name: str, seconds: float, warmup: float, parallel: bool, started: float) -> dict[str, Any]:
+    """Network alone, then the closed loop with the MuJoCo Baxter (circle task, plasticity on). ``started``:
+    when the parent launched this process (its start-up, interpreter and imports, is measured from it)."""
+    startup_s = time.time() - started
     exp, _ = load(["+task=circle", f"network={name}"])
     out = bench_network(exp.controller.network, seconds=seconds, warmup=warmup, parallel=parallel)
-    out["import_s"] = round(import_s, 3)
+    out["startup_s"] = round(startup_s, 3)
     loop = closed_loop_rt(["+task=circle", f"network={name}", f"controller.parallel={str(parallel).lower()}"],
                           seconds=seconds, warmup_s=warmup)
     out["closed_loop"] = {k: loop[k] for k in ("build_s", "rt_factor", "us_per_step")}
@@ -35,8 +37,6 @@ def _one_network(name: str, seconds: float, warmup: float, parallel: bool) -> di
 
 
 def _plant_pd(seconds: float) -> dict[str, Any]:
-    from cerebx.loop.timing import closed_loop_rt
-
     rows = {}
     for label, extra in (("baxter_pd", []), ("baxter_pd_physics_1ms", ["plant.physics_dt_ms=1.0"]),
                          ("baxter_sea_pd", ["plant=baxter_sea"])):
@@ -54,19 +54,16 @@ def main(argv: list[str]) -> dict[str, Any]:
     ap.add_argument("--lwpr", action="store_true", help="only LWPR on the reference library's 2-D cross and 1-D "
                     "examples (updates, predictions per second, nMSE, receptive fields)")
     ap.add_argument("--one", help=argparse.SUPPRESS)
+    ap.add_argument("--started", type=float, default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.lwpr:
-        from cerebx.lwpr.bench import bench_lwpr
-
         return {"lwpr": bench_lwpr()}
     if args.one:
-        return _one_network(args.one, args.seconds, args.warmup, not args.serial)
-    import os
-
+        return _one_network(args.one, args.seconds, args.warmup, not args.serial, args.started or time.time())
     report: dict[str, Any] = {"cpus": os.cpu_count(), "plant_pd": _plant_pd(args.seconds), "networks": {}}
     for name in filter(None, args.networks.split(",")):
         cmd = [sys.executable, "-m", "cerebx.cli", "bench", "--one", name, "--seconds", str(args.seconds),
-               "--warmup", str(args.warmup)] + (["--serial"] if args.serial else [])
+               "--warmup", str(args.warmup), "--started", repr(time.time())] + (["--serial"] if args.serial else [])
         proc = subprocess.run(cmd, capture_output=True, text=True)
         if proc.returncode != 0:
             report["networks"][name] = {"error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}

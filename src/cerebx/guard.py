@@ -19,6 +19,10 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+from hydra.core.config_store import ConfigStore
+from hydra.core.override_parser.overrides_parser import OverridesParser
+from hydra.core.plugins import Plugins
+from hydra.errors import HydraException
 
 from cerebx import registry
 
@@ -39,9 +43,6 @@ CONF_ROOT = Path(__file__).resolve().parent / "conf"
 def installed_plugins(group: str) -> tuple[str, ...]:
     """Options of ``hydra/<group>``: those registered by installed Hydra plugins (e.g. basic, joblib) and
     cerebx's own presets for them (``conf/hydra/<group>/*.yaml``, e.g. slurm)."""
-    from hydra.core.config_store import ConfigStore
-    from hydra.core.plugins import Plugins
-
     Plugins.instance()  # registers the installed plugins' configs
     repo = ConfigStore.instance().repo.get("hydra", {}).get(group, {})
     shipped = (p.stem for p in (CONF_ROOT / "hydra" / group).glob("*.yaml"))
@@ -78,8 +79,6 @@ def _why_group(group: str, option: Any) -> str | None:
 
 @functools.cache
 def _parser():
-    from hydra.core.override_parser.overrides_parser import OverridesParser
-
     return OverridesParser.create()
 
 
@@ -97,8 +96,6 @@ def _walk(node: Any, prefix: str) -> Iterator[str]:
 
 def check_overrides(overrides: list[str]) -> list[str]:
     """One line per command-line override that carries code (parsed as Hydra parses it)."""
-    from hydra.errors import HydraException
-
     problems: list[str] = []
     parser = _parser()
     for text in overrides:

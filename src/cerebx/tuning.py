@@ -30,6 +30,7 @@ from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 from cerebx.errors import CerebxError, Diverged
 from cerebx.loop.link import Link
 from cerebx.loop.loop import ClosedLoop
+from cerebx.schema.controller import PDController
 from cerebx.stages.controllers import TorqueControllerStage
 from cerebx.stages.receivers import Hold
 
@@ -218,8 +219,6 @@ def tune_pd(
     ``posture``: 'task_mean' (mean desired posture) or 'task_start'. Writes a preset YAML to
     ``out`` unless it is None. Returns the per-joint results and the tuned PD schema.
     """
-    from cerebx.schema.controller import PDController
-
     cfg, _ = load(list(overrides))
     if not isinstance(cfg.controller, PDController):
         raise CerebxError(

@@ -26,10 +26,12 @@ from pathlib import Path
 from typing import Any
 
 import cloudpickle
+import yaml
 
 from cerebx import __version__, runfiles
 from cerebx.errors import CerebxError, ConfigError
 from cerebx.loop.loop import ClosedLoop
+from cerebx.recording.reader import read_metadata
 from cerebx.recording.recorder import Recorder
 from cerebx.recording.segments import FIRST, add_segment
 from cerebx.schema.legacy import upgrade
@@ -146,8 +148,6 @@ def expand_args(args: list[str]) -> list[str]:
     run_dir = Path(given[-1].split("=", 1)[1].strip("'\""))
     saved = run_dir / runfiles.OVERRIDES
     try:
-        import yaml
-
         before = [str(o) for o in yaml.safe_load(saved.read_text()) or []]
     except (OSError, ValueError) as err:
         raise ConfigError(f"resume: cannot read the overrides of {run_dir} ({saved}: {type(err).__name__})") from None
@@ -218,8 +218,6 @@ def stale(run_dir: Path, plain: dict, summary: dict) -> str | None:
     """Why the completed run in ``run_dir`` cannot stand for the run ``plain`` asks for now, or None: its
     recorded configuration must equal ``plain`` (but for the trial count, logging and resumption), and
     the run it started from (``init_from``) must not have been written since it started."""
-    from cerebx.recording.reader import read_metadata
-
     try:
         old = json.loads(read_metadata(run_dir)["config"]["json"])
     except (CerebxError, KeyError, OSError, ValueError):

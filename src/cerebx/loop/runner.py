@@ -13,6 +13,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from tqdm import tqdm
+
 from cerebx import __version__, runfiles
 from cerebx.build import build_components
 from cerebx.errors import CerebxError, Diverged
@@ -45,8 +47,6 @@ def _progress(cfg, total: int):
     enabled = mode == "on" or (mode == "auto" and sys.stderr.isatty())
     if not enabled:
         return None
-    from tqdm import tqdm
-
     return tqdm(total=total, desc=f"{cfg.task.kind}/{cfg.controller.kind}", unit="trial", file=sys.stderr,
                 dynamic_ncols=True)
 

@@ -16,7 +16,10 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 
 import numpy as np
+from pydantic import ValidationError
 
+from cerebx import registry
+from cerebx.errors import CerebxError
 from cerebx.signals import Signal, joint_signals
 
 
@@ -102,11 +105,6 @@ class Plant(ABC):
 
     def handle_event(self, event: PlantEvent) -> None:
         """Apply a plant event through the event registry; an unknown or unsupported kind raises ValueError."""
-        from pydantic import ValidationError
-
-        from cerebx import registry
-        from cerebx.errors import CerebxError
-
         registry.load_plugins()
         try:
             fire = registry.events.build(registry.events.parse({"kind": event.kind, **event.params}), self)

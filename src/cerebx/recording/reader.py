@@ -9,6 +9,8 @@ from typing import Any
 
 from mcap.decoder import DecoderFactory
 from mcap.reader import make_reader
+from mcap.records import Channel, Message, Metadata
+from mcap.stream_reader import StreamReader
 
 from cerebx import runfiles
 from cerebx.errors import CerebxError
@@ -55,8 +57,6 @@ def _has_summary(fh) -> bool:
 def _scan(fh) -> Iterator[Any]:
     """Every complete record of a file read front to back, for a file without a summary (a run in
     progress, or one hard-killed): stops quietly at an incomplete tail, raises for a file that is not MCAP."""
-    from mcap.stream_reader import StreamReader
-
     records = StreamReader(fh, skip_magic=False).records
     try:
         first = next(records)
@@ -74,8 +74,6 @@ def _scan(fh) -> Iterator[Any]:
 
 
 def _stream_messages(fh, topics: list[str] | None) -> Iterator[tuple[str, int, Any]]:
-    from mcap.records import Channel, Message
-
     channels: dict[int, Channel] = {}
     for rec in _scan(fh):
         if isinstance(rec, Channel):
@@ -136,8 +134,6 @@ def _read_file(p: Path, topics: list[str] | None, start_ns: int | None,
 def channel_counts(path: Path | str) -> dict[str, int]:
     """Message count per topic: from the file's summary section, by scanning a file without one, or (a
     resumed run's folder) counted over its segments as :func:`read_messages` reads them."""
-    from mcap.records import Channel, Message
-
     if Path(path).is_dir() and len(segments(path)) > 1:
         per_topic: dict[str, int] = {}
         for topic, _t, _msg in read_messages(path):
@@ -176,8 +172,6 @@ def has_summary(path: Path | str) -> bool:
 def read_metadata(path: Path | str) -> dict[str, dict[str, str]]:
     """The metadata records of a file; of a run folder, its last segment's (each segment carries the
     config, and the last one the summary of the whole run)."""
-    from mcap.records import Metadata
-
     p = segments(path)[-1].path if Path(path).is_dir() else Path(path)
     if not p.exists():
         raise CerebxError(f"{p}: no such file")

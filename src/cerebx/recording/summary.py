@@ -18,6 +18,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from cerebx import runfiles
 from cerebx.errors import CerebxError
+from cerebx.metrics import final_mae
 
 SUMMARY_FILE = runfiles.SUMMARY
 
@@ -136,8 +137,6 @@ def read_summary(run_dir: Path | str) -> dict[str, Any]:
 
 def trial_fields(metrics: list[Any], sim_seconds: float) -> dict[str, Any]:
     """The per-trial lists and totals of a summary from the loop's trial metrics so far."""
-    from cerebx.metrics import final_mae
-
     mae = [m.mae for m in metrics]
     return {"trials_completed": len(metrics), "mae_per_trial": mae,
             "mae_per_joint_per_trial": [list(m.mae_per_joint) for m in metrics],

@@ -19,11 +19,14 @@ from collections import defaultdict
 from pathlib import Path
 
 from cerebx import runfiles
+from cerebx.config import estimate_jobs
 from cerebx.errors import CerebxError
+from cerebx.report import figures
 from cerebx.report.delays import delay_rows
 from cerebx.report.plot import fmt
 from cerebx.report.registry import Figure, MissingRuns, all_figures
 from cerebx.report.runs import RunSet, find_run_dirs, load_runs
+from cerebx.report.studies import execute, group, plan, study_runner
 
 MAX_TRACKING_RUNS = 12  # per-run joint-tracking figures only for small run sets
 
@@ -58,8 +61,6 @@ def _runs_table(runs: RunSet) -> list[list[str]]:
 
 def _general_figures(runs: RunSet, fig_dir: Path, problems: list[str]) -> list[str]:
     """Learning curves of every task, and joint tracking of each run when there are few."""
-    from cerebx.report import figures
-
     sections = []
     by_task: dict[str, list] = defaultdict(list)
     for r in runs:
@@ -189,13 +190,9 @@ def main(argv: list[str]) -> int:
             return 0
         failed: list[str] = []
         if a.profile:
-            from cerebx.report.studies import execute, group, plan, study_runner
-
             root = Path("runs") / "report"
             jobs = plan(a.profile, root, needed_studies(names))
             if a.dry_run:
-                from cerebx.config import estimate_jobs
-
                 for j in jobs:
                     print(f"{'reuse' if j.done() else 'run  '} {j.run_dir}  cerebx run {' '.join(j.overrides())}")
                 todo = [j.overrides() for j in jobs if not j.done()]

@@ -25,12 +25,21 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+from hydra import compose, initialize_config_module
+from hydra.core.global_hydra import GlobalHydra
+from hydra.core.override_parser.overrides_parser import OverridesParser
+from hydra.errors import HydraException
+from omegaconf import OmegaConf
 from pydantic import Field, ValidationError
 
+from cerebx.config import compose_with_choices, expand_sweep, load, to_plain
 from cerebx.errors import CerebxError, ConfigError
+from cerebx.loop.resume import stale
+from cerebx.loop.runner import run_experiment
+from cerebx.recording.summary import read_summary
 from cerebx.report.registry import STUDY_FILES, load_reports
 from cerebx.schema.base import Strict
-from cerebx.schema.experiment import format_errors
+from cerebx.schema.experiment import format_errors, validate
 
 PROFILES = ("quick", "full")
 
@@ -100,9 +109,6 @@ def _key(override: str) -> str:
 
 def is_sweep(override: str) -> bool:
     """Whether an override gives several values (``seed=0,1,2``, ``x=range(3)``), as ``cerebx run -m`` reads it."""
-    from hydra.core.override_parser.overrides_parser import OverridesParser
-    from hydra.errors import HydraException
-
     try:
         return OverridesParser.create().parse_overrides([override])[0].is_sweep_override()
     except HydraException:
@@ -120,13 +126,6 @@ def preset_sweep(args: list[str]) -> list[list[str]]:
 def _preset_sweep(args: tuple[str, ...]) -> tuple[tuple[str, ...], ...]:
     given = [a for a in args if is_sweep(a)]
     args = [a for a in args if not is_sweep(a)]
-    from hydra import compose, initialize_config_module
-    from hydra.core.global_hydra import GlobalHydra
-    from hydra.errors import HydraException
-    from omegaconf import OmegaConf
-
-    from cerebx.config import expand_sweep
-
     GlobalHydra.instance().clear()
     try:
         with initialize_config_module(config_module="cerebx.conf", version_base="1.3"):
@@ -182,8 +181,6 @@ class Job:
             shutil.rmtree(self.run_dir)  # an unfinished earlier attempt
 
     def describe(self) -> str:
-        from cerebx.recording.summary import read_summary
-
         s = read_summary(self.run_dir)
         mae = s.get("final_mae")
         return f"final MAE {mae if mae is None else round(mae, 4)} rad, {s.get('wall_seconds', 0):.0f} s"
@@ -191,9 +188,6 @@ class Job:
     def done(self) -> bool:
         """A completed run with enough trials, made from this job's configuration as the presets give it
         now and after the run it starts from (else ``resume=auto`` runs it again: a preset changed since)."""
-        from cerebx.loop.resume import stale
-        from cerebx.recording.summary import read_summary
-
         try:
             s = read_summary(self.run_dir)
         except CerebxError:
@@ -205,8 +199,6 @@ class Job:
     @functools.cached_property
     def _plain(self) -> dict | None:
         """This job's composed configuration (None when it does not compose: the run will say why)."""
-        from cerebx.config import load
-
         try:
             return load(self.overrides())[1]
         except CerebxError:
@@ -281,8 +273,6 @@ class Study:
         """Nothing to clear: each job reuses, resumes or restarts itself (resume=auto)."""
 
     def describe(self) -> str:
-        from cerebx.recording.summary import read_summary
-
         maes = [read_summary(j.run_dir)["final_mae"] for j in self.jobs]
         text = ", ".join("-" if m is None else f"{m:.4f}" for m in maes)
         return f"{len(self.jobs)} job{'s' * (len(self.jobs) > 1)}, final MAE {text} rad"
@@ -362,10 +352,6 @@ def study_runner(extra: list[str] = ()) -> Runner:
 
 def in_process_runner(job: Job) -> int:
     """Run in this process (for tests: no interpreter start-up per job)."""
-    from cerebx.config import compose_with_choices, to_plain
-    from cerebx.loop.runner import run_experiment
-    from cerebx.schema.experiment import validate
-
     cfg, choices = compose_with_choices(job.overrides())
     plain = to_plain(cfg)
     s = run_experiment(validate(plain), job.run_dir, plain, overrides=job.overrides(), choices=choices)

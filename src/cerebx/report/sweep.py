@@ -23,6 +23,7 @@ import yaml
 from cerebx import runfiles
 from cerebx.errors import CerebxError
 from cerebx.recording.summary import SUMMARY_FILE, read_summary
+from cerebx.report.plot import plt
 from cerebx.sweep import MAX_EXIT_CODE, OK_STATUSES
 
 STEM = "sweep_summary"
@@ -182,11 +183,6 @@ def write(summary: SweepSummary) -> list[Path]:
 
 
 def _plot(summary: SweepSummary, keys: list[str], path: Path) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     fig, axes = plt.subplots(1, len(keys), figsize=(4.2 * len(keys), 3.4), squeeze=False)
     for ax, key in zip(axes[0], keys):
         pts = sorted((_number(r.overrides.get(key)), r.final_mae_rad) for r in summary.rows

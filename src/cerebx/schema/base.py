@@ -6,6 +6,8 @@ from typing import Annotated
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
+from cerebx.signals import joint_signals
+
 JOINTS_BAXTER = ("s0", "s1", "e0", "e1", "w0", "w1")
 
 
@@ -40,13 +42,9 @@ class PlantSchema(Strict):
     The defaults are a joint-torque plant; a plant with other signals overrides both."""
 
     def sensor_signals(self) -> dict:
-        from cerebx.signals import joint_signals
-
         s = joint_signals(self.n_joints)  # type: ignore[attr-defined]
         return {"joint.q": s["joint.q"], "joint.qd": s["joint.qd"]}
 
     def command_signals(self) -> dict:
-        from cerebx.signals import joint_signals
-
         limit = getattr(self, "torque_limit_Nm", None)
         return {"joint.torque": joint_signals(self.n_joints, limit)["joint.torque"]}  # type: ignore[attr-defined]

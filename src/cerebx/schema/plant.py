@@ -7,6 +7,7 @@ from typing import Literal
 from pydantic import Field, model_validator
 
 from cerebx.schema.base import NonNegFloat, PhysicsStepMs, PlantSchema, PositiveFloat, Strict
+from cerebx.signals import Signal
 
 
 class Planar2Config(PlantSchema):
@@ -144,13 +145,9 @@ class UpperLimbConfig(PlantSchema):
         return 2
 
     def sensor_signals(self) -> dict:
-        from cerebx.signals import Signal
-
         n = len(MUSCLES_UPPER_LIMB)
         return {**super().sensor_signals(), "muscle.length": Signal("muscle.length", n, "mm"),
                 "muscle.velocity": Signal("muscle.velocity", n, "mm/s")}
 
     def command_signals(self) -> dict:
-        from cerebx.signals import Signal
-
         return {"muscle.activation": Signal("muscle.activation", len(MUSCLES_UPPER_LIMB), "", 0.0, 1.0)}

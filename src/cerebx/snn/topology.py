@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.polynomial import Polynomial as Pn
 
 from cerebx.snn.schema import AllToAll, JointCombinations, LIFNeuron, NetworkConfig, OneToOne
 
@@ -42,8 +43,6 @@ def step_polynomials(method: str, h: float, C: float, gL: float, E: float, d: fl
     (lowest order first, length N_COEF) of P and Q, computed exactly in float64. With n > 1 the
     step is n sub-steps of h/n (d, dh are then the decays over h/n and h/2n), composed into one
     pair: P = prod_k P1(g0 d^k), Q accordingly."""
-    from numpy.polynomial import Polynomial as Pn
-
     gp = Pn([0.0, 1.0])
     one, zero = Pn([1.0]), Pn([0.0])
 

@@ -15,8 +15,9 @@ def format_summary(s: dict[str, Any], run_dir: Path | None = None) -> str:
         lines.append(f"run       {run_dir}")
     lines.append(f"status    {s['status']}" + (f"  ({s['error']})" if s.get("error") else ""))
     chosen = {**{k: s[k] for k in ("controller", "plant", "delay")}, **(s.get("presets") or {})}  # delay=gamma45
+    network = f" network={s['network']}" if s.get("network") else ""
     lines.append(f"setup     task={s['task']} controller={chosen['controller']} plant={chosen['plant']} "
-                 f"delay={chosen['delay']} network={s.get('network')} seed={s['seed']}")
+                 f"delay={chosen['delay']}{network} seed={s['seed']}")
     mae = s.get("mae_per_trial") or []
     lines.append(f"trials    {s.get('trials_completed', len(mae))}/{s['trials']}")
     if mae:

@@ -1,0 +1,43 @@
+"""``cerebx inspect``: a run's summary and its MCAP channels; a bad summary or log is one line each, the
+other still shown."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from cerebx import runfiles
+from cerebx.commands.common import fail
+from cerebx.errors import CerebxError
+from cerebx.recording.console import format_summary
+from cerebx.recording.reader import channel_counts, has_summary, read_summary
+from cerebx.recording.segments import segments
+
+
+def main(args: list[str]) -> int:
+    if len(args) != 1:
+        return fail(["inspect: give one run folder or .mcap file"])
+    p = Path(args[0])
+    if not p.exists():
+        return fail([f"{p}: no such file or folder"])
+    run_dir = p if p.is_dir() else p.parent
+    problems: list[str] = []
+    if (run_dir / runfiles.SUMMARY).exists() or p.is_dir():
+        try:
+            print(format_summary(read_summary(run_dir), run_dir))
+        except CerebxError as err:
+            problems.append(str(err))
+    log = p
+    try:
+        files = [s.path for s in segments(p)] if p.is_dir() else [p]
+        log = files[-1]
+        counts = channel_counts(p)
+        width = max(map(len, counts), default=10)
+        closed = all(has_summary(f) for f in files)
+        print("\n" + " + ".join(str(f) for f in files)
+              + ("" if closed else "  (no summary section: counted by scanning up to the last "
+                                   "complete record; the run was killed or is still going)"))
+        for topic, n in counts.items():
+            print(f"  {topic:<{width}}  {n:>9,}")
+    except (CerebxError, OSError) as err:
+        problems.append(str(err) if isinstance(err, CerebxError) else f"{log}: {err.strerror}")
+    return fail(problems) if problems else 0
