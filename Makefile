@@ -15,7 +15,7 @@ BENCH_ARGS ?=
 PROFILE ?= quick
 REPORT_ARGS ?=
 
-.PHONY: help install run test test-full bench report lint format clean
+.PHONY: help install run test test-unit test-slow test-full bench report lint format clean
 
 help: ## list the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -31,8 +31,14 @@ install: $(STAMP) ## create .venv and install cerebx with its test tools
 run: $(STAMP) ## run the default experiment (RUN_ARGS=... to choose another)
 	$(BIN)/cerebx run $(RUN_ARGS)
 
-test: $(STAMP) ## the fast test suite (a few minutes)
+test: $(STAMP) ## unit and integration tests, not the slow ones (under 5 minutes on 2 cores)
 	$(BIN)/pytest -m "not slow"
+
+test-unit: $(STAMP) ## only the unit tests (seconds)
+	$(BIN)/pytest -m unit
+
+test-slow: $(STAMP) ## only the slow tests (what test-full adds to test)
+	$(BIN)/pytest -m slow
 
 test-full: $(STAMP) ## every test, including the slow ones
 	$(BIN)/pytest
@@ -43,8 +49,9 @@ bench: $(STAMP) ## speed of plant, network and closed loop, as JSON
 report: $(STAMP) ## run missing studies (PROFILE=quick|full), then build reports/index.html
 	$(BIN)/cerebx report --profile $(PROFILE) $(REPORT_ARGS)
 
-lint: $(STAMP) ## ruff lint
+lint: $(STAMP) ## ruff, and the import contracts of pyproject.toml (the layering: core, schema, papers)
 	$(BIN)/ruff check src tests
+	$(BIN)/lint-imports --no-cache
 
 format: $(STAMP) ## ruff format
 	$(BIN)/ruff format src tests

@@ -30,3 +30,10 @@ def in_tmp(tmp_path, monkeypatch):
     """Run with the working directory in a fresh temporary folder (runs/ lands there)."""
     monkeypatch.chdir(tmp_path)
     return tmp_path
+
+
+def pytest_collection_modifyitems(config, items):
+    """A test marked neither integration nor slow is a unit test (``-m unit`` runs only those)."""
+    for item in items:
+        if not any(item.get_closest_marker(m) for m in ("integration", "slow")):
+            item.add_marker(pytest.mark.unit)

@@ -18,6 +18,8 @@ from cerebx.controllers.pd import PD
 from cerebx.loop.runner import run_experiment
 from cerebx.recording.reader import channel_counts, read_messages, read_summary
 
+pytestmark = pytest.mark.integration
+
 DEMO = ["+experiment=demo"]
 
 

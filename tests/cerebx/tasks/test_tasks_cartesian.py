@@ -14,6 +14,8 @@ from cerebx.schema import task as T
 from cerebx.tasks import cartesian
 from cerebx.tasks.ik import SiteIK, rotation_angle
 
+pytestmark = pytest.mark.integration
+
 load_plugins()
 LO = np.array([r[0] for r in JOINT_RANGE])
 HI = np.array([r[1] for r in JOINT_RANGE])

@@ -14,7 +14,7 @@ from cerebx.guard import conf_roots
 from cerebx.loop.delays import Percentiles
 from cerebx.loop.link import DelayChannel
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 # name: (r2c mean, r2c std, c2r mean, c2r std, round-trip mean, round-trip std) in ms, as documented
 # in each preset's header (4e5-sample estimates, or exact for percentile tables and the trace file).

@@ -8,8 +8,12 @@ import os
 import socket
 from pathlib import Path
 
+import pytest
+
 from cerebx.cli import main
 from cerebx.report.sweep import summarize, write
+
+pytestmark = pytest.mark.integration
 
 
 def _job(root: Path, num: int, overrides: list[str], summary: dict | None) -> None:

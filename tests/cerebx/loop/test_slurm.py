@@ -15,7 +15,9 @@ import pytest
 
 from cerebx import jobenv
 
-ROOT = Path(__file__).resolve().parents[1]
+pytestmark = pytest.mark.integration
+
+ROOT = Path(__file__).resolve().parents[3]
 SCRIPT = ROOT / "scripts" / "slurm_local.sh"
 
 

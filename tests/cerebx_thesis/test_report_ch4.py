@@ -5,10 +5,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from cerebx.config import compose
 from cerebx.report.runs import Run, RunSet
 from cerebx_thesis.report.ch4 import PATHWAY_MS, fig4_5, learning_runs, perturbation_runs, trials_to
+
+pytestmark = pytest.mark.integration
 
 
 def _run(tmp: Path, name: str, task: str, period: float, spinal: str, mae, vel, events=(), warmup=0,

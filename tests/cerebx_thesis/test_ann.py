@@ -14,6 +14,8 @@ from cerebx.schema.controller import GivenRanges
 from cerebx_thesis.ann.controller import ANN
 from cerebx_thesis.ann.schema import ANNController
 
+pytestmark = pytest.mark.integration
+
 NJ = 6
 RANGES = GivenRanges(
     q_min=(-1.0,) * NJ,

@@ -17,6 +17,8 @@ from cerebx_capolei2020.modules.circuit import ModularCerebellarCircuit, k
 from cerebx_capolei2020.modules.controller import ForwardModuleStage
 from cerebx_capolei2020.modules.schema import CapoleiForward, CapoleiInverse
 
+pytestmark = pytest.mark.integration
+
 CTX = SimpleNamespace(cfg=SimpleNamespace(control_dt_ms=2.0))
 
 

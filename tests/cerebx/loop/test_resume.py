@@ -21,13 +21,15 @@ from cerebx.loop import resume
 from cerebx.recording.reader import channel_counts, read_messages, read_metadata
 from cerebx.recording.segments import segments
 
+pytestmark = pytest.mark.integration
+
 # PD on the planar arm over a random (gamma) link delay: every trial differs, so the continuation only
 # matches when the generators, the messages in flight and the plant's state are all restored.
 RUN = ["+experiment=demo", "delay=gamma25", "recording.progress=off"]
 
 
 def _cerebx(*args: str, cwd: Path) -> subprocess.Popen:
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src")}
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[3] / "src")}
     return subprocess.Popen([sys.executable, "-m", "cerebx", "run", *args], cwd=cwd, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 

@@ -16,7 +16,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from cerebx.cli import main
-from cerebx.guard import CONF_ROOT
+from cerebx.guard import conf_roots
+
+pytestmark = pytest.mark.integration
 
 FAST = settings(max_examples=40, derandomize=True, deadline=None, database=None,
                 suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
@@ -27,14 +29,18 @@ FULL_FILES = settings(FULL, max_examples=600)
 
 PROBLEM = re.compile(r"^\S[^\n]*?: \S")  # "where: problem"
 
-GROUPS = {d.name: sorted(p.stem for p in d.glob("*.yaml")) for d in sorted(CONF_ROOT.iterdir())
-          if d.is_dir() and d.name not in ("report", "__pycache__")}
+GROUPS: dict[str, list[str]] = {}
+for _root in conf_roots():  # cerebx's groups and every installed plugin's
+    for _d in sorted(_root.iterdir()):
+        if _d.is_dir() and _d.name != "__pycache__":
+            GROUPS[_d.name] = sorted({*GROUPS.get(_d.name, []), *(p.stem for p in _d.glob("*.yaml"))})
 TOP_KEYS = ["seed", "trials", "init_from", "start_at", "warmup_trials", "events", "name", "control_dt_ms",
             "recording.decimation", "recording.chunk_size_kb", "recording.compression", "recording.progress",
             "recording.save_state", "recording.joint_states", "controller.kp", "controller.mf.fibers_per_signal",
             "controller.pathway_delay_ms", "controller.record_spikes", "plant.physics_dt_ms",
-            "plant.torque_limit_Nm", "delay.total_ms", "task.period_s", "network.dt_ms",
-            "network.populations.gc.size", "network.projections.pf_pc.plasticity.kernel_peak_ms", "robot", "brain",
+            "plant.torque_limit_Nm", "delay.total_ms", "task.period_s", "controller.network.dt_ms",
+            "controller.network.populations.gc.size",
+            "controller.network.projections.pf_pc.plasticity.kernel_peak_ms", "robot", "brain",
             "spinal", "muscle", "nonexistent", "controller.nonexistent.deep", "hydra.run.dir", "_target_",
             "hydra.callbacks.x._target_"]
 

@@ -12,6 +12,8 @@ import yaml
 from cerebx.loop.runner import run_experiment
 from cerebx.tuning import envelope, main, tune_pd
 
+pytestmark = pytest.mark.integration
+
 DEMO = ["+experiment=demo"]
 
 

@@ -14,6 +14,8 @@ from cerebx.schema.muscles import EkebergConfig
 from cerebx.signals import Frame
 from cerebx.stages.muscles import Ekeberg
 
+pytestmark = pytest.mark.integration
+
 Q_REST = np.array([0.0, 0.22, 0.0, 1.34, 0.0, 0.0])
 
 

@@ -9,6 +9,8 @@ import pytest
 from cerebx.loop.runner import run_experiment
 from cerebx.recording.reader import read_messages
 
+pytestmark = pytest.mark.integration
+
 FAST = ["+experiment=upper_limb", "+task=vertical_circle_fast", "spinal=cord", "recording.joint_states=false"]
 
 

@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from cerebx.cli import main
-
-CONF = Path(__file__).resolve().parents[1] / "conf"
+from cerebx.guard import conf_roots
 
 
 def _options(group: str) -> list[str]:
-    return sorted(p.stem for p in (CONF / group).glob("*.yaml"))
+    """The options of a config group, cerebx's and every installed plugin's."""
+    return sorted(p.stem for root in conf_roots() for p in (root / group).glob("*.yaml"))
 
 
 UPPER_LIMB_TASKS = ("flexion_extension", "vertical_circle_slow", "vertical_circle_fast")
@@ -22,7 +20,7 @@ def _plant_for(task: str) -> list[str]:
     if task == "luque_eight":
         return ["plant=lwr3", "controller=luque2011"]
     if task == "wrist_oscillation":
-        return ["plant=icub_wrist", "controller=capolei_arch4", "network=small"]
+        return ["plant=icub_wrist", "controller=capolei_arch4"]
     if task in UPPER_LIMB_TASKS:
         return ["+experiment=upper_limb_pd"]
     return ["plant=planar2", "controller=pd_planar2"] if task == "joint_sine" else []
@@ -55,7 +53,7 @@ def test_every_option_validates(load, group):
         elif option == "muscle_rest":
             extra = ["+task=circle", "plant=baxter_muscles", "muscle=ekeberg"]
         elif option == "icub_wrist" or option.startswith("capolei_"):
-            extra = ["+task=wrist_oscillation", "plant=icub_wrist", "controller=capolei_arch4", "network=small"]
+            extra = ["+task=wrist_oscillation", "plant=icub_wrist", "controller=capolei_arch4"]
         elif option == "upper_limb":
             extra = ["+task=vertical_circle_slow", "+experiment=upper_limb_pd"]
         else:

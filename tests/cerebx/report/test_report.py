@@ -17,6 +17,8 @@ from cerebx.report.build import main as report_main
 from cerebx.report.registry import all_figures
 from cerebx.report.studies import Job, execute, load_studies, plan
 
+pytestmark = pytest.mark.integration
+
 
 @pytest.fixture(scope="module")
 def fixture_runs(tmp_path_factory):

@@ -8,6 +8,8 @@ import pytest
 from cerebx.build import build_components
 from cerebx.loop.loop import ClosedLoop
 
+pytestmark = pytest.mark.integration
+
 
 def test_snn_learning_reduces_error_on_small_network(load):
     cfg = load(["+task=circle", "+experiment=small_snn", "trials=30", "seed=0"])

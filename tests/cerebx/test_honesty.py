@@ -19,6 +19,8 @@ from cerebx.controllers.pd import PD
 from cerebx.loop.runner import run_experiment
 from cerebx.recording.reader import channel_counts, read_messages, read_summary
 
+pytestmark = pytest.mark.integration
+
 DEMO = ["+experiment=demo"]
 
 
@@ -400,7 +402,7 @@ def test_numba_cache_defaults_to_the_checkout(monkeypatch):
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     monkeypatch.delenv("CEREBX_CACHE", raising=False)
     assert main(["--version"]) == 0
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     assert os.environ["NUMBA_CACHE_DIR"] == str(root / ".cache" / "numba")
 
 

@@ -22,6 +22,8 @@ from cerebx.signals import Frame, Signal, StageIO
 from cerebx.stages.base import Stage
 from cerebx.stages.check import check_experiment
 
+pytestmark = pytest.mark.integration
+
 DEMO = ["+experiment=demo", "trials=1"]
 UPPER_LIMB = ["+experiment=upper_limb_pd", "+task=vertical_circle_fast", "trials=1"]
 

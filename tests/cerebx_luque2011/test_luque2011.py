@@ -13,6 +13,8 @@ import pytest
 from cerebx import metrics
 from cerebx_luque2011.cerebellum import kernels as k
 
+pytestmark = pytest.mark.integration
+
 # ---- kernel (Eq. 5) ---------------------------------------------------------------------------------------
 
 

@@ -1,0 +1,43 @@
+"""The import contracts of ``make lint`` hold, and they catch a violation planted in a copy of the tree."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.integration
+
+ROOT = Path(__file__).resolve().parents[2]
+LINT = Path(sys.executable).with_name("lint-imports")
+
+
+def _lint(src: Path, cwd: Path) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    return subprocess.run([str(LINT), "--no-cache", "--config", str(ROOT / "pyproject.toml")], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=300)
+
+
+def test_the_tree_keeps_every_contract(tmp_path):
+    done = _lint(ROOT / "src", tmp_path)
+    assert done.returncode == 0, done.stdout[-3000:]
+    assert "0 broken" in done.stdout
+
+
+@pytest.mark.parametrize(("where", "line", "contract"), [
+    ("cerebx/loop/planted.py", "import cerebx_thesis.ann.schema", "The platform imports no paper package"),
+    ("cerebx/schema/planted.py", "import cerebx.loop.runner", "The schema layer imports no runtime module"),
+    ("cerebx/stages/planted.py", "import cerebx.report.build", "import no report"),
+    ("cerebx_luque2011/planted.py", "import cerebx_capolei2020.task", "The papers are independent"),
+])
+def test_a_planted_violation_breaks_its_contract(tmp_path, where, line, contract):
+    src = tmp_path / "src"
+    shutil.copytree(ROOT / "src", src, ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    (src / where).write_text(f'"""A planted violation."""\n\n{line}\n')
+    done = _lint(src, tmp_path)
+    assert done.returncode != 0
+    assert contract in done.stdout and "BROKEN" in done.stdout
