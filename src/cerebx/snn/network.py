@@ -52,7 +52,11 @@ class Network:
         t_start = time.perf_counter()
         self.cfg = cfg
         self.parallel = parallel
-        self.n_threads = numba.get_num_threads() if parallel else 1
+        # started even when serial: a cached run_chunk that was compiled in a process which took
+        # run_step from the cache does not start numba's parallel runtime itself, and crashes
+        # without it (numba issue 8578)
+        threads = numba.get_num_threads()
+        self.n_threads = threads if parallel else 1
         self.topo = topo = build_topology(cfg)
         self.n_sub = topo.n_sub
         self.fingerprint = structure_fingerprint(cfg)
