@@ -45,8 +45,11 @@ mV), so a neuron returns to rest a few tens of ms after its last input.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
-from numba import njit, prange
+from numba import njit, prange, types
+from numba.experimental import structref
 
 from cerebx.snn.topology import (
     I_COMPACT,
@@ -84,6 +87,113 @@ RUN_MIN = 4  # targets at consecutive compact positions delivered as one vector 
 PAR_MIN = 4096  # neurons below which a population is integrated serially even when parallel
 
 MG_LN = float(np.log(1.2 / 3.57))  # NMDA Mg block g_inf(V) = 1 / (1 + e^(-0.062 V + MG_LN)), V in mV
+
+
+class Neurons(NamedTuple):
+    """Per-neuron state (compact slices in front, see the module docstring) and the bookkeeping of
+    the compact lists, one entry per population where marked."""
+
+    u: np.ndarray  # float32 [n]: V - E_L (mV)
+    g: np.ndarray  # float32 [3, n]: AMPA, NMDA, GABA conductance (nS)
+    ref: np.ndarray  # float32 [n]: refractory steps left
+    flag: np.ndarray  # uint8 [n]: spiked in the step just integrated
+    cid: np.ndarray  # int32 [n]: compact position -> global index
+    slot: np.ndarray  # int32 [n]: global index -> compact position (-1 at rest)
+    n_act: np.ndarray  # int64 [pop]: listed (non-resting) neurons
+    n_rest: np.ndarray  # int64 [pop]: listed neurons found at rest by the last step
+    pop_ep: np.ndarray  # int64 [pop]: version of the compact list (every compaction increments it)
+
+
+class Populations(NamedTuple):
+    """Fixed parameters of each population (rows: populations, columns: ``topology`` I_*/P_*)."""
+
+    pop_i: np.ndarray  # int64 [pop, I_*]: kind, bounds, step ratio, compact, bifixed sub-steps
+    pop_par: np.ndarray  # float64 [pop, P_*]: membrane, synapse and step constants
+    poly: np.ndarray  # float32 [pop, 2, 2, N_COEF]: step polynomials of AMPA-only populations
+
+
+class Delivery(NamedTuple):
+    """Spikes in flight and the synapses that deliver them."""
+
+    ring_idx: np.ndarray  # int32 [R, n]: spiking neurons per substep slot (t % R)
+    ring_n: np.ndarray  # int64 [R]: spikes in each slot
+    sp_i: np.ndarray  # int64 [proj, 7]: pre_lo, n_pre, row offset, receptor, delay, teaching, post pop
+    sp_ptr: np.ndarray  # int64: CSR row pointers by presynaptic neuron, all sparse projections
+    sp_post: np.ndarray  # int32: postsynaptic global index per synapse
+    sp_w: np.ndarray  # float32: weight per synapse (nS)
+    sp_c: np.ndarray  # int64 [rows, 2]: delivery cache (epoch, runs) per presynaptic neuron
+    c_k: np.ndarray  # int64: cached run start (compact position)
+    c_q: np.ndarray  # int64: cached run first synapse
+    c_l: np.ndarray  # int64: cached run length
+    de_i: np.ndarray  # int64 [proj, 9]: pre_lo, n_pre, post_lo, n_post, w_off, receptor, delay, rule, post pop
+    dense_w: np.ndarray  # float32: all-to-all weights, [n_pre, n_post] blocks (nS)
+
+
+class Plasticity(NamedTuple):
+    """PF-PC rules and the buffered PF arrivals LTD pairs with teacher spikes."""
+
+    pl_i: np.ndarray  # int64 [rule, 4]: dense projection, teaching projection, kernel offset, kernel length
+    pl_f: np.ndarray  # float64 [rule, 4]: LTP, LTD, w_lo, w_hi (nS)
+    kern: np.ndarray  # float32: LTD kernels by substep age, all rules
+    pf_t: np.ndarray  # int64 [rule, cap]: arrival substep of each buffered PF spike (ring)
+    pf_j: np.ndarray  # int32 [rule, cap]: its presynaptic index
+    pf_head: np.ndarray  # int64 [rule]: PF spikes buffered so far
+    pf_lost: np.ndarray  # int64 [rule]: overwritten while still inside the kernel window
+
+
+class Buffers(NamedTuple):
+    """Scratch space and the step's spike output."""
+
+    col_buf: np.ndarray  # int64 [n]: PCs hit by teacher spikes
+    acc: np.ndarray  # float64 [n]: summed kernel values per PF (zero between uses)
+    acc_j: np.ndarray  # int64 [n]: PFs with a nonzero acc
+    out_idx: np.ndarray  # int32 [n * n_sub]: spiking neurons of the step
+    out_t: np.ndarray  # int32 [n * n_sub]: their substep (1..n_sub)
+    scr_f: np.ndarray  # float32 [3, n]: compaction scratch (u, g_AMPA, ref)
+    scr_i: np.ndarray  # int64 [n]: compaction scratch (global index)
+
+
+class NetworkArrays(NamedTuple):
+    """Everything the step kernels read and write, by meaning; the arrays are the ``Network``'s own.
+    The entry points get it as one :class:`KernelState`; the helpers they call take the groups
+    (named tuples cost nothing inside numba)."""
+
+    neurons: Neurons
+    populations: Populations
+    delivery: Delivery
+    plasticity: Plasticity
+    buffers: Buffers
+
+
+@structref.register
+class _KernelStateType(types.StructRef):
+    """numba type of :class:`KernelState`."""
+
+
+class KernelState(structref.StructRefProxy):
+    """A network's :class:`NetworkArrays` as one numba object, the form :func:`run_step` and
+    :func:`run_chunk` take (make it with :func:`kernel_state`). numba passes it as one pointer, so a
+    call costs the same whatever the number of arrays: an empty step costs about half as much as
+    with the 38 arrays as arguments and a quarter as much as with the named tuples, whose arrays and
+    field names numba checks one by one on every call. Pickles as its arrays."""
+
+    def __reduce__(self):
+        return kernel_state, (self.arrays,)
+
+
+structref.define_proxy(KernelState, _KernelStateType, NetworkArrays._fields)
+
+
+@njit(cache=True)
+def _pack(arrays):
+    return KernelState(*arrays)
+
+
+def kernel_state(arrays: NetworkArrays) -> KernelState:
+    """The kernels' handle on ``arrays`` (the same array objects: writes either way are seen both ways)."""
+    state = _pack(arrays)
+    state.arrays = arrays
+    return state
 
 
 def mg_block(v: np.ndarray) -> np.ndarray:
@@ -159,15 +269,30 @@ def _coefs(c):
             c[1, 1, 0], c[1, 1, 1], c[1, 1, 2], c[1, 1, 3], c[1, 1, 4], c[1, 1, 5], c[1, 1, 6])
 
 
-@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _pass(u, g, ref, flag, cf, fine, ufine, lo_u, uth, nref, dwin):
-    """Step, threshold, reset, refractory count, conductance decay and rest count of every neuron
-    in one fused loop per variant (LLVM vectorises it). Returns (spikes, neurons at rest) as
-    floats (integer reductions of booleans defeat the vectoriser)."""
-    zero, one = np.float32(0.0), np.float32(1.0)
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _lif_poly(u, g, ref, flag, pops, pi):
+    """One step of the AMPA-only population ``pi`` (u, g, ref, flag: its slices; pops:
+    :class:`Populations`): u' = P(g0) u + Q(g0), or, when the population has bifixed sub-steps and
+    the step starts above u_fine or its one-step estimate ends above it, the bifixed pair (the n
+    sub-steps composed). ``pops.poly[pi]``: float32 [2, 2, N_COEF] coefficients (lowest order
+    first) of (P, Q) for the step and for the bifixed sub-steps composed.
+    Integration, threshold, reset, refractory count, conductance decay and the count of neurons
+    at rest are one fused loop per variant (LLVM vectorises it; ~25% faster than separate passes).
+    With bifixed sub-steps both polynomials are evaluated for every neuron: the bifixed one is
+    needed by ~12% of the active GCs (all those with two or more active inputs), and evaluating
+    it only where needed (a coarse pre-pass per block, then the bifixed one for the blocks that
+    need it) costs as much as it saves. Returns (spikes, neurons at rest after the step); both
+    are counted in floats (integer reductions of booleans defeat the vectoriser)."""
+    f32 = np.float32
+    pp = pops.pop_par[pi]
+    dwin, ufine = f32(pp[P_DA]), f32(pp[P_UFINE])
+    uth, nref = f32(pp[P_VTH] - pp[P_EL]), f32(pp[P_NREF])
+    lo_u = f32(0.0) if pp[P_CLAMP] > 0.5 else f32(-3.0e38)
+    cf = _coefs(pops.poly[pi])
+    zero, one = f32(0.0), f32(1.0)
     cnt = zero
     nrest = zero
-    if fine:
+    if pops.pop_i[pi, I_NFINE] > 1:
         for i in range(u.shape[0]):
             x = u[i]
             g0 = g[i]
@@ -194,30 +319,11 @@ def _pass(u, g, ref, flag, cf, fine, ufine, lo_u, uth, nref, dwin):
             cnt += one if spk else zero
             g[i] = gn
             nrest += one if (abs(un) + gn + rn) == zero else zero
-    return cnt, nrest
-
-
-@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
-def _lif_poly(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp):
-    """One step of an AMPA-only population (arguments are its slices): u' = P(g0) u + Q(g0), or,
-    when ``fine`` and the step starts above ufine or its one-step estimate ends above it, the
-    bifixed pair (the n sub-steps composed). c: float32 [2, 2, N_COEF] coefficients (lowest
-    order first) of (P, Q) for the step and for the bifixed sub-steps composed.
-    Integration, threshold, reset, refractory count, conductance decay and the count of neurons
-    at rest are one fused loop (it vectorises; ~25% faster than separate passes). With ``fine``
-    both polynomials are evaluated for every neuron: the bifixed one is needed by ~12% of the
-    active GCs (all those with two or more active inputs), and evaluating it only where needed
-    (a coarse pre-pass per block, then the bifixed one for the blocks that need it) costs as
-    much as it saves. Returns (spikes, neurons at rest after the step)."""
-    f32 = np.float32
-    lo_u = f32(0.0) if clamp else f32(-3.0e38)
-    cf = _coefs(c)
-    cnt, nrest = _pass(u, g, ref, flag, cf, fine, ufine, lo_u, uth, nref, dwin)
     return int(cnt), int(nrest)
 
 
 @njit(cache=True, parallel=True, fastmath=True, error_model="numpy", boundscheck=False)
-def _lif_poly_par(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nch):
+def _lif_poly_par(u, g, ref, flag, pops, pi, nch):
     """:func:`_lif_poly` on numba threads: ``nch`` contiguous chunks."""
     n = u.shape[0]
     cnt = 0
@@ -225,7 +331,7 @@ def _lif_poly_par(u, g, ref, flag, c, dwin, fine, ufine, uth, nref, clamp, nch):
     for ch in prange(nch):
         a = ch * n // nch
         b = (ch + 1) * n // nch
-        c1, r1 = _lif_poly(u[a:b], g[a:b], ref[a:b], flag[a:b], c, dwin, fine, ufine, uth, nref, clamp)
+        c1, r1 = _lif_poly(u[a:b], g[a:b], ref[a:b], flag[a:b], pops, pi)
         cnt += c1
         nrest += r1
     return cnt, nrest
@@ -354,11 +460,13 @@ def _collect(flag, ids, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp, so
 
 
 @njit(cache=True, boundscheck=False)
-def _compact(lo, hi, u, g, ref, cid, slot, sf, si):
-    """Drop the neurons at rest from a compact AMPA-only population and put the others in global
-    index order (the order of the list does not affect any result: every per-neuron operation is
-    independent and collected spikes are sorted; index order makes the targets of one presynaptic
-    neuron long runs, see :func:`_build_runs`). sf/si: scratch. Returns the new count."""
+def _compact(lo, hi, nrn, buf):
+    """Drop the neurons at rest from the compact AMPA-only population [lo, hi) and put the others in
+    global index order (the order of the list does not affect any result: every per-neuron
+    operation is independent and collected spikes are sorted; index order makes the targets of one
+    presynaptic neuron long runs, see :func:`_build_runs`). Returns the new count."""
+    u, g, ref, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot
+    sf, si = buf.scr_f, buf.scr_i
     j = 0
     for i in range(lo, hi):
         k = slot[i]
@@ -385,11 +493,13 @@ def _compact(lo, hi, u, g, ref, cid, slot, sf, si):
 
 
 @njit(cache=True, boundscheck=False)
-def _build_runs(qa, qb, sp_post, plo, pp, n_act, u, g, ref, cid, slot, c_k, c_q, c_l):
-    """Positions in the compact list of the targets sp_post[qa:qb] of one presynaptic neuron
-    (activating the ones at rest), as runs of consecutive positions: c_k start position, c_q
-    first synapse, c_l length, stored from qa on. Returns the number of runs. Valid until the
-    population is compacted again (activation only appends)."""
+def _build_runs(qa, qb, plo, pp, nrn, dl):
+    """Positions in the compact list of population pp (starting at plo) of the targets
+    sp_post[qa:qb] of one presynaptic neuron (activating the ones at rest), as runs of consecutive
+    positions: c_k start position, c_q first synapse, c_l length, stored from qa on. Returns the
+    number of runs. Valid until the population is compacted again (activation only appends)."""
+    u, g, ref, cid, slot, n_act = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot, nrn.n_act
+    sp_post, c_k, c_q, c_l = dl.sp_post, dl.c_k, dl.c_q, dl.c_l
     nr = 0
     prev = -2
     k0 = 0
@@ -431,11 +541,17 @@ def _build_runs(qa, qb, sp_post, plo, pp, n_act, u, g, ref, cid, slot, c_k, c_q,
 
 
 @njit(cache=True, fastmath=True, boundscheck=False)
-def _ltd(w, n_post, col, n_col, lo_w, ltd, kern, pf_t, pf_j, pf_head, t, acc, acc_j):
-    """LTD for CF arrivals at time t on the PCs in col[:n_col]: every buffered PF arrival (t_pf, j)
-    adds ltd * k(t - t_pf) to w[j, i], clipped at lo_w. The kernel values are first summed per PF
-    (float64), so each touched weight is updated once (LTD terms are all <= 0, so clipping the sum
-    equals clipping after every term)."""
+def _ltd(plast, pl, w, n_post, n_col, t, buf):
+    """LTD of rule pl for CF arrivals at time t on the PCs in buf.col_buf[:n_col]: every buffered
+    PF arrival (t_pf, j) adds ltd * k(t - t_pf) to w[j, i] (w: the rule's [n_pre, n_post] block,
+    flat), clipped at w_lo. The kernel values are first summed per PF (float64), so each touched
+    weight is updated once (LTD terms are all <= 0, so clipping the sum equals clipping after every
+    term)."""
+    k_off, k_len = plast.pl_i[pl, 2], plast.pl_i[pl, 3]
+    kern = plast.kern[k_off : k_off + k_len]
+    pf_t, pf_j, pf_head = plast.pf_t[pl], plast.pf_j[pl], plast.pf_head[pl]
+    lo_w, ltd = np.float32(plast.pl_f[pl, 2]), plast.pl_f[pl, 1]
+    col, acc, acc_j = buf.col_buf, buf.acc, buf.acc_j
     cap = pf_t.shape[0]
     klen = kern.shape[0]
     h = pf_head
@@ -467,19 +583,28 @@ def _ltd(w, n_post, col, n_col, lo_w, ltd, kern, pf_t, pf_j, pf_head, t, acc, ac
 
 
 @njit(cache=True, nogil=True, fastmath=True, error_model="numpy", boundscheck=False)
-def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n_rest,
-             pop_i, pop_par, poly, ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w, de_i, dense_w,
-             pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, acc, acc_j, out_idx, out_t,
-             sp_c, c_k, c_q, c_l, pop_ep, scr_f, scr_i):
-    """Advance the network by one control step of ``n_sub`` substeps starting at substep t0.
+def run_step(t0, n_sub, inputs, learn, par, net):
+    """Advance the network (``net``: its :class:`KernelState`) by one control step of ``n_sub``
+    substeps starting at substep t0.
 
-    ``inputs`` are global indices of input fibres spiking at t0. Returns the number of spikes
-    written to out_idx/out_t (out_t = substep 1..n_sub at whose end the spike happened).
+    ``inputs`` are global indices of input fibres spiking at t0; ``learn``: plasticity on; ``par``:
+    numba threads for the large populations. Returns the number of spikes written to
+    out_idx/out_t (out_t = substep 1..n_sub at whose end the spike happened).
 
     Sparse projections onto a compact population deliver through a per-presynaptic-neuron cache of
     the targets' compact positions (``_build_runs``; sp_c[off + j] = (epoch, runs), valid while
     the epoch equals pop_ep of the target population, which every compaction increments).
     """
+    nrn, pops, dl, plast, buf = net.neurons, net.populations, net.delivery, net.plasticity, net.buffers
+    u, g, ref, flag, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.flag, nrn.cid, nrn.slot
+    n_act, n_rest, pop_ep = nrn.n_act, nrn.n_rest, nrn.pop_ep
+    pop_i, pop_par = pops.pop_i, pops.pop_par
+    ring_idx, ring_n = dl.ring_idx, dl.ring_n
+    sp_i, sp_ptr, sp_post, sp_w, sp_c = dl.sp_i, dl.sp_ptr, dl.sp_post, dl.sp_w, dl.sp_c
+    c_k, c_q, c_l, de_i, dense_w = dl.c_k, dl.c_q, dl.c_l, dl.de_i, dl.dense_w
+    pl_i, pl_f, pf_t, pf_j = plast.pl_i, plast.pl_f, plast.pf_t, plast.pf_j
+    pf_head, pf_lost = plast.pf_head, plast.pf_lost
+    col_buf, out_idx, out_t = buf.col_buf, buf.out_idx, buf.out_t
     R = ring_idx.shape[0]
     slot0 = t0 % R
     m = ring_n[slot0]
@@ -518,8 +643,7 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
                         cj = off + j
                         qa = sp_ptr[cj]
                         if sp_c[cj, 0] != pop_ep[pp]:
-                            sp_c[cj, 1] = _build_runs(qa, sp_ptr[cj + 1], sp_post, plo, pp, n_act, u, g, ref,
-                                                      cid, slot, c_k, c_q, c_l)
+                            sp_c[cj, 1] = _build_runs(qa, sp_ptr[cj + 1], plo, pp, nrn, dl)
                             sp_c[cj, 0] = pop_ep[pp]
                         gr = g[rec]
                         for r in range(qa, qa + sp_c[cj, 1]):
@@ -625,10 +749,7 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
                         n_col += 1
                 if n_col > 0:
                     w_off = de_i[d, 4]
-                    k_off, k_len = pl_i[pl, 2], pl_i[pl, 3]
-                    _ltd(dense_w[w_off : w_off + de_i[d, 1] * n_post], n_post, col_buf, n_col,
-                         np.float32(pl_f[pl, 2]), pl_f[pl, 1], kern[k_off : k_off + k_len],
-                         pf_t[pl], pf_j[pl], pf_head[pl], t, acc, acc_j)
+                    _ltd(plast, pl, dense_w[w_off : w_off + de_i[d, 1] * n_post], n_post, n_col, t, buf)
         # integrate the LIF populations whose step ends at t + 1; spikes are stamped t + 1
         nxt = (t + 1) % R
         ring_n[nxt] = 0
@@ -643,13 +764,10 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
             hi = lo + na
             pp = pop_par[pi]
             if kind == KIND_LIF_AMPA:
-                args = (u[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], poly[pi], np.float32(pp[P_DA]),
-                        pop_i[pi, I_NFINE] > 1, np.float32(pp[P_UFINE]),
-                        np.float32(pp[P_VTH] - pp[P_EL]), np.float32(pp[P_NREF]), pp[P_CLAMP] > 0.5)
                 if par > 1 and na >= PAR_MIN:
-                    cnt, nr = _lif_poly_par(*args, par)
+                    cnt, nr = _lif_poly_par(u[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], pops, pi, par)
                 else:
-                    cnt, nr = _lif_poly(*args)
+                    cnt, nr = _lif_poly(u[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], pops, pi)
                 n_rest[pi] = nr
             else:
                 cnt = _lif_full(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp)
@@ -660,27 +778,22 @@ def run_step(t0, n_sub, inputs, learn, par, u, g, ref, flag, cid, slot, n_act, n
     # they are integrated as exact no-ops)
     for pi in range(pop_i.shape[0]):
         if pop_i[pi, I_COMPACT] != 0 and n_rest[pi] > 0 and COMPACT_FRACTION * n_rest[pi] >= n_act[pi]:
-            n_act[pi] = _compact(pop_i[pi, I_LO], pop_i[pi, I_HI], u, g, ref, cid, slot, scr_f, scr_i)
+            n_act[pi] = _compact(pop_i[pi, I_LO], pop_i[pi, I_HI], nrn, buf)
             pop_ep[pi] += 1
             n_rest[pi] = 0
     return n_out
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def run_chunk(t0, n_sub, inputs, in_off, learn, par, u, g, ref, flag, cid, slot, n_act, n_rest,
-              pop_i, pop_par, poly, ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w, de_i, dense_w,
-              pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, acc, acc_j, out_idx, out_t,
-              sp_c, c_k, c_q, c_l, pop_ep, scr_f, scr_i, chunk_idx, chunk_off):
+def run_chunk(t0, n_sub, inputs, in_off, learn, par, net, chunk_idx, chunk_off):
     """``len(in_off) - 1`` consecutive :func:`run_step` calls in one GIL-free call (a pipelined
     chunk runs without touching Python). Inputs of step s are inputs[in_off[s]:in_off[s + 1]];
     its spikes (global indices) end up in chunk_idx[chunk_off[s]:chunk_off[s + 1]]."""
+    out_idx = net.buffers.out_idx
     total = 0
     chunk_off[0] = 0
     for s in range(in_off.shape[0] - 1):
-        n = run_step(t0 + s * n_sub, n_sub, inputs[in_off[s]:in_off[s + 1]], learn, par, u, g, ref, flag, cid,
-                     slot, n_act, n_rest, pop_i, pop_par, poly, ring_idx, ring_n, sp_i, sp_ptr, sp_post, sp_w,
-                     de_i, dense_w, pl_i, pl_f, kern, pf_t, pf_j, pf_head, pf_lost, col_buf, acc, acc_j,
-                     out_idx, out_t, sp_c, c_k, c_q, c_l, pop_ep, scr_f, scr_i)
+        n = run_step(t0 + s * n_sub, n_sub, inputs[in_off[s]:in_off[s + 1]], learn, par, net)
         for i in range(n):
             chunk_idx[total + i] = out_idx[i]
         total += n

@@ -39,7 +39,9 @@ class Network:
     runs on the calling thread. ``compact_min``: AMPA-only populations at least this large keep
     only their non-resting neurons in the integration loop (exact; see kernels).
     ``V``, ``g`` and ``ref`` are assembled from the kernel state on access (read-only views of
-    the state; use :meth:`load_arrays` to set it).
+    the state; use :meth:`load_arrays` to set it). ``arrays`` groups the same array objects for the
+    kernels (:class:`~cerebx.snn.kernels.NetworkArrays`, handed to them as one ``KernelState``):
+    write into an array, never replace one.
     """
 
     STATE_KEYS = ("V", "g", "ref", "ring_idx", "ring_n", "pf_t", "pf_j", "pf_head", "pf_lost", "dense_w")
@@ -49,7 +51,11 @@ class Network:
         t_start = time.perf_counter()
         self.cfg = cfg
         self.parallel = parallel
-        self.n_threads = numba.get_num_threads() if parallel else 1
+        # started even when serial: a cached run_chunk that was compiled in a process which took
+        # run_step from the cache does not start numba's parallel runtime itself, and crashes
+        # without it (numba issue 8578)
+        threads = numba.get_num_threads()
+        self.n_threads = threads if parallel else 1
         self.topo = topo = build_topology(cfg)
         self.n_sub = topo.n_sub
         self.fingerprint = cfg.fingerprint()
@@ -120,8 +126,25 @@ class Network:
         self.scr_i = np.zeros(n, dtype=np.int64)
         self.learn = True
         self.t_sub = 0
+        self.arrays = self._kernel_arrays()
+        self._state = kernels.kernel_state(self.arrays)
         self.reset_state()
         self.build_s = time.perf_counter() - t_start
+
+    def _kernel_arrays(self) -> kernels.NetworkArrays:
+        """The kernels' view of this network: the same array objects, grouped (state is only ever
+        written in place, so it stays valid for the network's life)."""
+        return kernels.NetworkArrays(
+            neurons=kernels.Neurons(self.u, self._g, self._ref, self.flag, self.cid, self.slot, self.n_act,
+                                    self.n_rest, self.pop_ep),
+            populations=kernels.Populations(self.pop_i, self.pop_par, self.poly),
+            delivery=kernels.Delivery(self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
+                                      self.sp_c, self.c_k, self.c_q, self.c_l, self.de_i, self.dense_w),
+            plasticity=kernels.Plasticity(self.pl_i, self.pl_f, self.kern, self.pf_t, self.pf_j, self.pf_head,
+                                          self.pf_lost),
+            buffers=kernels.Buffers(self.col_buf, self.acc, self.acc_j, self.out_idx, self.out_t, self.scr_f,
+                                    self.scr_i),
+        )
 
     # ------------------------------------------------------------------ state
     def _set_neurons(self, V: np.ndarray, g: np.ndarray, ref: np.ndarray) -> None:
@@ -241,15 +264,8 @@ class Network:
         if getattr(self, "_chunk_idx", None) is None or self._chunk_idx.shape[0] < cap:
             self._chunk_idx = np.zeros(cap, dtype=np.int32)
         off = np.zeros(n + 1, dtype=np.int64)
-        total = kernels.run_chunk(
-            self.t_sub, self.n_sub, flat, in_off, self.learn, self.n_threads, self.u, self._g, self._ref,
-            self.flag, self.cid, self.slot, self.n_act, self.n_rest, self.pop_i, self.pop_par, self.poly,
-            self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
-            self.de_i, self.dense_w, self.pl_i, self.pl_f, self.kern, self.pf_t, self.pf_j,
-            self.pf_head, self.pf_lost, self.col_buf, self.acc, self.acc_j, self.out_idx, self.out_t,
-            self.sp_c, self.c_k, self.c_q, self.c_l, self.pop_ep, self.scr_f, self.scr_i,
-            self._chunk_idx, off,
-        )
+        total = kernels.run_chunk(self.t_sub, self.n_sub, flat, in_off, self.learn, self.n_threads, self._state,
+                                  self._chunk_idx, off)
         self.t_sub += self.n_sub * n
         return self._chunk_idx[:total].copy(), off
 
@@ -257,13 +273,6 @@ class Network:
         """One 2 ms step; ``inputs`` are global indices of input fibres spiking at its start
         (each fibre at most once)."""
         inputs = np.ascontiguousarray(inputs, dtype=np.int32)
-        n = kernels.run_step(
-            self.t_sub, self.n_sub, inputs, self.learn, self.n_threads, self.u, self._g, self._ref,
-            self.flag, self.cid, self.slot, self.n_act, self.n_rest, self.pop_i, self.pop_par, self.poly,
-            self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
-            self.de_i, self.dense_w, self.pl_i, self.pl_f, self.kern, self.pf_t, self.pf_j,
-            self.pf_head, self.pf_lost, self.col_buf, self.acc, self.acc_j, self.out_idx, self.out_t,
-            self.sp_c, self.c_k, self.c_q, self.c_l, self.pop_ep, self.scr_f, self.scr_i,
-        )
+        n = kernels.run_step(self.t_sub, self.n_sub, inputs, self.learn, self.n_threads, self._state)
         self.t_sub += self.n_sub
         return StepSpikes(self.out_idx[:n], self.out_t[:n])

@@ -66,7 +66,8 @@ class Luque2011Stage(Stage):
         self._allocate()
 
     def _allocate(self) -> None:
-        """Fresh neuron, history and buffer state (the weights are kept)."""
+        """Fresh neuron, history and buffer state (the weights are kept), grouped for the kernel in
+        ``circuit``."""
         cfg = self.cfg
         self.v_in = np.zeros(self.n_in)
         self.v_pc, self.ge_pc, self.gi_pc = np.full(N_PC, cfg.pc.rest_mV), np.zeros(N_PC), np.zeros(N_PC)
@@ -84,6 +85,12 @@ class Luque2011Stage(Stage):
         self._sensed: Any = None
         self._no_eps = np.full(N_JOINTS, np.nan)
         self.tau = np.zeros(N_JOINTS)
+        self.circuit = k.circuit_state(k.Circuit(
+            pars=self.pars, clock=self.clock,
+            inputs=k.InputCells(self.v_in, self.drive, self.enc, self.hist, self.head),
+            pc=k.LIFCells(self.v_pc, self.ge_pc, self.gi_pc, self.r_pc, self.p_pc),
+            dcn=k.LIFCells(self.v_dcn, self.ge_dcn, self.gi_dcn, self.r_dcn, self.p_dcn),
+            w=self.w, kern=self.kern, io_spike=self.io_spike, counts=self.counts, gain=self.gain))
 
     def reset(self, rng: np.random.Generator) -> None:
         self._allocate()
@@ -110,9 +117,7 @@ class Luque2011Stage(Stage):
         if row == 0 or self.uniform.shape[0] == 0:  # IO random numbers, drawn 1024 ticks at a time
             self.uniform = self.rng.random((1024, N_IO))
         self.tau = np.empty(N_JOINTS)
-        k.tick(x, eps, self.uniform[row], self.enc, self.pars, self.v_in, self.v_pc, self.ge_pc, self.gi_pc, self.r_pc,
-               self.v_dcn, self.ge_dcn, self.gi_dcn, self.r_dcn, self.w, self.kern, self.hist, self.head, self.clock,
-               self.p_pc, self.p_dcn, self.counts, self.io_spike, self.drive, self.gain, self.tau)
+        k.tick(x, eps, self.uniform[row], self.circuit, self.tau)
         self.emit(frame, "joint.torque", self.tau)
 
     def end_trial(self, trial: int) -> dict[str, float]:
@@ -130,7 +135,7 @@ class Luque2011Stage(Stage):
         data, meta = load_state_npz(path, "luque2011 cerebellum")
         if meta.get("kind") != "luque2011_cerebellum" or data["w"].shape != self.w.shape:
             raise StateMismatchError(f"{path}: not a luque2011_cerebellum state of {N_PC} x {self.n_in} weights")
-        self.w = np.array(data["w"], float)
+        self.w[...] = data["w"]  # in place: ``circuit`` holds this array
 
     def describe(self) -> dict[str, Any]:
         return {"input_cells": self.n_in, "io": N_IO, "pc": N_PC, "dcn": N_DCN,

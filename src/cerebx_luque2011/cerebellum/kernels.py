@@ -13,11 +13,78 @@ reaches its targets' conductances in the next sub-step. Populations are laid out
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.experimental import structref
 
 PEAK_X = math.atan(20.0)  # e^-x sin(x)^20 peaks where tan x = 20
+
+
+class InputCells(NamedTuple):
+    """The RBF-driven input cells and their recent spikes (for LTD)."""
+
+    v: np.ndarray  # [n_in]: integrator state (spike at 1)
+    drive: np.ndarray  # [n_in]: this tick's drive (Eq. 2.A)
+    enc: np.ndarray  # [2, n_in]: RBF centre and 1 / 2 sigma^2 per cell
+    hist: np.ndarray  # int64 [n_in, depth]: each cell's recent spike sub-steps, a ring (-1 empty)
+    head: np.ndarray  # int64 [n_in]: next ring position per cell
+
+
+class LIFCells(NamedTuple):
+    """State and parameters of a conductance-LIF population (PC or DCN)."""
+
+    v: np.ndarray  # membrane potential (mV)
+    ge: np.ndarray  # excitatory conductance (nS)
+    gi: np.ndarray  # inhibitory conductance (nS)
+    refr: np.ndarray  # int64: refractory sub-steps left
+    par: np.ndarray  # (C pF, g_rest nS, E_rest, threshold, refractory steps, decay_exc, decay_inh, E_exc, E_inh)
+
+
+class Circuit(NamedTuple):
+    """Everything :func:`tick` reads and writes besides the step's own inputs and output (it gets
+    them as one :class:`CircuitState`)."""
+
+    pars: np.ndarray  # network constants, see :func:`tick`
+    clock: np.ndarray  # int64: sub-step index, tick index, IO spike count
+    inputs: InputCells
+    pc: LIFCells
+    dcn: LIFCells
+    w: np.ndarray  # [n_pc, n_in]: PF-PC weights (nS)
+    kern: np.ndarray  # LTD kernel by age in sub-steps
+    io_spike: np.ndarray  # bool [n_io]: IO cells that fired this tick
+    counts: np.ndarray  # int64 [ticks, n_dcn]: DCN spikes per buffered tick
+    gain: np.ndarray  # [n_joints]: torque per DCN rate difference (N m / Hz)
+
+
+@structref.register
+class _CircuitStateType(types.StructRef):
+    """numba type of :class:`CircuitState`."""
+
+
+class CircuitState(structref.StructRefProxy):
+    """A :class:`Circuit` as one numba object, the form :func:`tick` takes (make it with
+    :func:`circuit_state`): numba passes it as one pointer, where separate arrays or named tuples of
+    them are checked and unboxed one by one on every tick. Pickles as its circuit."""
+
+    def __reduce__(self):
+        return circuit_state, (self.circuit,)
+
+
+structref.define_proxy(CircuitState, _CircuitStateType, Circuit._fields)
+
+
+@njit(cache=True)
+def _pack(circuit):
+    return CircuitState(*circuit)
+
+
+def circuit_state(circuit: Circuit) -> CircuitState:
+    """The kernel's handle on ``circuit`` (the same array objects)."""
+    state = _pack(circuit)
+    state.circuit = circuit
+    return state
 
 
 def ltd_kernel(age_ms: np.ndarray, peak_ms: float) -> np.ndarray:
@@ -48,9 +115,9 @@ def io_probability(eps: np.ndarray, full_scale: float, rate_max_hz: float, dt_s:
 
 
 @njit(cache=True, fastmath=False)
-def _lif(v, ge, gi, refr, p, dt):
-    """One sub-step of conductance LIF cells; returns the indices that spiked. p = (C pF, g_rest nS,
-    E_rest, threshold, refractory steps, decay_exc, decay_inh, E_exc, E_inh)."""
+def _lif(cells, dt):
+    """One sub-step of conductance LIF cells (:class:`LIFCells`); returns the indices that spiked."""
+    v, ge, gi, refr, p = cells.v, cells.ge, cells.gi, cells.refr, cells.par
     n = v.shape[0]
     spiked = np.empty(n, np.int64)
     ns = 0
@@ -114,26 +181,28 @@ def _depress(w, io_spike, ltd, kern, hist, now):
 
 
 @njit(cache=True)
-def tick(x, eps, u, enc, pars, v_in, v_pc, ge_pc, gi_pc, r_pc, v_dcn, ge_dcn, gi_dcn, r_dcn, w, kern, hist, head,
-         clock, p_pc, p_dcn, counts, io_spike, drive, gain, torque):
-    """Advance one 2 ms control step and write the corrective ``torque``.
+def tick(x, eps, uniform, circuit, torque):
+    """Advance ``circuit`` (a :class:`CircuitState`) one 2 ms control step and write the corrective
+    ``torque``.
 
     ``x``: desired (q1..q3, qd1..qd3); ``eps``: teaching error per joint (NaN: no measurement arrived);
-    ``u``: a uniform number per IO cell; ``enc`` = (centres, 1 / 2 sigma^2) per input cell; ``pars`` = (n_sub,
-    dt_ms, input decay, drive at centre, n_per, w_max, ltp, ltd, learn, w_dcn, w_inh, eps full scale,
-    IO p_max per step); ``clock`` = [sub-step index, tick index, IO spike count]; ``hist``/``head``: each
-    input cell's recent spike sub-steps as a ring (-1 empty); ``counts``: DCN spikes per buffered tick."""
+    ``uniform``: a uniform number per IO cell; ``circuit.pars`` = (n_sub, dt_ms, input decay, drive at centre, n_per,
+    w_max, ltp, ltd, learn, w_dcn, w_inh, eps full scale, IO p_max per step)."""
+    pars, clock, w, io_spike, counts = circuit.pars, circuit.clock, circuit.w, circuit.io_spike, circuit.counts
+    cells = circuit.inputs
+    v_in, drive, hist, head = cells.v, cells.drive, cells.hist, cells.head
+    ge_pc, ge_dcn, gi_dcn = circuit.pc.ge, circuit.dcn.ge, circuit.dcn.gi
     n_sub, dt, in_decay, scale, n_per = int(pars[0]), pars[1], pars[2], pars[3], int(pars[4])
     w_max, ltp, ltd, learn, w_dcn, w_inh = pars[5], pars[6], pars[7], pars[8] > 0.0, pars[9], pars[10]
-    n_in, n_pc, depth = v_in.shape[0], v_pc.shape[0], hist.shape[1]
+    n_in, n_pc, depth = v_in.shape[0], ge_pc.shape[0], hist.shape[1]
     now = clock[0]
-    _encode(x, enc[0], enc[1], n_per, scale, drive)
+    _encode(x, cells.enc[0], cells.enc[1], n_per, scale, drive)
     if not math.isnan(eps[0]):
-        if _olive(eps, u, pars[11], pars[12], n_pc // 6, io_spike):
+        if _olive(eps, uniform, pars[11], pars[12], n_pc // 6, io_spike):
             for i in range(n_pc):
                 clock[2] += io_spike[i]
             if learn and ltd > 0.0:
-                _depress(w, io_spike, ltd, kern, hist, now)
+                _depress(w, io_spike, ltd, circuit.kern, hist, now)
     slot = counts[clock[1] % counts.shape[0]]
     slot[:] = 0
     for _ in range(n_sub):
@@ -151,15 +220,15 @@ def tick(x, eps, u, enc, pars, v_in, v_pc, ge_pc, gi_pc, r_pc, v_dcn, ge_dcn, gi
                         w[i, j] = y if y < w_max else w_max
                 for k in range(ge_dcn.shape[0]):
                     ge_dcn[k] += w_dcn
-        for i in _lif(v_pc, ge_pc, gi_pc, r_pc, p_pc, dt):
+        for i in _lif(circuit.pc, dt):
             gi_dcn[i // 2] += w_inh
-        for k in _lif(v_dcn, ge_dcn, gi_dcn, r_dcn, p_dcn, dt):
+        for k in _lif(circuit.dcn, dt):
             slot[k] += 1
         now += 1
     clock[0] = now
     clock[1] += 1
     # buffered DCN rate per cell (Hz), + group minus - group, per joint
-    n_dcn = v_dcn.shape[0]
+    n_dcn = ge_dcn.shape[0]
     per = n_dcn // 6
     window_s = counts.shape[0] * n_sub * dt / 1000.0
     for j in range(torque.shape[0]):
@@ -169,4 +238,4 @@ def tick(x, eps, u, enc, pars, v_in, v_pc, ge_pc, gi_pc, r_pc, v_dcn, ge_dcn, gi
             for k in range(per):
                 pos += counts[b, 2 * j * per + k]
                 neg += counts[b, (2 * j + 1) * per + k]
-        torque[j] = gain[j] * (pos - neg) / (per * window_s)
+        torque[j] = circuit.gain[j] * (pos - neg) / (per * window_s)
