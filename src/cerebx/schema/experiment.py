@@ -11,6 +11,7 @@ from cerebx import registry
 from cerebx.errors import ConfigError
 from cerebx.registry import Plugin
 from cerebx.schema.base import CONTROL_DT_MS, NonNegFloat, Strict
+from cerebx.schema.live import LiveConfig
 from cerebx.schema.network import NetworkConfig
 
 
@@ -44,6 +45,9 @@ class RecordingConfig(Strict):
     checkpoint_every: int = Field(
         10, ge=0, description="trials between checkpoints of the whole loop (resume=RUN_DIR continues from the "
         "last one; a completed run deletes it); 0: none")
+    scene_every: int | None = Field(
+        None, ge=0, description="control steps between frames of the plant's 3-D scene in run.mcap (/scene/*); "
+        "null: every 10 steps when live.enabled, else none; 0: none")
 
 
 def _union(reg: registry.Registry) -> Any:
@@ -95,6 +99,7 @@ class _ExperimentBase(Strict):
     control_dt_ms: Literal[2.0] = CONTROL_DT_MS
     network: NetworkConfig
     recording: RecordingConfig = RecordingConfig()
+    live: LiveConfig = LiveConfig()
     events: list[ScheduledEvent] = Field(default_factory=list)
     brain: list[Plugin("stage")] = Field(
         default_factory=list, description="brain-side stages after the controller, in order (before the link)")
