@@ -1,6 +1,6 @@
 """What the live view costs a run: the same run with live off, with live on and no client, and with live on
-and one client subscribed to every channel (tests/live_client.py), alternated so that a change in the
-machine's load falls on both. Prints one JSON line per run and a summary.
+and one client subscribed to every channel (tests/live_client.py), in rounds so that a change in the
+machine's load falls on all three. Prints one JSON line per run and a summary.
 
     .venv/bin/python scripts/live_overhead.py --repeats 3 -- +task=circle trials=20
 """
@@ -56,11 +56,11 @@ def run(overrides: list[str], mode: str, out: Path) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeats", type=int, default=2, help="off/live pairs")
-    ap.add_argument("--no-client", action="store_true", help="skip the run with a client")
+    ap.add_argument("--repeats", type=int, default=2, help="rounds of off / live / live with a client")
+    ap.add_argument("--no-client", action="store_true", help="skip the runs with a client")
     ap.add_argument("overrides", nargs="*", default=["+task=circle", "trials=20"])
     a = ap.parse_args()
-    modes = [m for _ in range(a.repeats) for m in ("off", "live")] + ([] if a.no_client else ["client"])
+    modes = [m for _ in range(a.repeats) for m in ("off", "live", "client") if m != "client" or not a.no_client]
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for i, mode in enumerate(modes):
@@ -70,6 +70,7 @@ def main() -> None:
         by = {m: [r[key] for r in rows if r["mode"] == m] for m in ("off", "live", "client")}
         off = statistics.mean(by["off"])
         print(json.dumps({key: {m: {"runs": v, "mean": round(statistics.mean(v), 2),
+                                    "median": round(statistics.median(v), 2),
                                     "vs_off_percent": round(100 * (statistics.mean(v) / off - 1), 2)}
                                 for m, v in by.items() if v}}))
 

@@ -287,10 +287,13 @@ class SceneWriter:
 
     # ---- messages -----------------------------------------------------------------------------
     def transforms(self, ns: int) -> dict:
-        d, ts = self.data, stamp(ns)
-        return {"transforms": [{"timestamp": ts, "parent_frame_id": WORLD, "child_frame_id": name,
-                                "translation": _v3(d.xpos[b]), "rotation": _quat(d.xquat[b])}
-                               for name, b in self._bodies]}
+        ts, pos, quat = stamp(ns), self.data.xpos.tolist(), self.data.xquat.tolist()
+        out = []
+        for name, b in self._bodies:
+            (x, y, z), (qw, qx, qy, qz) = pos[b], quat[b]
+            out.append({"timestamp": ts, "parent_frame_id": WORLD, "child_frame_id": name,
+                        "translation": {"x": x, "y": y, "z": z}, "rotation": {"x": qx, "y": qy, "z": qz, "w": qw}})
+        return {"transforms": out}
 
     def markers(self, ns: int, ee: np.ndarray | None, ee_des: np.ndarray | None) -> dict:
         size = _v3([0.03] * 3)
