@@ -125,6 +125,23 @@ def test_a_client_that_stops_reading_loses_messages_and_never_blocks():
     assert grown_mb < 60, f"memory grew by {grown_mb:.0f} MB for a stalled client"
 
 
+def test_signal_hz_thins_what_the_viewer_gets_only():
+    view = live.LiveView(LiveConfig(enabled=True, port=0, signal_hz=20))
+    try:
+        sent = []
+        ch = view.twin("/control", "cerebx.Control")
+        ch.channel = type("Sink", (), {"log": lambda self, data, log_time: sent.append(log_time)})()
+        t0 = time.perf_counter()
+        n = 0
+        while time.perf_counter() - t0 < 0.5:
+            ch.log(b"{}", log_time=n)
+            n += 1
+        assert view.twin(scene.TRANSFORMS, "foxglove.FrameTransforms") is None
+    finally:
+        view.stop()
+    assert n > 1000 and 8 <= len(sent) <= 12 and sent[0] == 0
+
+
 def test_live_view_binds_to_localhost_by_default():
     assert LiveConfig().host == "127.0.0.1" and not LiveConfig().enabled
 

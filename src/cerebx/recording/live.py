@@ -15,6 +15,7 @@ has no authentication, so an address reachable from elsewhere lets anyone there 
 from __future__ import annotations
 
 import logging
+import time
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +32,21 @@ LAYOUT = Path(__file__).with_name("foxglove_layout.json")
 """The Foxglove layout shipped with cerebx (3-D scene, joints, MAE, spike raster, log)."""
 
 
+class _Paced:
+    """A live channel that passes at most one message per ``period_s`` of wall-clock time."""
+
+    __slots__ = ("channel", "period_s", "next_s")
+
+    def __init__(self, channel: foxglove.Channel, period_s: float):
+        self.channel, self.period_s, self.next_s = channel, period_s, 0.0
+
+    def log(self, data: bytes, log_time: int) -> None:
+        now = time.perf_counter()
+        if now >= self.next_s:
+            self.next_s = now + self.period_s
+            self.channel.log(data, log_time=log_time)
+
+
 class LiveView:
     """A Foxglove WebSocket server for one run, in a context of its own."""
 
@@ -40,6 +56,7 @@ class LiveView:
             name="cerebx", host=cfg.host, port=cfg.port, context=self.ctx, capabilities=[Capability.Time],
             message_backlog_size=cfg.backlog_messages)
         self.host, self.port, self.display_hz = cfg.host, self.server.port, cfg.display_hz
+        self.signal_period_s = 1.0 / cfg.signal_hz if cfg.signal_hz > 0 else 0.0
         self._channels: dict[str, foxglove.Channel] = {}
 
     @property
@@ -53,10 +70,13 @@ class LiveView:
             self._channels[topic] = ch
         return ch
 
-    def twin(self, topic: str, schema: str) -> foxglove.Channel | None:
-        """The live channel a recorder channel is also logged to (None for the scene's, sent by the scene
-        writer at the display rate)."""
-        return None if topic.startswith(PREFIX) else self.channel(topic, schema)
+    def twin(self, topic: str, schema: str) -> foxglove.Channel | _Paced | None:
+        """The live channel a recorder channel is also logged to, paced by ``live.signal_hz`` (None for the
+        scene's, sent by the scene writer at the display rate)."""
+        if topic.startswith(PREFIX):
+            return None
+        ch = self.channel(topic, schema)
+        return _Paced(ch, self.signal_period_s) if self.signal_period_s > 0 else ch
 
     def log(self, topic: str, schema: str, t_s: float, msg: dict) -> None:
         self.channel(topic, schema).log(orjson.dumps(msg, option=orjson.OPT_SERIALIZE_NUMPY),

@@ -102,7 +102,7 @@ class _Both:
 
     __slots__ = ("file", "live")
 
-    def __init__(self, file: foxglove.Channel, live: foxglove.Channel):
+    def __init__(self, file: foxglove.Channel, live: Any):
         self.file, self.live = file, live
 
     def log(self, data: bytes, log_time: int) -> None:

@@ -19,5 +19,8 @@ class LiveConfig(Strict):
     display_hz: float = Field(
         30.0, gt=0, le=500, description="at most this many 3-D scene frames per wall-clock second go to the viewer "
         "(the recorded scene has its own rate, recording.scene_every)")
+    signal_hz: float = Field(
+        0.0, ge=0, description="at most this many messages per wall-clock second per recorded channel go to the "
+        "viewer (the file keeps them all); 0: every message. Thins a fast run's stream (spike rasters too)")
     backlog_messages: int = Field(
         1024, ge=16, description="messages queued per client; a client that falls further behind loses the oldest")
