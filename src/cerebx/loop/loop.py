@@ -16,7 +16,8 @@ robot                 the receiver turns what arrived into this tick's command; 
                       order (supervisor, muscles, ...) read it and the plant's readings
 actuate               the plant takes its command signals (saturated)
 measure               true state, end-effector and command into the trial's metrics
-record                one ``/control`` and two joint-state messages (every ``decimation`` ticks)
+record                one ``/control`` and two joint-state messages (every ``decimation`` ticks);
+                      the 3-D scene when one is recorded or served (``scene``)
 physics               the plant advances one control step
 ====================  ========================================================================
 """
@@ -64,6 +65,7 @@ class ClosedLoop:
         self._task_rng = ctx.rng("task")
         self._events = sorted([(e, f) for e, f in ctx.events if e.at_s is not None], key=lambda ef: ef[0].at_s)
         self._trial_events = [(e, f) for e, f in ctx.events if e.at_trial is not None]
+        self.scene: Any = None  # a recording.scene.SceneWriter, set by the runner when the scene is wanted
 
     def start(self) -> None:
         q0 = self.task.first_sample() if self.cfg.start_at == "path" else self.task.start_position()
@@ -83,6 +85,8 @@ class ClosedLoop:
         if self.rec is not None:
             params = action.model_dump(exclude={"kind"})
             self.rec.write("/events", "cerebx.PlantEvent", t_s, {"t": t_s, "kind": action.kind, "params": params})
+            if self.scene is not None:
+                self.scene.note(t_s, f"event {action.kind} {params}")
 
     def step(self, q_des: np.ndarray, qd_des: np.ndarray, acc: TrialAccumulator | None = None, trial: int = 0,
              ee_des: np.ndarray | None = None, extra: dict[str, np.ndarray] | None = None) -> np.ndarray:
@@ -143,6 +147,8 @@ class ClosedLoop:
             if ee_des is not None:
                 msg["ee_des"] = ee_des
             rec.write("/control", "cerebx.Control", t, msg)
+        if self.scene is not None:
+            self.scene.step(tick, t, ee, ee_des)
         # physics
         plant.step()
         self.tick += 1
@@ -162,6 +168,8 @@ class ClosedLoop:
         if rec is not None and trial == 0 and ref.xyz is not None:
             rec.write("/task/cartesian_path", "cerebx.CartesianPath", 0.0,
                       {"x": ref.xyz[:, 0].copy(), "y": ref.xyz[:, 1].copy(), "z": ref.xyz[:, 2].copy()})
+        if self.scene is not None:
+            self.scene.start_trial(self.tick * self.dt_s, trial, ref.xyz)
         xyz = ref.xyz
         extra = [(f"ref.{name}", v) for name, v in ref.extra.items()]
         for i in range(ref.steps):
@@ -181,6 +189,8 @@ class ClosedLoop:
                       {**m.__dict__, "label": ref.label})
             if extra:
                 rec.write("/weights", "cerebx.WeightSummary", self.tick * self.dt_s, {"trial": trial, **extra})
+        if self.scene is not None:
+            self.scene.end_trial(self.tick * self.dt_s, m)
         return m
 
     @property

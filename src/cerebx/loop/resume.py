@@ -44,7 +44,7 @@ _LOOP_FIELDS = ("tick", "trials_done", "metrics", "_sensed", "_task_rng", "_even
 _RECORDER = "recorder"  # persistent id of the run's recorder inside the pickle
 
 
-NOT_SHARED = frozenset({"resume", "trials", "recording"})  # what a continued or reused run may differ in
+NOT_SHARED = frozenset({"resume", "trials", "recording", "live"})  # what a continued or reused run may differ in
 
 
 def same_config(cfg: Any) -> dict:

@@ -20,7 +20,9 @@ from cerebx.build import build_components
 from cerebx.errors import CerebxError, Diverged
 from cerebx.loop import resume
 from cerebx.loop.loop import ClosedLoop
+from cerebx.recording import live as live_view
 from cerebx.recording.recorder import Recorder
+from cerebx.recording.scene import scene_writer
 from cerebx.recording.sentinel import Sentinel
 from cerebx.recording.summary import new_summary, trial_fields, write_summary
 
@@ -62,8 +64,9 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
                           presets=dict(choices or {}))
     write_summary(run_dir, summary)
     sentinel = Sentinel(run_dir)  # finishes the log and summary.json if this process is hard-killed
+    live = live_view.start(cfg)
     rec = Recorder(resume.recorder_path(cfg, run_dir), chunk_size_kb=cfg.recording.chunk_size_kb,
-                   compression=cfg.recording.compression)
+                   compression=cfg.recording.compression, live=live)
     rec.metadata("cerebx", {"version": __version__, "overrides": json.dumps(list(overrides or []))})
     rec.metadata("config", {"json": json.dumps(resolved if resolved is not None else cfg.model_dump(mode="json"))})
     loop: ClosedLoop | None = None
@@ -83,6 +86,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             if loop is None:
                 loop = ClosedLoop(ctx, rec)
                 loop.start()
+            loop.scene = scene_writer(cfg, ctx.plant, rec, live)
             summary["controller_info"] = ctx.brain[0].describe()
             bar = _progress(cfg, cfg.trials)
             if bar is not None:
@@ -128,6 +132,8 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             rec.metadata("summary", {"json": json.dumps(summary)})
         finally:
             rec.close()
+            if live is not None:
+                live.stop()
             write_summary(run_dir, summary)
             sentinel.done()
             if summary["status"] == "completed":

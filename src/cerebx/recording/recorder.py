@@ -21,6 +21,10 @@ topic                      schema                 content
 /task/cartesian_path       cerebx.CartesianPath   desired Cartesian path of the first trial
 =========================  =====================  ===============================================
 
+With ``recording.scene_every`` or ``live.enabled`` the plant's 3-D scene is recorded too (``/scene/*``,
+``/log``: see ``recording/scene.py``). With a live view (``recording/live.py``) every channel is also
+logged to its server.
+
 Metadata records ``config`` (the resolved config as JSON) and ``cerebx`` (version, overrides).
 The file is finished in ``close`` (called from ``finally``), so an exception or Ctrl-C still
 leaves a valid file.
@@ -82,27 +86,52 @@ def _ns(t_s: float) -> int:
     return int(round(t_s * 1e9))
 
 
+def register_schema(name: str, schema: dict) -> None:
+    """Make a JSON Schema available to channels (a module with messages of its own calls this at import);
+    a name already registered with another schema is refused."""
+    if SCHEMAS.setdefault(name, schema) != schema:
+        raise ValueError(f"schema {name!r} is already registered with another definition")
+
+
+def channel_schema(name: str) -> foxglove.Schema:
+    return foxglove.Schema(name=name, encoding="jsonschema", data=json.dumps(SCHEMAS[name]).encode())
+
+
+class _Both:
+    """A topic logged into the MCAP file and to a live view."""
+
+    __slots__ = ("file", "live")
+
+    def __init__(self, file: foxglove.Channel, live: Any):
+        self.file, self.live = file, live
+
+    def log(self, data: bytes, log_time: int) -> None:
+        self.file.log(data, log_time=log_time)
+        self.live.log(data, log_time=log_time)
+
+
 class Recorder:
     """Owns the MCAP writer for one run. Channels are created lazily on first use."""
 
     def __init__(self, path: Path, joint_names: tuple[str, ...] = (), chunk_size_kb: int = 256,
-                 compression: str = "zstd"):
+                 compression: str = "zstd", live: Any = None):
         self.path = Path(path)
         self._ctx = foxglove.Context()  # one context per recording: nothing leaks between runs
         opts = MCAPWriteOptions(compression=_COMPRESSION[compression], chunk_size=chunk_size_kb * 1024,
                                 compression_threads=0, profile="")
         self._w = foxglove.open_mcap(self.path, allow_overwrite=True, context=self._ctx, writer_options=opts)
-        self._channels: dict[str, foxglove.Channel] = {}
+        self._channels: dict[str, foxglove.Channel | _Both] = {}
         self.joint_names = tuple(joint_names)
+        self.live = live  # a LiveView (recording/live.py) whose server also gets every channel, or None
         self.closed = False
 
-    def _channel(self, topic: str, schema: str) -> foxglove.Channel:
+    def _channel(self, topic: str, schema: str) -> foxglove.Channel | _Both:
         ch = self._channels.get(topic)
         if ch is None:
-            ch = foxglove.Channel(
-                topic, message_encoding="json", context=self._ctx,
-                schema=foxglove.Schema(name=schema, encoding="jsonschema", data=json.dumps(SCHEMAS[schema]).encode()),
-            )
+            ch = foxglove.Channel(topic, message_encoding="json", context=self._ctx, schema=channel_schema(schema))
+            twin = self.live.twin(topic, schema) if self.live is not None else None
+            if twin is not None:
+                ch = _Both(ch, twin)
             self._channels[topic] = ch
         return ch
 

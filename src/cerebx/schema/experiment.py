@@ -13,6 +13,7 @@ from cerebx.errors import ConfigError
 from cerebx.registry import Plugin
 from cerebx.schema.base import CONTROL_DT_MS, NonNegFloat, Strict
 from cerebx.schema.init_state import init_from_problems
+from cerebx.schema.live import LiveConfig
 from cerebx.wiring import BODY_SLOTS, wire
 
 
@@ -46,6 +47,9 @@ class RecordingConfig(Strict):
     checkpoint_every: int = Field(
         10, ge=0, description="trials between checkpoints of the whole loop (resume=RUN_DIR continues from the "
         "last one; a completed run deletes it); 0: none")
+    scene_every: int | None = Field(
+        None, ge=0, description="control steps between frames of the plant's 3-D scene in run.mcap (/scene/*); "
+        "null: every 10 steps when live.enabled, else none; 0: none")
 
 
 def _union(reg: registry.Registry) -> Any:
@@ -83,6 +87,7 @@ class _ExperimentBase(Strict):
     trials: int = Field(10, ge=1, le=MAX_TRIALS, description="trials to run (at most 100,000: 55 h of a 2 s task)")
     control_dt_ms: Literal[2.0] = CONTROL_DT_MS
     recording: RecordingConfig = RecordingConfig()
+    live: LiveConfig = LiveConfig()
     events: list[ScheduledEvent] = Field(default_factory=list)
     brain: list[Plugin("stage")] = Field(
         default_factory=list, description="brain-side stages after the controller, in order (before the link)")
