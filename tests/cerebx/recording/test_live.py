@@ -19,6 +19,8 @@ from cerebx.recording import live, scene
 from cerebx.recording.reader import read_messages
 from cerebx.schema.live import LiveConfig
 
+pytestmark = pytest.mark.integration
+
 SIGNALS = {"/joint_states/desired", "/joint_states/actual", "/control", "/spikes/dcn"}
 SCENE = {scene.TRANSFORMS, scene.MARKERS}
 
