@@ -147,15 +147,23 @@ _loading: str | None = None
 _done = False
 
 
+def _load_order(ep: Any) -> tuple[bool, str]:
+    """``core`` first, then the plugins of each distribution (by distribution name) in the order its metadata
+    lists them (a stable sort keeps that order), so the order never depends on where packages are installed."""
+    dist = getattr(ep, "dist", None)
+    return ep.name != "core", (dist.name if dist is not None else "")
+
+
 def load_plugins() -> None:
-    """Call every ``cerebx.plugins`` entry point once (those named in ``CEREBX_PLUGINS`` when it is set)."""
+    """Call every ``cerebx.plugins`` entry point once (those named in ``CEREBX_PLUGINS`` when it is set), in
+    :func:`_load_order`."""
     global _done, _loading
     if _done:
         return
     _done = True
     only = os.environ.get(ONLY_ENV)
     wanted = None if only is None else {n.strip() for n in only.split(",") if n.strip()}
-    for ep in sorted(entry_points(group=ENTRY_POINTS), key=lambda e: (e.name != "core", e.name)):
+    for ep in sorted(entry_points(group=ENTRY_POINTS), key=_load_order):
         if wanted is not None and ep.name not in wanted:
             continue
         _loading = ep.name

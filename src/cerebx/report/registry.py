@@ -69,12 +69,15 @@ def load_reports() -> None:
 
 
 def all_figures() -> dict[str, FigureSpec]:
-    """Every registered figure, in the order of the numbers in their names."""
+    """Every registered figure, in :func:`figure_order`."""
     load_reports()
     return {k: FIGURES[k] for k in sorted(FIGURES, key=figure_order)}
 
 
 def figure_order(name: str) -> tuple:
-    """Sort key of a figure name: its numeric parts (``x3_4`` -> (3, 4), ``fig`` and ``table`` prefixes dropped)."""
+    """Sort key of a figure name: the numbers of its figure part (``x3_4`` -> (3, 4); ``fig`` and ``table``
+    prefixes dropped); a part that is not a number counts 0 (so a paper-prefixed ``name2011_fig7c`` reads as
+    (0, 0)); at equal numbers a name without any digit (a study that is no paper's figure) comes first, then
+    the registration order (plugins load in ``registry.load_plugins``'s order)."""
     parts = name.replace("fig", "").replace("table", "").split("_")
-    return tuple(int(p) if p.isdigit() else 0 for p in parts)
+    return tuple(int(p) if p.isdigit() else 0 for p in parts), any(c.isdigit() for c in name)
