@@ -51,7 +51,7 @@ def main(args: list[str]) -> int:
     run_app()
     if root is None:
         return 0
-    return cli.run_command("summarize", [str(root)])
+    return cli.run_command("summarize", [str(root), "--end-of-sweep"])
 
 
 def size_problems(estimates: list, args: list[str], multirun: bool) -> list[str]:

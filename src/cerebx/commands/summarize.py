@@ -1,5 +1,6 @@
-"""``cerebx summarize``: one table of a sweep's jobs (CSV, Markdown, and a plot over numeric swept keys);
-printed to standard error when a job failed. Its exit code is the number of failed jobs."""
+"""``cerebx summarize``: one table of a sweep's jobs (CSV, Markdown, and a plot over numeric swept keys). Its
+exit code is the number of failed jobs. ``--end-of-sweep`` (how ``cerebx run -m`` calls it) prints the table to
+standard error when a job failed."""
 
 from __future__ import annotations
 
@@ -10,8 +11,10 @@ from cerebx.report.sweep import report
 
 
 def main(args: list[str]) -> int:
-    if len(args) != 1:
+    end_of_sweep = "--end-of-sweep" in args
+    folders = [a for a in args if a != "--end-of-sweep"]
+    if len(folders) != 1:
         return fail(["summarize: give one sweep folder (the multirun dir holding 0/, 1/ …)"])
-    text, code = report(args[0])
-    print(text, file=sys.stderr if code else sys.stdout)
+    text, code = report(folders[0])
+    print(text, file=sys.stderr if code and end_of_sweep else sys.stdout)
     return code
