@@ -8,7 +8,7 @@ import numpy as np
 
 from cerebx.config import compose
 from cerebx.report.runs import Run, RunSet
-from cerebx_thesis.report.ch4 import PATHWAY_MS, fig4_5, learning_runs, perturbation_runs, trials_to
+from cerebx_thesis.report.upper_limb import PATHWAY_MS, fig4_5, learning_runs, perturbation_runs, trials_to
 
 
 def _run(tmp: Path, name: str, task: str, period: float, spinal: str, mae, vel, events=(), warmup=0,
