@@ -9,7 +9,7 @@ import pytest
 
 from cerebx.config import compose
 from cerebx.report.runs import Run, RunSet
-from cerebx_thesis.report.ch4 import PATHWAY_MS, fig4_5, learning_runs, perturbation_runs, trials_to
+from cerebx_thesis.report.upper_limb import PATHWAY_MS, fig4_5, learning_runs, perturbation_runs, trials_to
 
 pytestmark = pytest.mark.integration
 

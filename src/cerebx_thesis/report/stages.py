@@ -1,5 +1,6 @@
-"""Thesis Fig. 2.6 / 2.7: the learning process at an initial, intermediate and final stage, drawn
-from a run's MCAP (time-windowed reads through the file's index)."""
+"""The learning process at an initial, intermediate and final stage, shared by the learning-from-scratch
+and reaching figures: thesis Fig. 2.6 / 2.7 a-f and g, drawn from a run's MCAP (time-windowed reads
+through the file's index), and the stage windows of Tables 2.3 / 2.4 beside the run's."""
 
 from __future__ import annotations
 
@@ -14,13 +15,22 @@ import numpy as np  # noqa: E402
 from matplotlib.colors import PowerNorm  # noqa: E402
 
 from cerebx.recording.reader import read_messages  # noqa: E402
-from cerebx.report.plot import panel_letter, save  # noqa: E402
+from cerebx.report.plot import mean_std, panel_letter, save  # noqa: E402
+from cerebx.report.runs import Run  # noqa: E402
 
 # thesis stages for a 500-trial run: t1 = 18-20 s, t2 = 318-320 s, t3 = 998-1000 s
 STAGE_FRACTIONS = (0.02, 0.32, 1.0)
+# Tables 2.3 / 2.4: thesis run length, snn windows (start, stop, mean, std), factory position MAE as printed
+PAPER_STAGES: dict[str, tuple[int, list[tuple[int, int, float, float]], str]] = {
+    "circle": (500, [(0, 100, 0.115, 0.055), (100, 200, 0.036, 0.013), (400, 500, 0.019, 0.003)], "0.077 ± 0.0004"),
+    "eight": (500, [(0, 100, 0.111, 0.034), (100, 200, 0.046, 0.013), (400, 500, 0.017, 0.003)], "0.063 ± 0.0003"),
+    "reaching": (1000, [(0, 100, 0.155, 0.050), (300, 400, 0.043, 0.024), (900, 1000, 0.019, 0.006)],
+                 "0.026 ± 0.006"),
+}
 
 
 def stage_trials(n_trials: int) -> list[int]:
+    """The trials drawn as the three stages: the thesis's stage times as fractions of the run."""
     return sorted({max(0, min(n_trials - 1, int(round(f * n_trials)) - 1)) for f in STAGE_FRACTIONS})
 
 
@@ -109,6 +119,7 @@ def stages_figure(run_dir: Path, summary: dict, out: Path) -> Path:
 
 
 def _baseline_label(b: dict) -> str:
+    """A baseline's controller preset (else its controller kind), for the legend."""
     return (b.get("presets") or {}).get("controller", b["controller"])
 
 
@@ -147,3 +158,31 @@ def mae_per_joint_figure(summary: dict, baselines: list[dict], out: Path, labels
     panel_letter(ax, "g")
     fig.tight_layout()
     return save(fig, out)
+
+
+def scaled_windows(n: int, total: int, windows: list[tuple[int, int, float, float]]) -> list[tuple[int, int]]:
+    """The thesis trial windows, scaled by n / total for runs shorter than the thesis's (at least 1 trial)."""
+    f = min(1.0, n / total)
+    out = []
+    for a, b, _, _ in windows:
+        lo = min(int(round(a * f)), n - 1)
+        out.append((lo, max(lo + 1, int(round(b * f)))))
+    return out
+
+
+def stage_table(run: Run, task: str, base: list[tuple[str, Run]]) -> tuple[list[list[str]], list[tuple[int, int]]]:
+    """Rows of Table 2.3 / 2.4 for ``task`` beside ours, and the windows used."""
+    total, ref, factory = PAPER_STAGES[task]
+    wins = scaled_windows(run.trials, total, ref)
+    rows = [["quantity", "paper", "cerebx"]]
+    for (a, b, m, s), (lo, hi) in zip(ref, wins, strict=True):
+        ours = f"trials {lo}–{hi}" if hi - lo > 1 else f"trial {lo}"
+        used = "" if (lo, hi) == (a, b) else f" [cerebx: {ours} of {run.trials}]"
+        rows.append([f"SNN MAE (rad), trials {a}–{b}{used}", f"{m:.3f} ± {s:.3f}", mean_std(run.mae[lo:hi])])
+    for name, b in base:
+        paper = factory if name == "factory position" else "not in the thesis table"
+        nd = 4 if name == "factory position" else 3
+        rows.append([f"{name} MAE (rad), all trials [cerebx: {b.n_measured} trials]", paper, mean_std(b.mae, nd)])
+    if not any(name == "factory position" for name, _ in base):
+        rows.append(["factory position MAE (rad), all trials", factory, "not run"])
+    return rows, wins

@@ -9,7 +9,7 @@ from cerebx.config import compose_with_choices, to_plain
 from cerebx.loop.runner import run_experiment
 from cerebx.report.runs import Run
 from cerebx.schema.experiment import validate
-from cerebx_thesis.report.ch2 import interaction_metrics
+from cerebx_thesis.report.adaptation import interaction_metrics
 
 
 @pytest.fixture(scope="module")

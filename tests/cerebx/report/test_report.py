@@ -15,7 +15,9 @@ from cerebx.config import check
 from cerebx.errors import ConfigError
 from cerebx.report.build import main as report_main
 from cerebx.report.registry import all_figures
+from cerebx.report.runs import Run, RunSet
 from cerebx.report.studies import Job, execute, load_studies, plan
+from cerebx_thesis.report.plant_realism import realism_cells
 
 pytestmark = pytest.mark.integration
 
@@ -250,9 +252,6 @@ def test_init_from_a_study_with_the_same_sweep_pairs_jobs_by_sweep_value(tmp_pat
 
 
 def test_plant_realism_takes_the_study_runs_not_chapter_3_runs_on_the_same_plant(tmp_path):
-    from cerebx.report.runs import Run, RunSet
-    from cerebx_thesis.report.ch3 import realism_cells
-
     def run(name, preset, peaks, trials, mae):
         kern = {f"pf_pc{i}": {"plasticity": {"kind": "kernel_stdp", "kernel_peak_ms": p}} for i, p in enumerate(peaks)}
         cfg = {"delay": {"total_ms": 0.0}, "init_from": "learned", "events": [],

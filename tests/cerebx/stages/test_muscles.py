@@ -10,9 +10,11 @@ import pytest
 from cerebx.cli import main
 from cerebx.loop.runner import run_experiment
 from cerebx.recording.reader import read_messages
+from cerebx.report.runs import Run, RunSet
 from cerebx.schema.muscles import EkebergConfig
 from cerebx.signals import Frame
 from cerebx.stages.muscles import Ekeberg
+from cerebx_thesis.report.baxter_muscles import fig4_6, payload_sag_cm
 
 pytestmark = pytest.mark.integration
 
@@ -84,9 +86,6 @@ def test_arm_stays_at_rest_with_zero_commands_and_no_gravity(load, tmp_path):
 
 
 def test_payload_sags_less_with_more_cocontraction_and_fig4_6_shows_it(load, tmp_path):
-    from cerebx.report.runs import Run, RunSet
-    from cerebx_thesis.report.ch4_muscles import fig4_6, payload_sag_cm
-
     runs = RunSet()
     for k in (0, 12):
         cfg = load(["+experiment=fig4_6b", f"muscle.cocontraction={k}"])

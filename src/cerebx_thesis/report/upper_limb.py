@@ -38,6 +38,7 @@ FINAL_FRACTION = 0.1  # "after learning": the last 10 % of the trials
 
 
 def task_key(run: Run) -> str | None:
+    """The Fig. 4.5 task of a run (the vertical circle split by its period), None for another task."""
     if run.task == "flexion_extension":
         return "flexion_extension"
     if run.task == "vertical_circle":
@@ -46,10 +47,12 @@ def task_key(run: Run) -> str | None:
 
 
 def _upper_limb(run: Run) -> bool:
+    """An SNN run on the upper-limb plant with logged trials."""
     return run.get("plant.kind") == "upper_limb" and run.controller == "snn" and run.trials > 0
 
 
 def pathway_ms(run: Run) -> float:
+    """The run's sensorimotor pathway delay each way (ms)."""
     return float(run.get("controller.pathway_delay_ms", SNNController.model_fields["pathway_delay_ms"].default))
 
 
@@ -98,6 +101,7 @@ def perturbation_runs(runs: RunSet) -> dict[tuple[str, float | None], Run]:
 
 
 def final(run: Run, key: str) -> np.ndarray:
+    """The last FINAL_FRACTION of a per-trial series: the run's values after learning."""
     v = run.series(key)
     return v[-max(1, int(round(FINAL_FRACTION * v.size))):]
 
@@ -120,6 +124,7 @@ def deviation(run: Run, reference: Run | None) -> float:
         ("fig4_5_learn", "fig4_5_learn_fast_cord", "fig4_5_learn_fast_direct", "fig4_5_perturb_cord",
          "fig4_5_perturb_direct", "fig4_5_learn_d50"))
 def fig4_5(runs: RunSet, stem: Path) -> Figure:
+    """A: position and velocity MAE after learning; B: trials to 0.1 rad; D: deviation under pulses."""
     learn, pert = learning_runs(runs), perturbation_runs(runs)
     if not learn:
         raise MissingRuns(f"no upper-limb SNN learning runs with the {PATHWAY_MS:g} ms pathway (studies fig4_5_learn*)")

@@ -37,6 +37,7 @@ def _table_4_1(r: Run) -> bool:
 
 
 def _k(r: Run) -> float | None:
+    """The run's cocontraction multiplier, None if it has no muscle."""
     k = r.get("muscle.cocontraction")
     return None if k is None else float(k)
 
@@ -73,6 +74,7 @@ def _borrowed(runs: list[Run]) -> str:
 @figure("fig4_6", "Baxter with Ekeberg muscles: MAE and payload sag per cocontraction",
         studies=("fig4_6a", "fig4_6b"))
 def fig4_6(runs: RunSet, stem: Path) -> Figure:
+    """A: MAE per cocontraction from a learned state; B: payload sag per cocontraction at rest."""
     muscles = runs.where(lambda r: r.completed and _table_4_1(r))
     eight = muscles.where(lambda r: r.controller == "snn" and r.task == "eight")
     learned = eight.where(lambda r: r.learned_from is not None and not r.events and r.n_measured > 0).by(_k)

@@ -1,0 +1,239 @@
+"""Controllers under constant round-trip delays: thesis Fig. 3.4 (MAE and torque variability of PD, ANN and
+SNN per delay on the horizontal circle) and Fig. 3.5 (end-effector density of PD vs SNN and ANN vs SNN
+under a 50 ms delay on the three chapter 3 tasks)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.colors import to_rgb  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
+
+from cerebx.report.plot import fmt, mean_std, save  # noqa: E402
+from cerebx.report.registry import Figure, MissingRuns, figure  # noqa: E402
+from cerebx.report.runs import Run, RunSet  # noqa: E402
+from cerebx_thesis.report.common import (  # noqa: E402
+    CH3_TASKS,
+    HEADER,
+    TASK_NAMES,
+    THESIS_KERNEL_MS,
+    delay_sweep,
+    finish,
+    mean_and_std,
+    origin,
+    reference_run,
+    trial_counts,
+)
+
+CONTROLLERS = {"pd": ("PD", "C3"), "ann": ("ANN", "C1"), "snn": ("SNN", "C0")}
+# Chapter 3 text: factory-default position controller MAE without delay (rad)
+PAPER_FACTORY_CH3 = {"circle": "0.077", "inclined_circle": "0.055", "circle_eight": "0.068"}
+FIG3_5_DELAY_MS = 50.0
+FIG3_5_TRIALS = 16  # trials read per run for the densities (evenly spaced)
+
+
+@figure("fig3_4", "PD, ANN and SNN under constant round-trip delays", studies=("fig3_4_snn", "fig3_4_ann", "fig3_4_pd"))
+def fig3_4(runs: RunSet, stem: Path) -> Figure:
+    """A: MAE and B: torque variability per constant delay of each controller, and the thesis's numbers."""
+    picked = {c: delay_sweep(runs, c) for c in CONTROLLERS}
+    sweeps = {c: s for c, (s, _) in picked.items()}
+    if not any(sweeps.values()):
+        raise MissingRuns("no circle runs of pd, ann or snn under a constant delay (studies fig3_4_pd/ann/snn)")
+    notes = [f"no {CONTROLLERS[c][0]} circle runs under a constant delay (study fig3_4_{c})"
+             for c, s in sweeps.items() if not s] + [n for _, ns in picked.values() for n in ns]
+    fig, (ax_a, ax_b) = plt.subplots(1, 2, figsize=(12, 4.6))
+    for c, sweep in sweeps.items():
+        if not sweep:
+            continue
+        name, color = CONTROLLERS[c]
+        x = np.array(list(sweep))
+        mae = np.array([mean_and_std(r.mae) for r in sweep.values()])
+        tv = np.array([mean_and_std(r.series("torque_variability_per_trial")) for r in sweep.values()])
+        ax_a.errorbar(x, mae[:, 0], mae[:, 1], marker="o", capsize=3, color=color, label=name)
+        ax_b.errorbar(x, tv[:, 0], tv[:, 1], marker="o", capsize=3, color=color, label=name)
+    pos = reference_run(runs, "position")
+    if pos is not None:
+        ax_a.axhline(pos.mae.mean(), ls="--", color="0.4", lw=1.1, label="factory position, no delay")
+    ax_a.set_ylabel("position MAE (rad), mean ± std over trials")
+    ax_b.set_ylabel("torque variability (N·m/ms), mean ± std")
+    for ax in (ax_a, ax_b):
+        ax.set_xlabel("constant round-trip delay δT (ms)")
+    png = finish(fig, stem, {"A": ax_a, "B": ax_b})
+
+    table = [HEADER]
+    paper0 = {"pd": "0.076", "ann": "0.021 ± 0.002", "snn": "0.018 ± 0.004"}
+    paper_avg = {"pd": "0.099 ± 0.027 (0–50 ms)", "ann": "0.053 ± 0.026 (0–50 ms)", "snn": "0.024 ± 0.011 (0–80 ms)"}
+    paper_tv = {"pd": "0.019 → 0.036", "ann": "0.016 → 0.026", "snn": "0.012 regardless of δT"}
+    paper80 = {"snn": "figure only: plateau ≈ 0.02–0.03 rad", "pd": "not run (stopped at 50 ms, unstable > 20 ms)",
+               "ann": "not run (stopped at 50 ms, unstable > 10 ms)"}
+    paper_ratio = {"snn": "barely deviated", "pd": "degraded significantly", "ann": "degraded significantly"}
+    for c, sweep in sweeps.items():
+        if not sweep:
+            continue
+        name = CONTROLLERS[c][0]
+        m0 = sweep[min(sweep)].mae if min(sweep) == 0 else None
+        hi = max(sweep)
+        table.append([f"{name} MAE at δT = 0 ms (rad)", paper0[c], "–" if m0 is None else mean_std(m0)])
+        table.append([f"{name} MAE at δT = {hi:g} ms (rad)", paper80[c], mean_std(sweep[hi].mae)])
+        ratio = None if m0 is None else sweep[hi].mae.mean() / m0.mean()
+        table.append([f"{name} MAE ratio {hi:g} / 0 ms", paper_ratio[c], fmt(ratio, 2)])
+        lim = 80 if c == "snn" else 50
+        pooled = np.concatenate([r.mae for d, r in sweep.items() if d <= lim])
+        table.append([f"{name} average MAE over δT ≤ {lim} ms (rad)", paper_avg[c], mean_std(pooled)])
+        if c != "snn" and sweeps["snn"]:
+            snn = np.concatenate([r.mae for r in sweeps["snn"].values()]).mean()
+            table.append([f"{name} average MAE ÷ SNN average MAE", "3 to 4× larger", fmt(pooled.mean() / snn, 2)])
+        x = np.array(list(sweep))
+        tv = np.array([r.series("torque_variability_per_trial").mean() for r in sweep.values()])
+        tv50 = np.interp(50.0, x, tv) if x.min() <= 50 <= x.max() else None
+        at50 = "" if 50 in sweep else " (50 ms interpolated)"
+        table.append([f"{name} torque variability 0 → 50 ms (N·m/ms){at50}", paper_tv[c],
+                      f"{fmt(tv[0] if x[0] == 0 else None)} → {fmt(tv50)}"])
+    counts = "; ".join(f"{CONTROLLERS[c][0]}: δT = {', '.join(f'{d:g}' for d in s)} ms, {trial_counts(s.values())} "
+                       f"per δT, {origin(next(iter(s.values())))}" for c, s in sweeps.items() if s)
+    caption = ("Fig. 3.4 — controllers under constant round-trip delays δT (split evenly between R2C and C2R), "
+               "horizontal circle. (A) position MAE, mean ± std over each run's trials; (B) torque variability "
+               "(Eq. 3.15: mean |Δτ| per ms over joints), mean ± std over trials. "
+               f"Runs — {counts}. The thesis used 100 trials per δT and stopped PD and ANN at 50 ms; every δT "
+               "run is shown here. The dashed grey line is the factory position controller without delay "
+               "(where such a run exists).")
+    return Figure([png], caption, table, notes)
+
+
+def _sample_ee(run: Run, trials: int = FIG3_5_TRIALS) -> tuple[np.ndarray, np.ndarray, int]:
+    """ee and ee_des of up to ``trials`` evenly spaced trials (time-windowed reads), and how many."""
+    n, period, w = run.trials, run.period_s, min(run.warmup, max(run.trials - 1, 0))
+    picks = np.unique(np.linspace(w, n - 1, min(n - w, trials)).round().astype(int))
+    ee, des = [], []
+    for k in picks:
+        c = run.control(["ee", "ee_des"], k * period, (k + 1) * period, every=2)
+        if c["ee"].size:
+            ee.append(c["ee"])
+            des.append(c["ee_des"])
+    if not ee:
+        return np.zeros((0, 3)), np.zeros((0, 3)), 0
+    return np.concatenate(ee), np.concatenate(des), len(picks)
+
+
+def plane(des: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Origin, 2x3 projection and axis labels: x-y for a flat path, else its two principal axes."""
+    if not des.size:
+        return np.zeros(3), np.eye(3)[:2], ["x (m)", "y (m)"]
+    spread = np.ptp(des, axis=0)
+    if spread[2] <= 0.05 * max(spread[0], spread[1]):
+        return np.zeros(3), np.eye(3)[:2], ["x (m)", "y (m)"]
+    centre = des.mean(0)
+    axes = np.linalg.svd(des - centre, full_matrices=False)[2][:2]
+    for i in range(2):  # orient: first axis along +x, second along +y
+        if axes[i, i] < 0:
+            axes[i] *= -1
+    labels = [f"{u} (m) along ({a[0]:.2f}, {a[1]:.2f}, {a[2]:.2f})" for u, a in zip("uv", axes, strict=True)]
+    return centre, axes, labels
+
+
+def _limits(des2: np.ndarray, clouds: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Panel limits: the desired path with a 6 cm margin, widened to the 1-99 % range of the densities but at
+    most 35 cm from the path's centre."""
+    if not des2.size:
+        return np.full(2, -0.3), np.full(2, 0.3)
+    lo, hi = des2.min(0) - 0.06, des2.max(0) + 0.06
+    if clouds:
+        pts = np.concatenate(clouds)
+        lo, hi = np.minimum(lo, np.percentile(pts, 1, axis=0)), np.maximum(hi, np.percentile(pts, 99, axis=0))
+    mid = (des2.min(0) + des2.max(0)) / 2
+    return np.maximum(lo, mid - 0.35), np.minimum(hi, mid + 0.35)
+
+
+def _density_rgba(h: np.ndarray, color: str) -> np.ndarray:
+    """A 2-D histogram as an RGBA image of one colour, opacity rising with the square root of the count."""
+    img = np.zeros((*h.shape, 4))
+    img[..., :3] = to_rgb(color)
+    img[..., 3] = 0.85 * np.sqrt(h / h.max()) if h.max() > 0 else 0.0
+    return img
+
+
+@figure("fig3_5", "End-effector density under a 50 ms delay: PD vs SNN and ANN vs SNN (Fig. 3.5)",
+        studies=("fig3_5_snn_circle", "fig3_5_snn_inclined_circle", "fig3_5_snn_circle_eight", "fig3_5_ann_circle",
+                 "fig3_5_ann_inclined_circle", "fig3_5_ann_circle_eight", "fig3_5_pd_circle",
+                 "fig3_5_pd_inclined_circle", "fig3_5_pd_circle_eight", "fig3_5_position", "baselines_circle"))
+def fig3_5(runs: RunSet, stem: Path) -> Figure:
+    """PD vs SNN (A-C) and ANN vs SNN (D-F) end-effector densities per task under a 50 ms delay."""
+    delayed = runs.where(lambda r: r.delay == "constant" and r.delay_total_ms == FIG3_5_DELAY_MS and r.trials > 0
+                         and (r.controller != "snn" or r.kernel_peaks_ms == [THESIS_KERNEL_MS]))
+    slots = {(task, c): delayed.where(task=task, controller=c).best()
+             for task in CH3_TASKS for c in ("pd", "ann", "snn")}
+    if not any(slots.values()):
+        raise MissingRuns(f"no pd / ann / snn runs under a constant {FIG3_5_DELAY_MS:.0f} ms delay "
+                          "(studies fig3_5_*)")
+    refs = {task: runs.where(lambda r: r.is_factory_position and r.trials > 0, task=task, delay="none").best()
+            for task in CH3_TASKS}
+    data = {key: _sample_ee(r) for key, r in slots.items() if r is not None}
+    colors = {"pd": "C3", "ann": "C1", "snn": "C0"}
+    fig, axes = plt.subplots(2, 3, figsize=(15, 9.6))
+    notes: list[str] = []
+    table = [["quantity", "paper", "cerebx"]]
+    claims = {"snn": "figure only (SNN stays accurate)", "ann": "figure only (ANN degrades)",
+              "pd": "figure only (PD degrades)"}
+    for col, task in enumerate(CH3_TASKS):
+        des = next((data[(task, c)][1] for c in ("snn", "ann", "pd") if (task, c) in data), np.zeros((0, 3)))
+        ref = refs[task]
+        ref_ee = (ref.control(["ee"], (ref.trials - 1) * ref.period_s, ref.trials * ref.period_s)["ee"]
+                  if ref is not None else np.zeros((0, 3)))
+        if not des.size and ref_ee.size:
+            des = ref_ee
+        centre, proj, labels = plane(des)
+        pd_ = {key: (v[0] - centre) @ proj.T for key, v in data.items() if key[0] == task}
+        des2 = (des - centre) @ proj.T if des.size else np.zeros((0, 2))
+        lo, hi = _limits(des2, list(pd_.values()))
+        for row, other in enumerate(("pd", "ann")):
+            ax = axes[row, col]
+            handles = []
+            for c in (other, "snn"):
+                pts = pd_.get((task, c))
+                r = slots[(task, c)]
+                if pts is None or r is None:
+                    continue
+                h, xe, ye = np.histogram2d(pts[:, 0], pts[:, 1], bins=120, range=[[lo[0], hi[0]], [lo[1], hi[1]]])
+                ax.imshow(_density_rgba(h.T, colors[c]), origin="lower", extent=(xe[0], xe[-1], ye[0], ye[-1]),
+                          interpolation="nearest", aspect="equal")
+                handles.append(Patch(color=colors[c], label=f"{c.upper()} ({data[(task, c)][2]} trials)"))
+            if des2.size:
+                handles += ax.plot(des2[:, 0], des2[:, 1], "k--", lw=1, label="desired")
+            if ref_ee.size:
+                r2 = (ref_ee - centre) @ proj.T
+                handles += ax.plot(r2[:, 0], r2[:, 1], color="C2", lw=1.2, label="factory position, no delay")
+            ax.set_xlim(lo[0], hi[0])
+            ax.set_ylim(lo[1], hi[1])
+            ax.set_xlabel(labels[0], fontsize=8)
+            ax.set_ylabel(labels[1], fontsize=8)
+            ax.set_title(f"{'ABCDEF'[3 * row + col]}  {other.upper()} vs SNN, {TASK_NAMES[task]}", loc="left",
+                         fontweight="bold", fontsize=10)
+            if handles:
+                ax.legend(handles=handles, fontsize=7, loc="upper right")
+            else:
+                ax.text(0.5, 0.5, "no runs", transform=ax.transAxes, ha="center")
+        for c in ("pd", "ann", "snn"):
+            r = slots[(task, c)]
+            table.append([f"{TASK_NAMES[task]}, {c.upper()} at {FIG3_5_DELAY_MS:.0f} ms: MAE (rad)", claims[c],
+                          f"{mean_std(r.mae)} ({r.n_measured} trials)" if r is not None else "not run"])
+        missing = [c for c in ("pd", "ann", "snn") if slots[(task, c)] is None]
+        if missing:
+            notes.append(f"no {' / '.join(missing)} run on {task} at {FIG3_5_DELAY_MS:.0f} ms")
+        table.append([f"{TASK_NAMES[task]}, factory position, no delay: MAE (rad)", PAPER_FACTORY_CH3[task],
+                      f"{mean_std(ref.mae)} ({ref.n_measured} trials)" if ref is not None else "not run"])
+        if ref is None:
+            notes.append(f"no factory position run on {task} without delay: no reference path")
+    fig.suptitle(f"End-effector density under a constant {FIG3_5_DELAY_MS:.0f} ms round-trip delay", fontsize=11)
+    fig.tight_layout()
+    counts = sorted({f"{data[k][2]} of {slots[k].trials}" for k in data})
+    caption = (f"Thesis Fig. 3.5: end-effector density of PD vs SNN (A–C) and ANN vs SNN (D–F) under a constant "
+               f"{FIG3_5_DELAY_MS:.0f} ms round-trip delay (thesis: 100 trials per controller; here the density of "
+               f"{', '.join(counts)} trials, evenly spaced, every 2nd control step); dashed: desired path; green: "
+               "last trial of the factory position controller without delay. Circle and circle-Lissajous in the xy "
+               "plane, the inclined circle in the principal plane of its desired path.")
+    return Figure([save(fig, stem)], caption, table, notes)
