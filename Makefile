@@ -4,6 +4,7 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
+DOCS_STAMP := $(VENV)/.docs-stamp
 export NUMBA_CACHE_DIR ?= $(CURDIR)/.cache/numba
 export CEREBX_CACHE ?= $(CURDIR)/.cache/cerebx
 
@@ -15,7 +16,7 @@ BENCH_ARGS ?=
 PROFILE ?= quick
 REPORT_ARGS ?=
 
-.PHONY: help install run test test-unit test-slow test-full bench report lint format clean
+.PHONY: help install run test test-unit test-slow test-full bench report lint docs format clean
 
 help: ## list the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -25,6 +26,10 @@ $(STAMP): pyproject.toml
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet -e ".[test]"
 	touch $(STAMP)
+
+$(DOCS_STAMP): $(STAMP) pyproject.toml
+	$(BIN)/pip install --quiet -e ".[test,docs]"
+	touch $(DOCS_STAMP)
 
 install: $(STAMP) ## create .venv and install cerebx with its test tools
 
@@ -53,9 +58,12 @@ lint: $(STAMP) ## ruff, and the import contracts of pyproject.toml (the layering
 	$(BIN)/ruff check src tests
 	$(BIN)/lint-imports --no-cache
 
+docs: $(DOCS_STAMP) ## build the docs site into site/ (strict: a broken link or reference fails the build)
+	DISABLE_MKDOCS_2_WARNING=true $(BIN)/mkdocs build --strict --site-dir site
+
 format: $(STAMP) ## ruff format
 	$(BIN)/ruff format src tests
 
 clean: ## remove caches (keeps .venv and runs/)
-	rm -rf .cache .pytest_cache .ruff_cache build dist src/*.egg-info
+	rm -rf .cache .pytest_cache .ruff_cache build dist site src/*.egg-info
 	find . -name __pycache__ -type d -prune -not -path './.venv/*' -exec rm -rf {} +
