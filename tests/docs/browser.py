@@ -85,8 +85,10 @@ class Browser:
                 await asyncio.sleep(0.05)
             check = ("JSON.stringify([...document.images].map(i => ({src: i.getAttribute('src'), "
                      "ok: i.complete && i.naturalWidth > 0})))")
-            images = json.loads((await call("Runtime.evaluate", expression=check, returnByValue=True))["result"]["value"])
-            title = (await call("Runtime.evaluate", expression="document.title", returnByValue=True))["result"]["value"]
+            found = await call("Runtime.evaluate", expression=check, returnByValue=True)
+            images = json.loads(found["result"]["value"])
+            named = await call("Runtime.evaluate", expression="document.title", returnByValue=True)
+            title = named["result"]["value"]
             if screenshot is not None:
                 shot = await call("Page.captureScreenshot", format="png")
                 screenshot.write_bytes(base64.b64decode(shot["data"]))
