@@ -2,7 +2,8 @@
 
 Groups: ``task``, ``plant``, ``controller`` (brain-side parts), ``stage`` (brain- or robot-side
 stages: torque filters, the supervisor, muscles, ...), ``delay`` (link delay models), ``event``
-(plant events) and ``encoder`` (cerebellar input codes). Built-in variants register in
+(plant events), ``encoder`` (cerebellar input codes) and ``link`` (transports between the brain side
+and the robot side). Built-in variants register in
 ``schema/builtin.py``; third-party packages register through the ``cerebx.plugins`` entry-point
 group (each entry point is a callable taking no arguments that registers its variants).
 Configuration only ever names a ``kind``: it cannot import anything.
@@ -91,8 +92,9 @@ stages = Registry("stage")
 delays = Registry("delay")
 events = Registry("event")
 encoders = Registry("encoder")
+links = Registry("link")
 
-GROUPS = {r.group: r for r in (tasks, plants, controllers, stages, delays, events, encoders)}
+GROUPS = {r.group: r for r in (tasks, plants, controllers, stages, delays, events, encoders, links)}
 
 
 def Plugin(group: str) -> Any:  # noqa: N802 - reads as a type in schemas

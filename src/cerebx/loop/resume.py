@@ -217,7 +217,8 @@ def continued(exp: Any, plain: dict, output_dir: Path) -> tuple[Any, Path, dict 
 
 # Options added since runs were first recorded, with the value that does what runs without them did
 # (CHANGELOG: their recorded data did not change). A config that lacks one counts as having that value.
-ADDED_WITHOUT_EFFECT: dict[str, Any] = {"controller.output": "torque", "controller.decoder.spikes_full_scale": 100.0}
+ADDED_WITHOUT_EFFECT: dict[str, Any] = {"controller.output": "torque", "controller.decoder.spikes_full_scale": 100.0,
+                                        "link": {"kind": "sim"}, "clock": "sim"}
 
 
 def _with_added(config: dict) -> dict:

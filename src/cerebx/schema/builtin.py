@@ -50,6 +50,13 @@ registry.delays.register(d.GammaDelay, "cerebx.loop.delays:gamma_delay")
 registry.delays.register(d.TraceDelay, "cerebx.loop.delays:trace_delay")
 registry.delays.register(d.PercentileDelay, "cerebx.loop.delays:percentile_delay")
 
+# links: the tick-grid one of simulated time, and transports between processes; builders take (cfg, role, via_relay)
+from cerebx.link import schema as lk  # noqa: E402
+
+registry.links.register(lk.SimLink, "cerebx.link.transport:build_sim")
+registry.links.register(lk.ZenohLink, "cerebx.link.zenoh_link:ZenohTransport")
+registry.links.register(lk.UdpLink, "cerebx.link.udp:UdpTransport")
+
 # event builders take (cfg, plant) and return the function that fires the event
 registry.events.register(e.AttachPayload, "cerebx.plants.events:attach_payload")
 registry.events.register(e.DetachPayload, "cerebx.plants.events:detach_payload")
