@@ -7,6 +7,7 @@ line each and exit with code 2, before any run folder is created.
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import re
@@ -26,12 +27,18 @@ commands:
   report [RUN_DIR ...]                                 build reports/ from run logs
   summarize MULTIRUN_DIR                               one table of a sweep's jobs (CSV, Markdown, plot)
   tune [--out PATH] OVERRIDES...                       Ziegler-Nichols PD gains on the simulated plant
+  robot [--run-dir DIR] OVERRIDES...                   the robot side of a wall-clock run (link=zenoh|udp clock=wall)
+  relay [--out DIR] OVERRIDES...                       the delay relay on a real link's path
+  delays RUN_DIR [--out trace.csv] [--raw]             measured link delays: vs the model, as a delay=trace file
 
 groups: task (required, +task=), controller (snn), plant (baxter), delay (none),
         network (thesis_ch3), experiment (presets: +experiment=NAME)
 """
 
-COMMANDS = ("run", "validate", "inspect", "bench", "report", "tune", "summarize")
+COMMANDS = ("run", "validate", "inspect", "bench", "report", "tune", "summarize", "robot", "relay", "delays")
+BY_NAME = {"robot": "cerebx.loop.robot_side:main", "relay": "cerebx.link.relay:main",
+           "delays": "cerebx.link.trace:main"}
+"""Commands whose module is loaded by name when used (they bring the link's transports)."""
 _PASS_THROUGH = ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i", "--resolve",
                  "--package", "-p", "-sc", "--shell-completion", "--config-dir", "-cd",
                  "--config-name", "-cn", "--config-path", "-cp", "--experimental-rerun")
@@ -247,8 +254,11 @@ def main(argv: list[str] | None = None) -> int:
     cmd, rest = argv[0], argv[1:]
     handlers = {"run": _run, "validate": _validate, "inspect": _inspect, "bench": _bench, "report": _report,
                 "tune": _tune, "summarize": _summarize}
-    if cmd not in handlers:
+    if cmd not in handlers and cmd not in BY_NAME:
         return _fail([f"{cmd}: unknown command (choose from {', '.join(COMMANDS)})"])
+    if cmd in BY_NAME:
+        module, _, attr = BY_NAME[cmd].partition(":")
+        handlers[cmd] = getattr(importlib.import_module(module), attr)
     try:
         return handlers[cmd](rest)
     except CerebxError as err:
