@@ -19,6 +19,7 @@ import argparse
 import json
 import os
 import signal
+import sys
 import threading
 import time
 from collections import deque
@@ -31,7 +32,7 @@ from cerebx import registry
 from cerebx.build import BuildContext
 from cerebx.config import load
 from cerebx.errors import CerebxError
-from cerebx.link.clock import now_ns
+from cerebx.link.clock import now_ns, realtime_process
 from cerebx.link.stats import describe
 from cerebx.link.transport import Transport
 from cerebx.link.wire import DATA_KINDS, Kind, peek_kind, peek_seq
@@ -130,6 +131,9 @@ def main(argv: list[str]) -> int:
     cfg, _ = load(overrides)
     if not cfg.link.real:
         raise CerebxError("relay: needs a real link (link=zenoh or link=udp)")
+    why = realtime_process(cfg.link.rt_priority)
+    if why:
+        print(f"relay: {why}", file=sys.stderr)
     transport = registry.links.build(cfg.link, "relay", True)
     relay = Relay(cfg, transport)
     signal.signal(signal.SIGTERM, lambda *_: relay.stop.set())

@@ -91,8 +91,9 @@ class RealLink(Strict):
                                                                 "the command the brain computes for that tick")
     brain_wait_ms: float = Field(0.6, ge=0, lt=2, description="the brain computes a tick when its sensor message "
                                                               "arrives, or this long after the tick starts")
-    safe_stop_after_ms: float = Field(10.0, ge=0, description="robot: without a new command for this long, the "
-                                                              "previous command decays (the original's safe stop)")
+    safe_stop_after_ms: float = Field(
+        20.0, ge=0, description="robot: without a new command for this long, the previous command decays (the "
+        "original's safe stop; a receiver with its own, as future_past, decides itself)")
     safe_stop_decay_per_step: float = Field(0.998, gt=0, le=1)
     hold_pose_after_ms: float = Field(500.0, gt=0, description="robot: without any command for this long, the "
                                                                "supervisor holds the current pose")

@@ -11,9 +11,11 @@ i-th sensor and command message), in one of two forms:
 - ``--raw``: the measured delays in ms (drawn delay + transport + relay wake-up), which the tick-grid
   channel rounds up to whole ticks.
 
-A message that never arrived (lost) takes the previous message's delay; the header says how many.
-The model's distribution is drawn from the run's own delay config and seed in the order the relay drew
-it, so the i-th model value is the delay injected into the i-th message.
+A message that never arrived (lost) takes the previous message's delay; a command the robot side used
+before its tick (the robot side was running late, catching up) gets 0; the header says how many of each.
+The model's distribution is drawn from the run's own delay config and seed, as the relay drew it; the
+relay's own log (``relay/injected.csv``) gives the delay it drew for each message, so the transport's
+share of each measured delay (measured - drawn: two hops and the relay's wake-up) is shown too.
 """
 
 from __future__ import annotations
@@ -84,20 +86,46 @@ def _fill(v: np.ndarray, n: int) -> tuple[np.ndarray, int]:
     return out, missing
 
 
+def injected(run_dir: Path) -> dict[str, np.ndarray] | None:
+    """The delays the relay drew, per path indexed by sequence number (NaN: never reached it), from its log."""
+    path = Path(run_dir) / "relay" / "injected.csv"
+    if not path.exists():
+        return None
+    rows: dict[str, list[tuple[int, float]]] = {p: [] for p in PATHS}
+    for line in path.read_text().splitlines():
+        if line.startswith("#") or not line.strip():
+            continue
+        p, seq, drawn, _held = line.split(",")
+        rows[p].append((int(seq), float(drawn)))
+    out = {}
+    for p, r in rows.items():
+        v = np.full(max((s for s, _ in r), default=-1) + 1, np.nan)
+        for s, d in r:
+            v[s] = d
+        out[p] = v
+    return out
+
+
 def compare(run_dir: Path) -> dict[str, Any]:
-    """Measured (raw and on the tick grid) against the model, per path; with the relay's log, the transport's
-    own share (measured - drawn) per message."""
+    """Measured (raw and on the tick grid) against the model's distribution, per path; with the relay's log,
+    the transport's own share per message (measured - the delay the relay drew for that very message)."""
     m = measured(run_dir)
     n = max(len(v["raw"]) for v in m.values())
     model, kind = model_draws(run_dir, n)
+    drawn = injected(run_dir)
     out: dict[str, Any] = {"delay": kind, "messages": n}
     for path in PATHS:
         raw = m[path]["raw"]
         k = len(raw)
-        extra = raw - model[path][:k]
-        out[path] = {"measured_ms": describe(raw), "ticks_ms": describe(m[path]["grid"]),
-                     "model_ms": describe(model[path][:k]), "measured_minus_model_ms": describe(extra),
-                     "lost": int(np.isnan(raw).sum())}
+        row = {"measured_ms": describe(raw), "ticks_ms": describe(m[path]["grid"]),
+               "model_ms": describe(model[path][:k]), "lost": int(np.isnan(raw).sum())}
+        if drawn is not None:
+            d = np.full(k, np.nan)
+            j = min(k, len(drawn[path]))
+            d[:j] = drawn[path][:j]
+            row["injected_ms"] = describe(d)
+            row["transport_ms"] = describe(raw - d)
+        out[path] = row
     return out
 
 
@@ -105,28 +133,33 @@ def write_trace(run_dir: Path, out: Path, raw: bool) -> dict[str, int]:
     m = measured(run_dir)
     n = max(len(v["raw"]) for v in m.values())
     key = "raw" if raw else "grid"
-    cols, missing = [], {}
+    cols, missing, clamped = [], {}, {}
     for path in PATHS:
         col, miss = _fill(m[path][key], n)
-        cols.append(col)
+        clamped[path] = int((col < 0).sum())
+        cols.append(np.maximum(col, 0.0))
         missing[path] = miss
     out.parent.mkdir(parents=True, exist_ok=True)
     with open(out, "w") as fh:
         fh.write(f"# measured link delays of {run_dir} ({'raw, ms' if raw else 'on the 2 ms tick grid, ms'}); "
-                 f"one row per message; filled (lost): r2c {missing['r2c']}, c2r {missing['c2r']}\n")
+                 f"one row per message; filled (lost): r2c {missing['r2c']}, c2r {missing['c2r']}; raised to 0 "
+                 f"(used before its tick: the robot side was late): r2c {clamped['r2c']}, c2r {clamped['c2r']}\n")
         fh.write("# r2c_ms,c2r_ms\n")
         for a, b in zip(*cols):
             fh.write(f"{a:.4f},{b:.4f}\n")
-    return {"rows": n, **{f"filled_{p}": v for p, v in missing.items()}}
+    return {"rows": n, **{f"filled_{p}": v for p, v in missing.items()},
+            **{f"clamped_{p}": v for p, v in clamped.items()}}
 
 
 def _table(cmp: dict[str, Any]) -> str:
     lines = [f"delay model: {cmp['delay']}, {cmp['messages']} messages per path",
              f"{'path':<5} {'series':<22} {'mean':>8} {'std':>7} {'p5':>7} {'p50':>7} {'p95':>7} {'p99':>7} {'max':>8}"]
     for path in PATHS:
-        for name in ("measured_ms", "ticks_ms", "model_ms", "measured_minus_model_ms"):
-            d = cmp[path][name]
-            if d["n"] == 0:
+        for name in ("measured_ms", "ticks_ms", "model_ms", "injected_ms", "transport_ms"):
+            d = cmp[path].get(name)
+            if d is None:
+                continue
+            if not d["n"]:
                 continue
             lines.append(f"{path:<5} {name:<22} " + " ".join(
                 f"{d[k]:>{w}.3f}" for k, w in (("mean", 8), ("std", 7), ("p5", 7), ("p50", 7), ("p95", 7),

@@ -4,7 +4,7 @@ nothing is sent to an address the configuration did not name.
 Key expressions ``<namespace>/<path>/<hop>`` (e.g. ``cerebx/r2c/0``). The robot side listens on
 ``link.robot``; the relay listens on ``link.relay`` and connects to the robot; the brain side listens on
 ``link.brain`` and connects to the robot (and the relay). Publishers are express (no batching) with
-real-time priority; samples that arrive are put into the inbox by zenoh's own threads.
+real-time priority and a 16-slot queue; samples that arrive are put into the inbox by zenoh's own threads.
 """
 
 from __future__ import annotations
@@ -36,6 +36,9 @@ class ZenohTransport(Transport):
         conf.insert_json5("connect/endpoints", json.dumps(connect))
         conf.insert_json5("scouting/multicast/enabled", "false")
         conf.insert_json5("scouting/gossip/enabled", "false")
+        # express packets are not batched, so each is one queue slot: 16 slots (zenoh's maximum; 2 by default)
+        # ride out a send thread stalled for a few ticks instead of dropping after 1 ms
+        conf.insert_json5("transport/link/tx/queue/size/real_time", "16")
         self._endpoints = {"listen": listen, "connect": connect}
         try:
             self.session = zenoh.open(conf)

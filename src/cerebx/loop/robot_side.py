@@ -118,7 +118,7 @@ class RobotSide:
         self.state = RUNNING
         self._first_command = False
         self._last_command_ns = t0_ns
-        self._silent_since = t0_ns
+        self.stops = 0  # times the safe stop started
         self._last_packet_ns = t0_ns
         self._applied: dict[str, np.ndarray] = {}
         self._holder = _holder(ctx)
@@ -177,28 +177,44 @@ class RobotSide:
             inbox.wait((until_ns - now) / 1e9)
 
     def _starvation(self, t: float, now: int, arrived: list[Arrived], q: np.ndarray) -> None:
-        """Safe stop, then the pose held, as the time without commands grows; back to running on a command."""
+        """The robot's state from the time without commands: running; safe stop (a receiver with its own,
+        such as Eq. 3.6's, says when it is starved; for the others it starts after ``safe_stop_after_ms``);
+        the pose held after ``hold_pose_after_ms``. Each change is a link event."""
         if arrived:
             self._first_command = True
             self._last_command_ns = arrived[-1].recv_ns
-            if self.state != RUNNING:
-                silent = (now - self._silent_since) / 1e6
-                self.events.add(t, "commands_resumed", f"after {silent:.1f} ms without commands")
-                self.state, self._holding = RUNNING, None
-            return
         if not self._first_command:
             return
         silent_ms = (now - self._last_command_ns) / 1e6
-        if self.state == RUNNING and silent_ms >= self.link.safe_stop_after_ms:
-            self.state, self._silent_since = SAFE_STOP, self._last_command_ns
-            self.events.add(t, SAFE_STOP, f"no command for {silent_ms:.1f} ms: previous command x "
-                                          f"{self.link.safe_stop_decay_per_step} per step")
-        if self.state == SAFE_STOP and silent_ms >= self.link.hold_pose_after_ms and self._holder is not None:
-            self.state = HOLD_POSE
+        if self.receiver.safe_stop:
+            stopped = self.receiver.starved
+        else:
+            stopped = silent_ms >= self.link.safe_stop_after_ms
+        new = RUNNING
+        if silent_ms >= self.link.hold_pose_after_ms and self._holder is not None:
+            new = HOLD_POSE
+        elif stopped:
+            new = SAFE_STOP
+        if new == self.state:
+            return
+        if new == HOLD_POSE:
             self._holding = self._holder
             self._holding.lo, self._holding.hi = q.copy(), q.copy()
             self._holding.s[:] = 0.0
-            self.events.add(t, HOLD_POSE, f"no command for {silent_ms:.1f} ms: the supervisor holds the pose")
+            detail = f"no command for {silent_ms:.1f} ms: the supervisor holds the pose"
+        elif new == SAFE_STOP:
+            self._holding = None
+            if self.receiver.safe_stop:
+                detail = f"too few future commands ({silent_ms:.1f} ms since the last): the receiver decays its output"
+            else:
+                detail = (f"no command for {silent_ms:.1f} ms: previous command x {self.link.safe_stop_decay_per_step}"
+                          " per step")
+        else:
+            self._holding = None
+            detail = f"{silent_ms:.1f} ms since the last command"
+        self.events.add(t, new if new != RUNNING else "commands_resumed", detail)
+        self.state = new
+        self.stops += new == SAFE_STOP
 
     # ------------------------------------------------------------------ one tick
     def step(self, q_des: np.ndarray, qd_des: np.ndarray, acc: TrialAccumulator, trial: int,
@@ -219,9 +235,9 @@ class RobotSide:
         now = now_ns()
         if now - self._last_packet_ns > self.link.link_lost_after_ms * 1e6:
             raise LinkLost(f"link lost: nothing from the brain side for {(now - self._last_packet_ns) / 1e9:.1f} s")
-        self._starvation(t, now, arrived, sensed["joint.q"] if "joint.q" in sensed else np.zeros(0))
         values = self.receiver.receive([a.message for a in arrived], t)
-        if self.state == RUNNING:
+        self._starvation(t, now, arrived, sensed["joint.q"] if "joint.q" in sensed else np.zeros(0))
+        if self.state == RUNNING or self.receiver.safe_stop:
             self._applied = values
         else:
             decay = self.link.safe_stop_decay_per_step
@@ -309,7 +325,7 @@ class RobotSide:
     def timing(self) -> dict[str, Any]:
         out = self.log.totals()
         out.update({"ticks": self.log.n, "overruns": self.overruns, "commands_late": self.late,
-                    "commands_lost": self.end.data.lost, "c2r_ms": describe(self.c2r_delays)})
+                    "commands_lost": self.end.data.lost, "safe_stops": self.stops, "c2r_ms": describe(self.c2r_delays)})
         return out
 
     @property
