@@ -73,10 +73,11 @@ def model_draws(run_dir: Path, n: int) -> tuple[dict[str, np.ndarray], str]:
 
 
 def _fill(v: np.ndarray, n: int) -> tuple[np.ndarray, int]:
-    """``v`` extended to ``n`` rows, each missing value taking the one before it (or the first known)."""
+    """``v`` extended to ``n`` rows, each missing value taking the one before it (or the first known); the
+    number of messages lost among ``v``'s."""
     out = np.full(n, np.nan)
     out[:len(v)] = v
-    missing = int(np.isnan(out).sum())
+    missing = int(np.isnan(v).sum())
     known = out[np.isfinite(out)]
     prev = known[0] if known.size else 0.0
     for i in range(n):

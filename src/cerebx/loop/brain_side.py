@@ -462,6 +462,7 @@ def _run_paired(cfg: Any, run_dir: Path, ctx: Any, end: LinkEnd, welcome: Packet
         summary["status"], summary["error"] = "interrupted", f"the robot side ended ({err.status}): {err}"
     except LinkLost as err:
         summary["status"], summary["error"] = "interrupted", str(err)
+        print(f"brain side: {err} (status interrupted, {run_dir})", file=sys.stderr)
     except KeyboardInterrupt:
         summary["status"], summary["error"] = "interrupted", "interrupted by signal"
     except Diverged as err:
