@@ -8,6 +8,7 @@ import time
 import numpy as np
 import pytest
 
+from cerebx.build import build_components
 from cerebx.errors import ConfigError
 from cerebx.link import clock
 from cerebx.link.auth import Signer
@@ -56,8 +57,6 @@ def test_watchdog_has_nothing_to_shed_without_targets():
 
 
 def test_snn_controller_is_a_shedding_target(load):
-    from cerebx.build import build_components
-
     ctx = build_components(load(["+experiment=small_snn", "+task=circle", "trials=1"]))
     (target,) = shed_targets(ctx.brain)
     net = target.net

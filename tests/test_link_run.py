@@ -23,9 +23,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from cerebx.config import load
 from cerebx.link.auth import KEY_ENV, Signer
 from cerebx.link.transport import free_port
 from cerebx.link.wire import HEADER, Kind, encode
+from cerebx.loop.runner import run_experiment
 from cerebx.recording.reader import channel_counts, read_messages, read_summary
 
 CLI = [sys.executable, "-m", "cerebx.cli"]
@@ -85,9 +87,6 @@ def alive(pid: int) -> bool:
 
 
 def sim_mae(tmp_path: Path, overrides: list[str]) -> list[float]:
-    from cerebx.config import load
-    from cerebx.loop.runner import run_experiment
-
     cfg, plain = load(overrides)
     return run_experiment(cfg, tmp_path / "sim", plain)["mae_per_trial"]
 

@@ -10,11 +10,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from cerebx.errors import CerebxError
+from cerebx.errors import CerebxError, ConfigError
 from cerebx.link.auth import KEY_ENV, KEY_FILE_ENV, Signer, key_from_env, require_key
 from cerebx.link.channel import LinkEnd
 from cerebx.link.transport import Arrival, Inbox
 from cerebx.link.wire import HEADER, HEADER_BYTES, MIN_BYTES, REASONS, VERSION, Kind, WireError, decode, encode
+from cerebx.signals import Message
 
 KEY = Signer(b"k" * 32)
 OTHER = Signer(b"o" * 32)
@@ -143,8 +144,6 @@ def test_key_from_file_and_env(tmp_path):
 
 
 def test_the_key_is_not_configuration(load):
-    from cerebx.errors import ConfigError
-
     with pytest.raises(ConfigError, match="link.key"):
         load(["+task=circle", "controller=pd", "link=zenoh", "clock=wall", "+link.key=abcdefabcdefabcdef"])
 
@@ -177,8 +176,6 @@ def test_link_end_counts_and_drops_what_it_refuses():
 def test_link_end_sends_signed_packets_and_measures_delay():
     t = FakeTransport()
     end = LinkEnd(t, KEY, "brain", {"joint.q": 2, "joint.qd": 2}, run_id=RUN)
-    from cerebx.signals import Message
-
     end.send_message(Message(0.004, {"joint.torque": np.ones(6)}), 2)
     path, hop, raw = t.sent[0]
     assert (path, hop) == ("c2r", 0)

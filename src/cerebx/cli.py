@@ -182,6 +182,14 @@ def _inspect(args: list[str]) -> int:
                                    "complete record; the run was killed or is still going)"))
         for topic, n in counts.items():
             print(f"  {topic:<{width}}  {n:>9,}")
+        robot = run_dir / "robot"
+        if p.is_dir() and (robot / "run.mcap").exists():  # the robot side of a wall-clock run
+            log = robot / "run.mcap"
+            counts = channel_counts(robot)
+            width = max(map(len, counts), default=10)
+            print(f"\n{log}  (robot side: {read_summary(robot)['status']})")
+            for topic, n in counts.items():
+                print(f"  {topic:<{width}}  {n:>9,}")
     except (CerebxError, OSError) as err:
         problems.append(str(err) if isinstance(err, CerebxError) else f"{log}: {err.strerror}")
     return _fail(problems) if problems else 0
