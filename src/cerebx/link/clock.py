@@ -46,14 +46,30 @@ def pace(deadline_ns: int, spin_ns: int) -> int:
 SWITCH_INTERVAL_S = 1e-4
 
 
-def realtime_process(priority: int) -> str | None:
+RANK = {"robot": 0, "relay": 1, "brain": 2}
+"""Real-time priority below ``link.rt_priority`` per process: the paced robot side first, then the relay
+(whose wake-ups add to the delays), then the brain side (which has the pathway delay's slack)."""
+
+
+def host_steal_ms() -> float:
+    """CPU time the hypervisor took from this machine since boot, ms (0 where the kernel does not say)."""
+    try:
+        fields = Path("/proc/stat").read_text().split("\n", 1)[0].split()
+        return float(fields[8]) * 1000.0 / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError):
+        return 0.0
+
+
+def realtime_process(priority: int, role: str = "robot") -> str | None:
     """Prepare this process for a paced loop: threads take turns at the interpreter lock every 0.1 ms (not
     5 ms), so the transport's threads that receive packets do not wait for a tick to finish; with
     ``priority`` > 0 the process (and the threads it starts later) runs under the kernel's real-time
-    ``SCHED_FIFO`` policy at that priority. Returns why that could not be done, or None."""
+    ``SCHED_FIFO`` policy at that priority less its ``role``'s :data:`RANK`. Returns why that could not be
+    done, or None."""
     sys.setswitchinterval(SWITCH_INTERVAL_S)
     if priority <= 0:
         return None
+    priority = max(1, priority - RANK[role])
     try:
         os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
     except (AttributeError, OSError) as err:

@@ -131,7 +131,7 @@ def main(argv: list[str]) -> int:
     cfg, _ = load(overrides)
     if not cfg.link.real:
         raise CerebxError("relay: needs a real link (link=zenoh or link=udp)")
-    why = realtime_process(cfg.link.rt_priority)
+    why = realtime_process(cfg.link.rt_priority, "relay")
     if why:
         print(f"relay: {why}", file=sys.stderr)
     transport = registry.links.build(cfg.link, "relay", True)

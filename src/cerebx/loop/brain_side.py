@@ -379,7 +379,7 @@ def run_brain_side(cfg: Any, run_dir: Path, resolved: dict | None = None, overri
     cfg = cfg.model_copy(update={"link": link})
     via_relay = link.relay_on(cfg.delay.kind)
     signer, key_env = _signer(link)
-    why = clock.realtime_process(link.rt_priority)
+    why = clock.realtime_process(link.rt_priority, "brain")
     if why:
         print(f"brain side: {why}", file=sys.stderr)
     children = Children()

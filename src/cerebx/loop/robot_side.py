@@ -42,7 +42,7 @@ from cerebx.config import load
 from cerebx.errors import CerebxError, Diverged
 from cerebx.link.auth import require_key
 from cerebx.link.channel import Arrived, LinkEnd
-from cerebx.link.clock import host_identity, now_ns, pace, realtime_process
+from cerebx.link.clock import host_identity, host_steal_ms, now_ns, pace, realtime_process
 from cerebx.link.pairing import START_LEAD_S, RemoteController, fingerprint, pong, wait_for_hello
 from cerebx.link.stats import describe
 from cerebx.link.wire import Kind, Packet
@@ -59,6 +59,7 @@ from cerebx.stages.supervisor import Supervisor
 log = logging.getLogger("cerebx")
 
 RUNNING, SAFE_STOP, HOLD_POSE = "running", "safe_stop", "hold_pose"
+STALL_MS = 5.0  # a tick that starts this late begins a stall (counted in the timing summary)
 
 
 def build_robot_parts(cfg: Any, facts: dict[str, Any], run_dir: Path | None) -> BuildContext:
@@ -131,6 +132,7 @@ class RobotSide:
         self.overruns = 0
         self.late = 0
         self.ended_ns = t0_ns
+        self._steal0 = host_steal_ms()
 
     def start(self) -> None:
         q0 = self.task.first_sample() if self.cfg.start_at == "path" else self.task.start_position()
@@ -324,6 +326,11 @@ class RobotSide:
 
     def timing(self) -> dict[str, Any]:
         out = self.log.totals()
+        late = self.log.series["lateness_ms"][:self.log.n]
+        starts = np.flatnonzero((late > STALL_MS) & ~np.r_[False, late[:-1] > STALL_MS])
+        out["stalls"] = {"count": int(starts.size), "longest_ms": round(float(late[starts].max()), 3) if starts.size
+                         else 0.0, "threshold_ms": STALL_MS}
+        out["host_steal_ms"] = round(host_steal_ms() - self._steal0, 1)
         out.update({"ticks": self.log.n, "overruns": self.overruns, "commands_late": self.late,
                     "commands_lost": self.end.data.lost, "safe_stops": self.stops, "c2r_ms": describe(self.c2r_delays)})
         return out
@@ -442,7 +449,7 @@ def main(argv: list[str]) -> int:
     if not cfg.link.real:
         raise CerebxError("robot: needs a real link (link=zenoh or link=udp) and clock=wall")
     signer = require_key()
-    why = realtime_process(cfg.link.rt_priority)
+    why = realtime_process(cfg.link.rt_priority, "robot")
     if why:
         print(f"robot side: {why}", file=sys.stderr)
     via_relay = cfg.link.relay_on(cfg.delay.kind)
