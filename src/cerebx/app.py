@@ -18,7 +18,8 @@ from omegaconf import DictConfig
 
 from cerebx import runfiles
 from cerebx.config import to_plain, user_choices
-from cerebx.errors import ConfigError
+from cerebx.errors import CerebxError, ConfigError
+from cerebx.link.pairing import PairingRefused
 from cerebx.loop import resume
 from cerebx.loop.runner import run_experiment
 from cerebx.recording.console import print_summary
@@ -48,7 +49,11 @@ def run_app(cfg: DictConfig) -> float | None:
         print(f"reused: {run_dir} already completed {reused.get('trials_completed')} trials")
         return reused.get("final_mae")
     choices = user_choices(hc.runtime.choices)
-    summary = run_experiment(exp, run_dir, plain, overrides=list(hc.overrides.task), choices=choices)
+    try:
+        summary = run_experiment(exp, run_dir, plain, overrides=list(hc.overrides.task), choices=choices)
+    except CerebxError as err:  # a wall-clock run whose sides did not pair (refused: composed differently)
+        print(err, file=sys.stderr)
+        raise SystemExit(2 if isinstance(err, PairingRefused) else 1) from None
     print_summary(summary, run_dir)
     if summary["status"] == "interrupted":
         raise SystemExit(130)

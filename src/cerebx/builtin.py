@@ -4,6 +4,7 @@ heavy modules (MuJoCo, numba kernels) load only when a run uses them."""
 
 from cerebx import registry
 from cerebx.controllers.snn import schema as snn
+from cerebx.link import schema as lk
 from cerebx.schema import arm_tasks as at
 from cerebx.schema import controller as c
 from cerebx.schema import delay as d
@@ -64,3 +65,8 @@ def register() -> None:
     # mossy encoders take (cfg, lo, hi); climbing encoders (cfg, n_joints, fibres_per_joint, kpos, kvel, rng)
     registry.encoders.register(snn.BoxEncoder, "cerebx.snn.encoders:MossyEncoder")
     registry.encoders.register(snn.CFEncoder, "cerebx.snn.encoders:ClimbingEncoder")
+
+    # links: the tick-grid one of simulated time, and transports between processes; builders take (cfg, role, via_relay)
+    registry.links.register(lk.SimLink, "cerebx.link.transport:build_sim")
+    registry.links.register(lk.ZenohLink, "cerebx.link.zenoh_link:ZenohTransport")
+    registry.links.register(lk.UdpLink, "cerebx.link.udp:UdpTransport")

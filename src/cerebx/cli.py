@@ -29,13 +29,17 @@ commands:
   report [RUN_DIR ...]                                 build reports/ from run logs
   summarize MULTIRUN_DIR                               one table of a sweep's jobs (CSV, Markdown, plot)
   tune [--out PATH] OVERRIDES...                       Ziegler-Nichols PD gains on the simulated plant
+  robot [--run-dir DIR] OVERRIDES...                   the robot side of a wall-clock run (link=zenoh|udp clock=wall)
+  relay [--out DIR] OVERRIDES...                       the delay relay on a real link's path
+  delays RUN_DIR [--out trace.csv] [--raw]             measured link delays: vs the model, as a delay=trace file
 
 groups: task (required, +task=), controller (snn), plant (baxter), delay (none),
         experiment (presets: +experiment=NAME); network (full), with controller=snn
 """
 
-COMMANDS = {name: f"cerebx.commands.{name}" for name in
-            ("run", "validate", "inspect", "bench", "report", "tune", "summarize")}
+COMMANDS = {**{name: f"cerebx.commands.{name}" for name in
+               ("run", "validate", "inspect", "bench", "report", "tune", "summarize")},
+            "robot": "cerebx.loop.robot_side", "relay": "cerebx.link.relay", "delays": "cerebx.link.trace"}
 """Command name -> the module whose ``main(args)`` runs it."""
 
 

@@ -2,7 +2,8 @@
 
 Groups: ``task``, ``plant``, ``controller`` (brain-side parts), ``stage`` (brain- or robot-side
 stages: torque filters, the supervisor, muscles, ...), ``delay`` (link delay models), ``event``
-(plant events) and ``encoder`` (cerebellar input codes). Every kind arrives through a plugin: a callable
+(plant events), ``encoder`` (cerebellar input codes) and ``link`` (transports between the brain side and
+the robot side). Every kind arrives through a plugin: a callable
 taking no arguments, exposed as a ``cerebx.plugins`` entry point, that registers its kinds here. The
 platform's own kinds come the same way (entry point ``core``, ``cerebx.builtin:register``). A plugin may
 also add a folder of Hydra presets (:func:`add_config_source`) and a report module with its figures and
@@ -102,8 +103,9 @@ stages = Registry("stage")
 delays = Registry("delay")
 events = Registry("event")
 encoders = Registry("encoder")
+links = Registry("link")
 
-GROUPS = {r.group: r for r in (tasks, plants, controllers, stages, delays, events, encoders)}
+GROUPS = {r.group: r for r in (tasks, plants, controllers, stages, delays, events, encoders, links)}
 
 
 def Plugin(group: str) -> Any:  # noqa: N802 - reads as a type in schemas

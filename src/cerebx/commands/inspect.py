@@ -38,6 +38,14 @@ def main(args: list[str]) -> int:
                                    "complete record; the run was killed or is still going)"))
         for topic, n in counts.items():
             print(f"  {topic:<{width}}  {n:>9,}")
+        robot = run_dir / "robot"
+        if p.is_dir() and (robot / runfiles.MCAP).exists():  # the robot side of a wall-clock run
+            log = robot / runfiles.MCAP
+            counts = channel_counts(robot)
+            width = max(map(len, counts), default=10)
+            print(f"\n{log}  (robot side: {read_summary(robot)['status']})")
+            for topic, n in counts.items():
+                print(f"  {topic:<{width}}  {n:>9,}")
     except (CerebxError, OSError) as err:
         problems.append(str(err) if isinstance(err, CerebxError) else f"{log}: {err.strerror}")
     return fail(problems) if problems else 0

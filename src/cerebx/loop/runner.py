@@ -19,6 +19,7 @@ from cerebx import __version__, runfiles
 from cerebx.build import build_components
 from cerebx.errors import CerebxError, Diverged
 from cerebx.loop import resume
+from cerebx.loop.brain_side import run_brain_side
 from cerebx.loop.loop import ClosedLoop
 from cerebx.recording import live as live_view
 from cerebx.recording.recorder import Recorder
@@ -55,7 +56,10 @@ def _progress(cfg, total: int):
 
 def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
                    overrides: list[str] | None = None, choices: dict[str, str] | None = None) -> dict:
-    """Run ``cfg`` into ``run_dir``: writes run.mcap, summary.json and the controller state."""
+    """Run ``cfg`` into ``run_dir``: writes run.mcap, summary.json and the controller state. Over a real link
+    this is the brain side of a wall-clock run (``loop/brain_side.py``)."""
+    if cfg.link.real:
+        return run_brain_side(cfg, Path(run_dir), resolved, overrides, choices)
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
     started = time.time()

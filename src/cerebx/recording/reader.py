@@ -14,6 +14,7 @@ from mcap.stream_reader import StreamReader
 
 from cerebx import runfiles
 from cerebx.errors import CerebxError
+from cerebx.recording.pair import merge, robot_log
 from cerebx.recording.segments import segments
 from cerebx.recording.summary import read_summary
 
@@ -93,12 +94,22 @@ def read_messages(path: Path | str, topics: list[str] | None = None, start_ns: i
 
     A run folder is read across its segments (a resumed run: ``run.mcap``, ``run.1.mcap`` …) as one
     log. A file without a summary section (a run still going, or one killed with SIGKILL) is read as a
-    stream up to its last complete record.
+    stream up to its last complete record. The folder of a wall-clock run also holds its robot side's log
+    (``robot/run.mcap``): the two are read as one (``recording/pair.py``).
     """
     p = Path(path)
     if not p.is_dir():
         yield from _read_file(p, topics, start_ns, end_ns)
         return
+    robot = robot_log(p)
+    if robot is not None:
+        yield from merge(_read_segments(p, topics, start_ns, end_ns), _read_file(robot, topics, start_ns, end_ns))
+        return
+    yield from _read_segments(p, topics, start_ns, end_ns)
+
+
+def _read_segments(p: Path, topics: list[str] | None, start_ns: int | None,
+                   end_ns: int | None) -> Iterator[tuple[str, int, Any]]:
     for seg in segments(p):
         lo = seg.start_ns if start_ns is None else max(start_ns, seg.start_ns)
         hi = seg.end_ns + 1 if seg.end_ns is not None else None  # the boundary itself: see owns()
@@ -171,8 +182,16 @@ def has_summary(path: Path | str) -> bool:
 
 def read_metadata(path: Path | str) -> dict[str, dict[str, str]]:
     """The metadata records of a file; of a run folder, its last segment's (each segment carries the
-    config, and the last one the summary of the whole run)."""
-    p = segments(path)[-1].path if Path(path).is_dir() else Path(path)
+    config, and the last one the summary of the whole run); of a wall-clock run's folder, also the robot
+    side's records under ``robot.<name>``."""
+    if Path(path).is_dir() and robot_log(path) is not None:
+        both = _metadata(segments(path)[-1].path)
+        both.update({f"robot.{k}": v for k, v in _metadata(robot_log(path)).items()})
+        return both
+    return _metadata(segments(path)[-1].path if Path(path).is_dir() else Path(path))
+
+
+def _metadata(p: Path) -> dict[str, dict[str, str]]:
     if not p.exists():
         raise CerebxError(f"{p}: no such file")
     with open(p, "rb") as fh:

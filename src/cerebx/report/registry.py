@@ -76,8 +76,8 @@ def all_figures() -> dict[str, FigureSpec]:
 
 def figure_order(name: str) -> tuple:
     """Sort key of a figure name: the numbers of its figure part (``x3_4`` -> (3, 4); ``fig`` and ``table``
-    prefixes dropped); a part that is not a number counts 0 (so a paper-prefixed ``name2011_fig7c`` reads as
-    (0, 0)); at equal numbers a name without any digit (a study that is no paper's figure) comes first, then
+    prefixes dropped); a part that is not a number counts 0 (so a name with a paper prefix reads as zeros); at
+    equal numbers a name without any digit (a study that is no paper's figure) comes first, then
     the registration order (plugins load in ``registry.load_plugins``'s order)."""
     parts = name.replace("fig", "").replace("table", "").split("_")
     return tuple(int(p) if p.isdigit() else 0 for p in parts), any(c.isdigit() for c in name)

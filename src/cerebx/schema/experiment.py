@@ -10,6 +10,7 @@ from pydantic import BaseModel, Field, ValidationError, create_model, model_vali
 
 from cerebx import registry, runfiles
 from cerebx.errors import ConfigError
+from cerebx.link.schema import clock_problems
 from cerebx.registry import Plugin
 from cerebx.schema.base import CONTROL_DT_MS, NonNegFloat, Strict
 from cerebx.schema.init_state import init_from_problems
@@ -79,6 +80,11 @@ def complete(data: Any) -> Any:
     return data
 
 
+ADDED_WITHOUT_EFFECT: dict[str, Any] = {"link": {"kind": "sim"}, "clock": "sim"}
+"""Top-level keys added after runs were first recorded, with the value that does what those runs did (see
+``schema/legacy.py``; controller kinds list theirs in ``added_without_effect``)."""
+
+
 class _ExperimentBase(Strict):
     """Top-level keys shared by every experiment."""
 
@@ -108,6 +114,12 @@ class _ExperimentBase(Strict):
     warmup_trials: int = Field(
         0, ge=0, description="the first trials let a learned controller settle onto the path; they are run and "
         "logged like the others, and the report leaves them out of its statistics")
+    link: Plugin("link") = Field(
+        {"kind": "sim"}, description="the link between the brain side and the robot side: sim (the tick-grid link of "
+        "one simulated-time process) or a transport between processes (zenoh, udp; see SPEC §5.1)")
+    clock: Literal["sim", "wall"] = Field(
+        "sim", description="sim: simulated time, deterministic; wall: the robot side paced by the wall clock at the "
+        "control rate (needs a real link)")
     start_at: Literal["home", "path"] = Field(
         "home", description="where the arm starts: the task's home pose, or at rest on the path's first sample "
         "(as consecutive trials do; used when a learned controller is evaluated)")
@@ -153,6 +165,9 @@ class _ExperimentBase(Strict):
                 wire(self)
             except ConfigError as err:
                 problems += err.problems
+        problems += clock_problems(self)
+        if self.link.real and self.resume is not None:
+            problems.append("resume: a wall-clock run over a real link cannot be continued from a checkpoint")
         if self.warmup_trials >= self.trials:
             problems.append(f"warmup_trials: {self.warmup_trials} leaves no measured trial of {self.trials}")
         if self.init_from is not None:

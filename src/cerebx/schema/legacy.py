@@ -4,7 +4,7 @@ experiment (reports reuse it, ``resume`` continues it) when its recorded data wo
 Two changes are undone here: the spiking network used to be a top-level ``network`` key of every experiment
 (it now belongs to the controller that runs it: any controller kind whose schema has a ``network`` field,
 and nothing else), and options added since a run was recorded are filled in with the value that does what
-the run did (each controller kind lists them in ``added_without_effect``)."""
+the run did (each controller kind lists them in ``added_without_effect``, the experiment schema its own keys)."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ import copy
 from typing import Any
 
 from cerebx import registry
+from cerebx.schema.experiment import ADDED_WITHOUT_EFFECT
 
 
 def _schema(part: Any) -> Any:
@@ -37,6 +38,8 @@ def upgrade(config: dict[str, Any]) -> dict[str, Any]:
     """A copy of a recorded experiment config in today's layout (unchanged when it already is)."""
     registry.load_plugins()
     out = copy.deepcopy(config)
+    for key, value in ADDED_WITHOUT_EFFECT.items():
+        out.setdefault(key, copy.deepcopy(value))
     network = out.pop("network", None)
     controller = out.get("controller")
     if not isinstance(controller, dict):

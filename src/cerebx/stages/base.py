@@ -69,9 +69,12 @@ class Stage(ABC):
 
 class Receiver(ABC):
     """First robot-side stage: turns the command messages that arrived this tick (zero or more)
-    into the command values to apply now."""
+    into the command values to apply now. A receiver with ``safe_stop`` decays its previous output by
+    itself when too few commands arrived, and says so in ``starved`` after each tick."""
 
     name: str = "receiver"
+    safe_stop: bool = False
+    starved: bool = False
 
     def __init__(self, signals: tuple[Signal, ...]):
         self.signals = signals

@@ -82,6 +82,7 @@ class FuturePastFilter(Receiver):
     """
 
     name = "future_past"
+    safe_stop = True
 
     def __init__(self, signals: tuple[Signal, ...], cfg: schema.FuturePastFilterConfig):
         super().__init__(signals)
@@ -98,7 +99,8 @@ class FuturePastFilter(Receiver):
             self.past.append(self.future.pop(0))
         n = self.cfg.past_samples
         f = min(len(self.future), n + 1)
-        if f >= self.cfg.min_future_samples + 1:
+        self.starved = f < self.cfg.min_future_samples + 1
+        if not self.starved:
             chosen = self.future[:f]
             k = min(f - 1, len(self.past))
             if k:

@@ -22,6 +22,7 @@ The teaching signal is the joint error either way.
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import json
 import threading
@@ -93,6 +94,9 @@ class SNNControllerImpl(Controller):
         self.width = 2 * nj if self.muscles else nj  # values per step in the output FIFO ([ag, at] or tau)
         self.full_scale = np.asarray(cfg.decoder.full_scale(nj), float)  # M = 1 (agonist_antagonist output)
         self.recorder = None
+        self.pathway_delay_ms = cfg.pathway_delay_ms
+        self._shed = 0  # real-time load shedding level (link/shedding.py); 0: everything runs
+        self._summaries = True  # periodic weight summaries (left out in wall-clock runs)
         self.record = {name: self.net.index(name) for name in cfg.record_spikes}
         self.fingerprint = self.net.fingerprint
         self.config_hash = hashlib.sha256(
@@ -122,9 +126,12 @@ class SNNControllerImpl(Controller):
     def _simulate(self, inputs: list[np.ndarray], first_step: int) -> list[tuple]:
         """Run the network over ``inputs`` (one GIL-free call); per step: (time, output, DCN spike
         count, recorded spikes), the output a torque or [M_ag, M_at]. Decoding is done for the whole
-        chunk at once."""
-        idx, off = self.net.step_many(inputs)
+        chunk at once. With spike propagation shed the network is not run and the DCN stay silent."""
         n, nj = len(inputs), self.n_ctrl
+        if self._shed >= 2:
+            self.net.t_sub += self.net.n_sub * n
+            return [((first_step + i) * STEP_S, np.zeros(self.width), 0, None) for i in range(n)]
+        idx, off = self.net.step_many(inputs)
         step_of = np.repeat(np.arange(n), np.diff(off))
         lo, hi = self.sl_dcn.start, self.sl_dcn.stop
         sel = (idx >= lo) & (idx < hi)
@@ -139,7 +146,7 @@ class SNNControllerImpl(Controller):
         out = []
         for i in range(n):
             rec = None
-            if self.recorder is not None:
+            if self.recorder is not None and self._shed < 3:
                 step_idx = idx[off[i]:off[i + 1]]
                 rec = {name: step_idx[(step_idx >= sl.start) & (step_idx < sl.stop)] - sl.start
                        for name, sl in self.record.items()}
@@ -194,6 +201,22 @@ class SNNControllerImpl(Controller):
         if self._worker is None and len(self._pending) >= self.chunk:
             self._launch()
 
+    def prepare_real_time(self) -> None:
+        """Before the first tick of a wall-clock run: load (or compile) every kernel a step uses, changing no
+        state, and leave out the periodic weight summaries (a pass over every plastic weight takes longer than
+        the pathway delay leaves between two ticks; the learned state is still saved at the end)."""
+        self.net.step_many([])
+        z = np.zeros(self.n_ctrl)
+        self.mf.active(z, z, z, z)
+        copy.deepcopy(self.cf).active(z)
+        self._summaries = False
+
+    def shed(self, level: int) -> None:
+        """Real-time load shedding (the original's watchdog levels): 0 everything runs, 1 plasticity off,
+        2 spike propagation off too, 3 spike recording and weight summaries off too."""
+        self._shed = level
+        self.net.learn = self.cfg.plasticity and level == 0
+
     def reset(self, rng: np.random.Generator) -> None:
         self.cf.rng = rng
         self.cf.reset()
@@ -247,7 +270,7 @@ class SNNControllerImpl(Controller):
             out["dcn_rate_hz"] = self._dcn_spikes / (n_dcn * self._steps * STEP_S)
         self._dcn_spikes = self._steps = 0
         every = self.cfg.weight_summary_every_trials
-        if every and trial % every == 0:
+        if every and trial % every == 0 and self._summaries and self._shed < 3:
             for name in self.net.plastic_projections:
                 w = self.net.weights(name)
                 out[f"w_{name}_mean"] = float(w.mean(dtype=np.float64))
