@@ -10,6 +10,8 @@ A run folder (Hydra's output directory) holds:
 ``checkpoint.pkl``       the whole live loop every ``checkpoint_every`` trials (``resume``), with a
                          small JSON head ``checkpoint.pkl.json``; deleted when the run completes
 ``error.txt``            a sweep job refused before its run started: why
+``robot/``, ``relay/``   a wall-clock run over a real link: the robot side's run folder and the delay
+                         relay's counts and drawn delays (``injected.csv``)
 ``.hydra/``              Hydra's record of the composed config and the overrides
 =======================  ===================================================================
 """
@@ -23,6 +25,9 @@ CHECKPOINT_HEAD = CHECKPOINT + ".json"
 ERROR = "error.txt"
 HYDRA = ".hydra"
 OVERRIDES = HYDRA + "/overrides.yaml"
+ROBOT = "robot"
+RELAY = "relay"
+INJECTED = "injected.csv"
 
 
 def part_state(state_name: str, i: int) -> str:

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx import registry
+from cerebx import registry, runfiles
 from cerebx.build import BuildContext
 from cerebx.config import load
 from cerebx.errors import CerebxError
@@ -109,8 +109,8 @@ class Relay:
 
     def write(self, out: Path) -> None:
         out.mkdir(parents=True, exist_ok=True)
-        (out / "summary.json").write_text(json.dumps(self.summary(), indent=2))
-        with open(out / "injected.csv", "w") as fh:
+        (out / runfiles.SUMMARY).write_text(json.dumps(self.summary(), indent=2))
+        with open(out / runfiles.INJECTED, "w") as fh:
             fh.write("# path,seq,drawn_ms,held_ms\n")
             for path, seq, drawn, held in self.rows:
                 fh.write(f"{path},{seq},{drawn:.4f},{held:.4f}\n")

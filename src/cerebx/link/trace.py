@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx import registry
+from cerebx import registry, runfiles
 from cerebx.build import BuildContext
 from cerebx.errors import CerebxError
 from cerebx.link.stats import describe
@@ -89,7 +89,7 @@ def _fill(v: np.ndarray, n: int) -> tuple[np.ndarray, int]:
 
 def injected(run_dir: Path) -> dict[str, np.ndarray] | None:
     """The delays the relay drew, per path indexed by sequence number (NaN: never reached it), from its log."""
-    path = Path(run_dir) / "relay" / "injected.csv"
+    path = Path(run_dir) / runfiles.RELAY / runfiles.INJECTED
     if not path.exists():
         return None
     rows: dict[str, list[tuple[int, float]]] = {p: [] for p in PATHS}

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx import __version__, registry
+from cerebx import __version__, registry, runfiles
 from cerebx.build import build_components
 from cerebx.errors import CerebxError, Diverged
 from cerebx.link import clock
@@ -48,8 +48,6 @@ from cerebx.recording.sentinel import Sentinel
 from cerebx.recording.summary import new_summary, read_summary, trial_fields, write_summary
 from cerebx.signals import Frame, Message
 
-STATE_FILE = "controller_state.npz"
-RELAY_DIR = "relay"
 CHILD_DROPS = ("init_from", "resume", "link.robot", "link.brain", "link.relay", "link.spawn_robot",
                "recording.progress")
 BYE_WAIT_S = 5.0  # after the last tick, for the robot side's last trial and its BYE
@@ -390,12 +388,12 @@ def run_brain_side(cfg: Any, run_dir: Path, resolved: dict | None = None, overri
             folder = run_dir / ROBOT_DIR
             children.procs["robot"] = (spawn("robot", ["--run-dir", str(folder), *args], folder, key_env), folder)
         if via_relay:
-            folder = run_dir / RELAY_DIR
+            folder = run_dir / runfiles.RELAY
             children.procs["relay"] = (spawn("relay", ["--out", str(folder), "--parent-pipe", *args], folder,
                                              {"CEREBX_LINK_KEY": "", "CEREBX_LINK_KEY_FILE": ""}, pipe=True), folder)
         ctx = build_components(cfg, run_dir)
         if cfg.init_from:
-            state = Path(cfg.init_from) / STATE_FILE
+            state = Path(cfg.init_from) / runfiles.STATE
             if not state.exists():
                 raise CerebxError(f"init_from: {state} does not exist")
             ctx.brain[0].load_state(state)
@@ -424,7 +422,7 @@ def _run_paired(cfg: Any, run_dir: Path, ctx: Any, end: LinkEnd, welcome: Packet
                           presets=dict(choices or {}), side="brain")
     write_summary(run_dir, summary)
     sentinel = Sentinel(run_dir)
-    rec = Recorder(run_dir / "run.mcap", chunk_size_kb=cfg.recording.chunk_size_kb, compression=cfg.link.compression)
+    rec = Recorder(run_dir / runfiles.MCAP, chunk_size_kb=cfg.recording.chunk_size_kb, compression=cfg.link.compression)
     run_id = end.run_id or bytes(16)
     rec.joint_names = tuple(ctx.plant.joint_names)
     rec.metadata("cerebx", {"version": __version__, "overrides": json.dumps(overrides)})
@@ -506,7 +504,7 @@ def _finish(cfg: Any, run_dir: Path, summary: dict[str, Any], side: BrainSide | 
     codes = children.finish() if children.procs else {}
     robot_dir = run_dir / ROBOT_DIR
     metrics = side.metrics() if side is not None else []
-    if (robot_dir / "summary.json").exists():
+    if (robot_dir / runfiles.SUMMARY).exists():
         try:
             rs = read_summary(robot_dir)
             robot.setdefault("timing", (rs.get("link") or {}).get("timing"))
@@ -536,7 +534,7 @@ def _finish(cfg: Any, run_dir: Path, summary: dict[str, Any], side: BrainSide | 
                 "c2r_ms": (robot.get("timing") or {}).get("c2r_ms")})
     if side is not None and cfg.recording.save_state and side.tick > 0:
         try:
-            side.ctx.brain[0].save_state(run_dir / STATE_FILE)
+            side.ctx.brain[0].save_state(run_dir / runfiles.STATE)
         except Exception as err:  # the state is a bonus; the log must still be finished
             summary["state_error"] = str(err)
 

@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx import __version__, registry
+from cerebx import __version__, registry, runfiles
 from cerebx.build import BuildContext
 from cerebx.config import load
 from cerebx.errors import CerebxError, Diverged
@@ -53,8 +53,8 @@ from cerebx.recording.sentinel import Sentinel
 from cerebx.recording.summary import new_summary, trial_fields, write_summary
 from cerebx.schema.stages import SupervisorConfig
 from cerebx.signals import Frame, Message
-from cerebx.stages.base import wire
 from cerebx.stages.supervisor import Supervisor
+from cerebx.wiring import wire
 
 log = logging.getLogger("cerebx")
 
@@ -367,7 +367,7 @@ def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, hello: Any, overrides: list
     summary = new_summary(cfg, version=__version__, overrides=overrides, started_at=started, side="robot")
     write_summary(run_dir, summary)
     sentinel = Sentinel(run_dir)
-    rec = Recorder(run_dir / "run.mcap", chunk_size_kb=cfg.recording.chunk_size_kb, compression=cfg.link.compression)
+    rec = Recorder(run_dir / runfiles.MCAP, chunk_size_kb=cfg.recording.chunk_size_kb, compression=cfg.link.compression)
     run_id = end.run_id or bytes(16)
     rec.metadata("cerebx", {"version": __version__, "overrides": json.dumps(overrides)})
     rec.metadata("config", {"json": json.dumps(cfg.model_dump(mode="json"))})

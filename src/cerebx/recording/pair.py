@@ -13,13 +13,15 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-ROBOT_DIR = "robot"
+from cerebx import runfiles
+
+ROBOT_DIR = runfiles.ROBOT
 MERGED = "/control"
 
 
 def robot_log(run_dir: Path) -> Path | None:
     """The robot side's log inside a brain-side run folder, if there is one."""
-    p = Path(run_dir) / ROBOT_DIR / "run.mcap"
+    p = Path(run_dir) / ROBOT_DIR / runfiles.MCAP
     return p if p.exists() else None
 
 
