@@ -114,24 +114,23 @@ class PIDVelocity(ControllerConfig):
         return len(self.kp)
 
     def cross_check(self, exp: Any) -> list[str]:
-        out = []
-        if self.n_joints != exp.plant.n_joints:
-            out.append(f"kp: {self.n_joints} joints, plant {exp.plant.kind} has {exp.plant.n_joints}")
-        why = rate_problem(self.rate_hz, exp.control_dt_ms)
-        return out + ([why] if why else [])
+        return periodic_part_problems("kp", self.n_joints, self.rate_hz, exp)
 
     def io(self, n_joints: int) -> StageIO:
         reads = ("ref.qd",) + ((self.correction_signal,) if self.correction_signal else ())
         return StageIO(reads, (Signal("joint.torque", n_joints, "N·m"), Signal(VELOCITY_ERROR, n_joints, "rad/s")))
 
 
-def rate_problem(rate_hz: float, control_dt_ms: float) -> str | None:
-    """Why a part cannot update at ``rate_hz`` on the loop's control step (it must be the loop rate divided
-    by a whole number), or None."""
-    n = 1000.0 / (rate_hz * control_dt_ms)
+def periodic_part_problems(joints_field: str, n_joints: int, rate_hz: float, exp: Any) -> list[str]:
+    """Problems of a part that updates ``n_joints`` joints at ``rate_hz``: it must drive the plant's joints,
+    and its rate must be the loop rate divided by a whole number."""
+    out = []
+    if n_joints != exp.plant.n_joints:
+        out.append(f"{joints_field}: {n_joints} joints, plant {exp.plant.kind} has {exp.plant.n_joints}")
+    n = 1000.0 / (rate_hz * exp.control_dt_ms)
     if abs(n - round(n)) > 1e-9 or round(n) < 1:
-        return f"rate_hz: {rate_hz:g} Hz is not the loop rate divided by a whole number"
-    return None
+        out.append(f"rate_hz: {rate_hz:g} Hz is not the loop rate divided by a whole number")
+    return out
 
 
 def muscle_command_signals(n_joints: int) -> tuple[Signal, Signal]:

@@ -12,7 +12,7 @@ from pydantic import Field, model_validator
 
 from cerebx.lwpr.schema import LWPRParams
 from cerebx.schema.base import PositiveFloat, Strict
-from cerebx.schema.controller import VELOCITY_ERROR, ControllerConfig, rate_problem
+from cerebx.schema.controller import VELOCITY_ERROR, ControllerConfig, periodic_part_problems
 from cerebx.signals import Signal, StageIO
 
 QD_CORRECTION = "capolei.qd_correction"
@@ -92,11 +92,7 @@ class CerebellarModule(ControllerConfig):
         return len(self.signal_range)
 
     def cross_check(self, exp: Any) -> list[str]:
-        out = []
-        if self.n_joints != exp.plant.n_joints:
-            out.append(f"signal_range: {self.n_joints} joints, plant {exp.plant.kind} has {exp.plant.n_joints}")
-        why = rate_problem(self.rate_hz, exp.control_dt_ms)
-        return out + ([why] if why else [])
+        return periodic_part_problems("signal_range", self.n_joints, self.rate_hz, exp)
 
 
 class CapoleiForward(CerebellarModule):
