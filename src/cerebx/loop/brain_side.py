@@ -22,7 +22,6 @@ import os
 import subprocess
 import sys
 import time
-import traceback
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +29,7 @@ import numpy as np
 
 from cerebx import __version__, registry, runfiles
 from cerebx.build import build_components
-from cerebx.errors import CerebxError, Diverged
+from cerebx.errors import CerebxError, LinkLost, PeerEnded, outcome
 from cerebx.link import clock
 from cerebx.link.auth import Signer, key_from_env, new_key, require_key
 from cerebx.link.channel import Arrived, LinkEnd
@@ -41,12 +40,13 @@ from cerebx.link.stats import describe
 from cerebx.link.transport import with_free_ports
 from cerebx.link.wire import Kind, Packet
 from cerebx.loop.loop import RECORD_AS
-from cerebx.loop.realtime import ROBOT_DIR, LinkEvents, LinkLost, PeerEnded, TickLog, side_summary
+from cerebx.loop.phases import brain_phase
+from cerebx.loop.realtime import ROBOT_DIR, LinkEvents, TickLog, side_summary
 from cerebx.metrics import TrialMetrics
 from cerebx.recording.recorder import Recorder
 from cerebx.recording.sentinel import Sentinel
 from cerebx.recording.summary import new_summary, read_summary, trial_fields, write_summary
-from cerebx.signals import Frame, Message
+from cerebx.signals import Message
 
 CHILD_DROPS = ("init_from", "resume", "link.robot", "link.brain", "link.relay", "link.spawn_robot",
                "recording.progress")
@@ -106,7 +106,8 @@ class BrainSide:
             self.trials[int(pkt.info.get("trial", -1))] = pkt.info
         elif pkt.kind == Kind.BYE:
             self.robot_bye = pkt.info
-            raise PeerEnded(str(pkt.info.get("status", "interrupted")), str(pkt.info.get("reason") or ""))
+            status = str(pkt.info.get("status", "interrupted"))
+            raise PeerEnded(status, f"the robot side ended ({status}): {pkt.info.get('reason') or ''}")
 
     def _poll(self) -> None:
         data, control = self.end.poll()
@@ -171,14 +172,7 @@ class BrainSide:
                   file=sys.stderr)
         if began - self._last_packet_ns > self.link.link_lost_after_ms * 1e6:
             raise LinkLost(f"link lost: nothing from the robot side for {(began - self._last_packet_ns) / 1e9:.1f} s")
-        signals = {"ref.q": q_des, "ref.qd": qd_des}
-        if extra:
-            signals.update(extra)
-        if self._sensed is not None:
-            signals.update(self._sensed.values)
-        frame = Frame(k, t, signals, self._sensed)
-        for st in self.brain:
-            st.step(frame)
+        frame, signals = brain_phase(self.brain, k, t, q_des, qd_des, extra, self._sensed)
         out = {name: signals[name] for name in self._sent}
         end.send_message(Message(frame.stamp_s, out), k)
         sent = now_ns()
@@ -283,7 +277,8 @@ def start(end: LinkEnd, offset_ns: int, timeout_s: float) -> int:
             if pkt.kind == Kind.START:
                 return int(pkt.info["t0_ns"])
             if pkt.kind == Kind.BYE:
-                raise PeerEnded(str(pkt.info.get("status")), f"the robot side ended: {pkt.info.get('reason')}")
+                status = str(pkt.info.get("status"))
+                raise PeerEnded(status, f"the robot side ended ({status}): {pkt.info.get('reason')}")
     raise LinkLost(f"link lost: the robot side did not start within {timeout_s:g} s")
 
 
@@ -451,25 +446,14 @@ def _run_paired(cfg: Any, run_dir: Path, ctx: Any, end: LinkEnd, welcome: Packet
         except PeerEnded as err:
             if err.status == "completed" and side.tick >= cfg.trials * ctx.task.steps_per_trial:
                 summary["status"] = "completed"
-            elif err.status == "diverged":
-                summary["status"], summary["error"] = "diverged", f"robot side: {err}"
             else:
-                summary["status"] = "interrupted"
-                summary["error"] = f"the robot side ended ({err.status}): {err}"
-    except PeerEnded as err:
-        summary["status"], summary["error"] = "interrupted", f"the robot side ended ({err.status}): {err}"
-    except LinkLost as err:
-        summary["status"], summary["error"] = "interrupted", str(err)
-        print(f"brain side: {err} (status interrupted, {run_dir})", file=sys.stderr)
-    except KeyboardInterrupt:
-        summary["status"], summary["error"] = "interrupted", "interrupted by signal"
-    except Diverged as err:
-        summary["status"], summary["error"] = "diverged", str(err)
-    except CerebxError as err:
-        summary["status"], summary["error"] = "failed", str(err)
-    except Exception as err:
-        summary["status"], summary["error"] = "failed", f"{type(err).__name__}: {err}"
-        summary["traceback"] = traceback.format_exc()
+                summary.update(outcome(err), status="diverged" if err.status == "diverged" else "interrupted")
+    except BaseException as err:  # recorded in the log and summary.json; the exit code follows it
+        summary.update(outcome(err))
+        if isinstance(err, LinkLost):
+            print(f"brain side: {err} (status interrupted, {run_dir})", file=sys.stderr)
+        if not isinstance(err, (Exception, KeyboardInterrupt)):
+            raise
     finally:
         if summary["status"] == "running":
             summary["status"] = "failed"

@@ -28,10 +28,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from cerebx.errors import Diverged
+from cerebx.loop.phases import DIVERGENCE_CHECK_TICKS, brain_phase, check_diverged, control_message, robot_phase
 from cerebx.metrics import TrialAccumulator, TrialMetrics
 from cerebx.recording.recorder import Recorder
-from cerebx.signals import Frame, Message
+from cerebx.signals import Message
 
 if TYPE_CHECKING:
     from cerebx.build import BuildContext
@@ -104,27 +104,14 @@ class ClosedLoop:
         if arrived:
             self._sensed = arrived[-1]
         # brain
-        signals = {"ref.q": q_des, "ref.qd": qd_des}
-        if extra:
-            signals.update(extra)
-        if self._sensed is not None:
-            signals.update(self._sensed.values)
-        frame = Frame(tick, t, signals, self._sensed)
-        for st in self.brain:
-            st.step(frame)
+        frame, signals = brain_phase(self.brain, tick, t, q_des, qd_des, extra, self._sensed)
         # downlink
         out = {name: signals[name] for name in self._sent}
         link.c2r.send(Message(frame.stamp_s, out), tick)
         # robot
         robot = dict(self.receiver.receive(link.c2r.receive(tick), t))
         robot.update(sensed)
-        rframe = Frame(tick, t, robot)
-        for st in self.robot:
-            st.step(rframe)
-        command = {name: robot[name] for name in self._commands}
-        for name, v in command.items():
-            if not np.isfinite(v).all():
-                raise Diverged(f"trial {trial}, t = {t:.3f} s: non-finite {name} command {v.tolist()}")
+        command = robot_phase(self.robot, tick, t, robot, self._commands, trial)
         # actuate, measure
         applied = plant.actuate(command)
         q, qd = plant.true_state()
@@ -140,22 +127,15 @@ class ClosedLoop:
             for name, field in self._record_as:
                 msg[field] = out[name]
             msg.update({"error": q_des - q, "r2c_ms": link.r2c.last_delay_ms, "c2r_ms": link.c2r.last_delay_ms})
-            for st in self.robot:
-                msg.update(st.record())
-            if ee is not None:
-                msg["ee"] = ee
-            if ee_des is not None:
-                msg["ee_des"] = ee_des
+            control_message(msg, self.robot, ee, ee_des)
             rec.write("/control", "cerebx.Control", t, msg)
         if self.scene is not None:
             self.scene.step(tick, t, ee, ee_des)
         # physics
         plant.step()
         self.tick += 1
-        if tick % 50 == 0:
-            why = plant.is_diverged()
-            if why:
-                raise Diverged(f"trial {trial}, t = {t:.3f} s: {why}")
+        if tick % DIVERGENCE_CHECK_TICKS == 0:
+            check_diverged(plant, trial, t)
         return applied
 
     def run_trial(self, trial: int) -> TrialMetrics:
@@ -175,9 +155,7 @@ class ClosedLoop:
         for i in range(ref.steps):
             self.step(ref.q[i], ref.qd[i], acc, trial, xyz[i] if xyz is not None else None,
                       {name: v[i] for name, v in extra} if extra else None)
-        why = self.plant.is_diverged()
-        if why:
-            raise Diverged(f"trial {trial}: {why}")
+        check_diverged(self.plant, trial)
         m = acc.finish(trial)
         self.metrics.append(m)
         self.trials_done = trial + 1

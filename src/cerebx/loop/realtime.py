@@ -31,7 +31,6 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.errors import CerebxError
 from cerebx.link.stats import describe
 from cerebx.recording.pair import ROBOT_DIR
 from cerebx.recording.recorder import SCHEMAS, Recorder
@@ -55,19 +54,7 @@ SCHEMAS.update({
         "t": _NUM, "offset_ms": _NUM, "uncertainty_ms": _NUM, "method": {"type": "string"}, "probes": _INT}},
 })
 
-__all__ = ["ROBOT_DIR", "LinkEvents", "LinkLost", "PeerEnded", "TickLog", "side_summary"]
-
-
-class LinkLost(CerebxError):
-    """Nothing came from the other side for too long: the run ends, status interrupted."""
-
-
-class PeerEnded(CerebxError):
-    """The other side said it stopped (its BYE): ``status`` is its status, the message its reason."""
-
-    def __init__(self, status: str, reason: str):
-        self.status = status
-        super().__init__(reason)
+__all__ = ["ROBOT_DIR", "LinkEvents", "TickLog", "side_summary"]
 
 
 @dataclass

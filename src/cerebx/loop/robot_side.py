@@ -29,7 +29,6 @@ import json
 import logging
 import sys
 import time
-import traceback
 from datetime import datetime
 from pathlib import Path
 from typing import Any
@@ -39,20 +38,21 @@ import numpy as np
 from cerebx import __version__, registry, runfiles
 from cerebx.build import BuildContext
 from cerebx.config import load
-from cerebx.errors import CerebxError, Diverged
+from cerebx.errors import CerebxError, LinkLost, PeerEnded, outcome
 from cerebx.link.auth import require_key
 from cerebx.link.channel import Arrived, LinkEnd
 from cerebx.link.clock import host_identity, host_steal_ms, now_ns, pace, realtime_process
 from cerebx.link.pairing import START_LEAD_S, RemoteController, fingerprint, pong, wait_for_hello
 from cerebx.link.stats import describe
 from cerebx.link.wire import Kind, Packet
-from cerebx.loop.realtime import LinkEvents, LinkLost, PeerEnded, TickLog, side_summary
+from cerebx.loop.phases import DIVERGENCE_CHECK_TICKS, check_diverged, control_message, robot_phase
+from cerebx.loop.realtime import LinkEvents, TickLog, side_summary
 from cerebx.metrics import TrialAccumulator, TrialMetrics
 from cerebx.recording.recorder import Recorder
 from cerebx.recording.sentinel import Sentinel
 from cerebx.recording.summary import new_summary, trial_fields, write_summary
 from cerebx.schema.stages import SupervisorConfig
-from cerebx.signals import Frame, Message
+from cerebx.signals import Message
 from cerebx.stages.supervisor import Supervisor
 from cerebx.wiring import wire
 
@@ -218,6 +218,11 @@ class RobotSide:
         self.state = new
         self.stops += new == SAFE_STOP
 
+    def _hold(self, robot: dict[str, Any]) -> None:
+        """While the pose is held: the supervisor's correction added to the torque the stages left."""
+        q, qd = robot["joint.q"], robot["joint.qd"]
+        robot["joint.torque"] = robot["joint.torque"] + self._holding.correction(q, qd)
+
     # ------------------------------------------------------------------ one tick
     def step(self, q_des: np.ndarray, qd_des: np.ndarray, acc: TrialAccumulator, trial: int,
              ee_des: np.ndarray | None) -> None:
@@ -246,16 +251,8 @@ class RobotSide:
             self._applied = {name: v * decay for name, v in self._applied.items()}
         robot = dict(self._applied)
         robot.update(sensed)
-        rframe = Frame(k, t, robot)
-        for st in self.robot:
-            st.step(rframe)
-        if self._holding is not None:
-            robot["joint.torque"] = robot["joint.torque"] + self._holding.correction(sensed["joint.q"],
-                                                                                     sensed["joint.qd"])
-        command = {name: robot[name] for name in self._commands}
-        for name, v in command.items():
-            if not np.isfinite(v).all():
-                raise Diverged(f"trial {trial}, t = {t:.3f} s: non-finite {name} command {v.tolist()}")
+        command = robot_phase(self.robot, k, t, robot, self._commands, trial,
+                              self._hold if self._holding is not None else None)
         applied = plant.actuate(command)
         q, qd = plant.true_state()
         ee = plant.end_effector()
@@ -275,12 +272,7 @@ class RobotSide:
                 rec.joint_states("/joint_states/actual", t, q, qd, applied if applied.size == q.size else None)
             msg: dict[str, Any] = {"t": t, "trial": trial, "error": q_des - q, "c2r_ms": self._c2r_ms,
                                    "link_state": self.state}
-            for st in self.robot:
-                msg.update(st.record())
-            if ee is not None:
-                msg["ee"] = ee
-            if ee_des is not None:
-                msg["ee_des"] = ee_des
+            control_message(msg, self.robot, ee, ee_des)
             rec.write("/control", "cerebx.Control", t, msg)
         plant.step()
         done = now_ns()
@@ -296,10 +288,8 @@ class RobotSide:
                    "state": self.state})
         self.ended_ns = done
         self.tick += 1
-        if k % 50 == 0:
-            why = plant.is_diverged()
-            if why:
-                raise Diverged(f"trial {trial}, t = {t:.3f} s: {why}")
+        if k % DIVERGENCE_CHECK_TICKS == 0:
+            check_diverged(plant, trial, t)
 
     def run_trial(self, trial: int) -> TrialMetrics:
         ref = self.task.trial(trial, self._task_rng)
@@ -313,9 +303,7 @@ class RobotSide:
         xyz = ref.xyz
         for i in range(ref.steps):
             self.step(ref.q[i], ref.qd[i], acc, trial, xyz[i] if xyz is not None else None)
-        why = self.plant.is_diverged()
-        if why:
-            raise Diverged(f"trial {trial}: {why}")
+        check_diverged(self.plant, trial)
         m = acc.finish(trial)
         self.metrics.append(m)
         self.trials_done = trial + 1
@@ -390,17 +378,10 @@ def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, hello: Any, overrides: list
             summary.update(trial_fields(side.metrics, side.sim_seconds))
             write_summary(run_dir, summary)
         summary["status"] = "completed"
-    except (PeerEnded, LinkLost) as err:
-        summary["status"], summary["error"] = "interrupted", str(err)
-    except KeyboardInterrupt:
-        summary["status"], summary["error"] = "interrupted", "interrupted by signal"
-    except Diverged as err:
-        summary["status"], summary["error"] = "diverged", str(err)
-    except CerebxError as err:
-        summary["status"], summary["error"] = "failed", str(err)
-    except Exception as err:
-        summary["status"], summary["error"] = "failed", f"{type(err).__name__}: {err}"
-        summary["traceback"] = traceback.format_exc()
+    except BaseException as err:  # recorded in the log and summary.json; the exit code follows it
+        summary.update(outcome(err))
+        if not isinstance(err, (Exception, KeyboardInterrupt)):
+            raise
     finally:
         if summary["status"] == "running":
             summary["status"] = "failed"

@@ -8,7 +8,6 @@ import logging
 import signal
 import sys
 import time
-import traceback
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -17,7 +16,7 @@ from tqdm import tqdm
 
 from cerebx import __version__, runfiles
 from cerebx.build import build_components
-from cerebx.errors import CerebxError, Diverged
+from cerebx.errors import CerebxError, outcome
 from cerebx.loop import resume
 from cerebx.loop.brain_side import run_brain_side
 from cerebx.loop.loop import ClosedLoop
@@ -106,17 +105,10 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
                                wall_seconds=wall_before + time.perf_counter() - wall0)
                 write_summary(run_dir, summary)
             summary["status"] = "completed"
-    except KeyboardInterrupt:
-        summary["status"] = "interrupted"
-        summary["error"] = "interrupted by signal"
-    except Diverged as err:
-        summary["status"] = "diverged"
-        summary["error"] = str(err)
-    except CerebxError as err:
-        summary["status"], summary["error"] = "failed", str(err)
-    except Exception as err:  # record any crash, then re-raise for the caller's exit code
-        summary["status"], summary["error"] = "failed", f"{type(err).__name__}: {err}"
-        summary["traceback"] = traceback.format_exc()
+    except BaseException as err:  # recorded in the log and summary.json; the caller's exit code follows it
+        summary.update(outcome(err))
+        if not isinstance(err, (Exception, KeyboardInterrupt)):
+            raise
     finally:
         if bar is not None:
             bar.close()

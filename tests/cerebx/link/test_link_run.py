@@ -270,7 +270,9 @@ def test_fuzzed_packets_to_the_robot_port(tmp_path):
     run = tmp_path / "run"
     addr = ports()
     robot = ("127.0.0.1", int(addr[0].rsplit(":", 1)[1]))
-    brain = start(["run", *PD, "link=udp", "trials=3", f"hydra.run.dir={run}", *addr])
+    # long enough (20 s of wall clock) that the robot side still listens when the last packet is sent,
+    # even when generating the packets is slow on a busy machine
+    brain = start(["run", *PD, "link=udp", "trials=10", f"hydra.run.dir={run}", *addr])
     wait_for(lambda: ticking(run), 60, "the robot side")
     time.sleep(1.0)
     sent = []
