@@ -45,7 +45,7 @@ from cerebx.loop.realtime import ROBOT_DIR, LinkEvents, TickLog, side_summary
 from cerebx.metrics import TrialMetrics
 from cerebx.recording.recorder import Recorder
 from cerebx.recording.sentinel import Sentinel
-from cerebx.recording.summary import new_summary, read_summary, trial_fields, write_summary
+from cerebx.recording.summary import finish_run, new_summary, read_summary, trial_fields, write_summary
 from cerebx.signals import Message
 
 CHILD_DROPS = ("init_from", "resume", "link.robot", "link.brain", "link.relay", "link.spawn_robot",
@@ -460,12 +460,7 @@ def _run_paired(cfg: Any, run_dir: Path, ctx: Any, end: LinkEnd, welcome: Packet
         if side is not None and (side.robot_bye is None or summary["status"] != "completed"):
             _bye(end, summary)
         _finish(cfg, run_dir, summary, side, end, events, sync, wall0, children)
-        try:
-            rec.metadata("summary", {"json": json.dumps(summary)})
-        finally:
-            rec.close()
-            write_summary(run_dir, summary)
-            sentinel.done()
+        finish_run(rec, run_dir, summary, sentinel)
     return summary
 
 

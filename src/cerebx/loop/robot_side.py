@@ -50,7 +50,7 @@ from cerebx.loop.realtime import LinkEvents, TickLog, side_summary
 from cerebx.metrics import TrialAccumulator, TrialMetrics
 from cerebx.recording.recorder import Recorder
 from cerebx.recording.sentinel import Sentinel
-from cerebx.recording.summary import new_summary, trial_fields, write_summary
+from cerebx.recording.summary import finish_run, new_summary, trial_fields, write_summary
 from cerebx.schema.stages import SupervisorConfig
 from cerebx.signals import Message
 from cerebx.stages.supervisor import Supervisor
@@ -395,12 +395,7 @@ def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, hello: Any, overrides: list
         summary["link"] = side_summary(cfg, "robot", run_id, end, timing, events)
         if not isinstance(summary.get("error"), str) or not summary["error"].startswith("the brain side ended"):
             _bye(end, summary, timing)
-        try:
-            rec.metadata("summary", {"json": json.dumps(summary)})
-        finally:
-            rec.close()
-            write_summary(run_dir, summary)
-            sentinel.done()
+        finish_run(rec, run_dir, summary, sentinel)
     return summary
 
 

@@ -24,7 +24,7 @@ from cerebx.recording import live as live_view
 from cerebx.recording.recorder import Recorder
 from cerebx.recording.scene import scene_writer
 from cerebx.recording.sentinel import Sentinel
-from cerebx.recording.summary import new_summary, trial_fields, write_summary
+from cerebx.recording.summary import finish_run, new_summary, trial_fields, write_summary
 
 log = logging.getLogger("cerebx")
 
@@ -125,13 +125,10 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
         summary["wall_seconds"] = wall
         summary["rt_factor"] = summary["sim_seconds"] / wall if wall > 0 else None
         try:
-            rec.metadata("summary", {"json": json.dumps(summary)})
+            finish_run(rec, run_dir, summary, sentinel)
         finally:
-            rec.close()
             if live is not None:
                 live.stop()
-            write_summary(run_dir, summary)
-            sentinel.done()
             if summary["status"] == "completed":
                 resume.finish(run_dir)
     return summary

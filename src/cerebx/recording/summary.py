@@ -144,3 +144,14 @@ def trial_fields(metrics: list[Any], sim_seconds: float) -> dict[str, Any]:
             "torque_variability_per_trial": [m.torque_variability_Nm_per_ms for m in metrics],
             "ee_error_per_trial": [m.ee_error_m for m in metrics],
             "final_mae": final_mae(mae), "sim_seconds": sim_seconds}
+
+
+def finish_run(rec: Any, run_dir: Path, summary: dict[str, Any], sentinel: Any) -> None:
+    """The last step of every run, whatever ended it: the summary into the log's metadata, the log closed
+    (its summary and footer written), ``summary.json`` written, the sentinel told the run ended itself."""
+    try:
+        rec.metadata("summary", {"json": json.dumps(summary)})
+    finally:
+        rec.close()
+        write_summary(run_dir, summary)
+        sentinel.done()
