@@ -496,11 +496,18 @@ def _update_output(sub, cfg, wk, y):
 
 
 @njit(**_INLINE)
-def _update_sample(st, cfg, wk, x, y, out):
-    """One training pair for every output (each with a free slot); out gets the predictions."""
+def _normalise_input(cfg, wk, x):
+    """The input divided by its normalisation into the workspace; returns its dimension."""
     n = x.shape[0]
     for i in range(n):
         wk.xn[i] = x[i] / cfg[N_HP + i]
+    return n
+
+
+@njit(**_INLINE)
+def _update_sample(st, cfg, wk, x, y, out):
+    """One training pair for every output (each with a free slot); out gets the predictions."""
+    n = _normalise_input(cfg, wk, x)
     for d in range(y.shape[0]):
         norm = cfg[N_HP + n + d]
         out[d] = _update_output(_sub(st, d), cfg, wk, y[d] / norm) * norm
@@ -573,9 +580,7 @@ def _predict_output(sub, cfg, wk, act):
 
 @njit(**_INLINE)
 def _predict_sample(st, cfg, wk, x, out, act):
-    n = x.shape[0]
-    for i in range(n):
-        wk.xn[i] = x[i] / cfg[N_HP + i]
+    n = _normalise_input(cfg, wk, x)
     for d in range(out.shape[0]):
         out[d] = _predict_output(_sub(st, d), cfg, wk, act[d]) * cfg[N_HP + n + d]
 
