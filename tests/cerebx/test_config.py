@@ -109,6 +109,8 @@ INVALID = [
       "+controller.mf.ranges={kind: given, q_min: [0,0,0,0,0,0], q_max: [1,1,1,1,1,0], "
       "qd_des_min: [0,0,0,0,0,0], qd_des_max: [1,1,1,1,1,1], qd_min: [0,0,0,0,0,0], qd_max: [1,1,1,1,1,1]}"],
      "controller.mf.ranges: q_min must be below q_max (empty range at joint 5)"),
+    (["+experiment=demo", "robot=[{kind: hold}, {kind: mean}]"],
+     "robot.1: 'mean' is a receiver, which can only be the first robot stage"),
 ]
 
 
