@@ -135,6 +135,14 @@ def test_sweep_is_checked_before_any_job(in_tmp, capsys):
     assert not (in_tmp / "runs").exists()
 
 
+def test_a_sweep_cannot_print_its_config(in_tmp, capsys):
+    code = main(["run", "-m", "+experiment=demo", "seed=1,2", "--cfg", "job"])
+    assert code == 2
+    assert capsys.readouterr().err.strip().splitlines() == ["--cfg: cannot be combined with -m (drop -m to see one "
+                                                            "job's config)"]
+    assert not (in_tmp / "runs").exists()
+
+
 def test_config_cannot_import_code(load):
     """A '_target_' in config is refused before Hydra composes anything (tests/test_honesty.py: every route)."""
     with pytest.raises(Exception, match="controller._target_: names a Python callable"):
