@@ -147,7 +147,7 @@ class _ExperimentBase(Strict):
                 if side not in st.sides:
                     problems.append(f"{side}.{i}: stage {st.kind!r} runs on the {' or '.join(st.sides)} side")
                 elif st.receiver and not (side == "robot" and i == 0):
-                    problems.append(f"{side}.{i}: {st.kind!r} is a receiver; it can only be the first robot stage")
+                    problems.append(f"{side}.{i}: {st.kind!r} is a receiver, which can only be the first robot stage")
         for slot in BODY_SLOTS:
             st = getattr(self, slot)
             if st is None:
