@@ -115,8 +115,9 @@ class _ExperimentBase(Strict):
         0, ge=0, description="the first trials let a learned controller settle onto the path; they are run and "
         "logged like the others, and the report leaves them out of its statistics")
     link: Plugin("link") = Field(
-        {"kind": "sim"}, description="the link between the brain side and the robot side: sim (the tick-grid link of "
-        "one simulated-time process) or a transport between processes (zenoh, udp; see SPEC §5.1)")
+        {"kind": "sim"}, description="the link between the brain side and the robot side: sim (the tick-grid link "
+        "of one simulated-time process) or a transport between processes (zenoh, udp; see "
+        "docs/guide/delays.md#real-links)")
     clock: Literal["sim", "wall"] = Field(
         "sim", description="sim: simulated time, deterministic; wall: the robot side paced by the wall clock at the "
         "control rate (needs a real link)")
