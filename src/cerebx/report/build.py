@@ -227,7 +227,7 @@ def main(argv: list[str]) -> int:
                     "`cerebx run -m`, whose launcher runs its jobs")
     ap.add_argument("-o", "--override", action="append", default=[], metavar="OVERRIDE",
                     help="Hydra override for every study's multirun, e.g. -o hydra/launcher=slurm "
-                    "(repeatable; see README 'Sweeps on SLURM')")
+                    "(repeatable; see docs/guide/sweeps.md)")
     ap.add_argument("--dry-run", action="store_true", help="with --profile: list the jobs, run nothing")
     ap.add_argument("--out", type=Path, default=Path("reports"), help="output folder (default reports/)")
     ap.add_argument("--list", action="store_true", help="list the figures and the studies they need")

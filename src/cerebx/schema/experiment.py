@@ -117,7 +117,7 @@ class _ExperimentBase(Strict):
     link: Plugin("link") = Field(
         {"kind": "sim"}, description="the link between the brain side and the robot side: sim (the tick-grid link "
         "of one simulated-time process) or a transport between processes (zenoh, udp; see "
-        "docs/guide/delays.md#real-links)")
+        "docs/guide/links.md)")
     clock: Literal["sim", "wall"] = Field(
         "sim", description="sim: simulated time, deterministic; wall: the robot side paced by the wall clock at the "
         "control rate (needs a real link)")
