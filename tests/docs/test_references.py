@@ -1,6 +1,7 @@
 """Every reference in the code and the docs resolves inside the repository: no citation of files that are not
 in it (the shared facts sheets, the product specification, paths of a development machine), and every
-``docs/<page>.md#anchor`` the code cites names a heading that exists on that page."""
+``docs/<page>.md#anchor`` the code cites names a heading that exists on that page; the README stays short and
+every link in it resolves."""
 
 from __future__ import annotations
 
@@ -21,7 +22,8 @@ OUTSIDE = {
         r"|\b(original_implementation|baxter_left_arm|upper_limb_arm26|luque2011_capolei2020|dependency_stack_notes)"
         r"\.md\b"),
     "the product specification": re.compile(r"\bSPEC\b|\bSPEC\.md\b"),
-    "a path of a development machine": re.compile(r"/work/|/home/|/Users/|\.\./shared\b|\bshared/(facts|seeds)\b"),
+    "a path of a development machine": re.compile(
+        r"/work/|/home/|/Users/|(?<![\w.])/tmp/|\.\./shared\b|\bshared/(facts|seeds)\b"),
 }
 CITATION = re.compile(r"\bdocs/((?:[\w-]+/)*[\w-]+\.md)(?:#([\w-]+))?")
 ANCHORED_PAGES = {"models.md", "provenance.md"}  # reference pages: the code cites one of their sections
@@ -80,7 +82,7 @@ def outside_citations(files: list[Path], pattern: re.Pattern) -> list[str]:
 
 def citation_problems(files: list[Path], docs: Path = DOCS) -> list[str]:
     """Citations of ``docs/<page>.md[#anchor]`` whose page or heading does not exist, or that cite a reference
-    page without a section."""
+    page without a section from code or configuration."""
     cache: dict[str, set[str] | None] = {}
     problems = []
     for f in files:
@@ -93,7 +95,7 @@ def citation_problems(files: list[Path], docs: Path = DOCS) -> list[str]:
                     problems.append(f"{where}: docs/{page} does not exist")
                 elif anchor and anchor not in cache[page]:
                     problems.append(f"{where}: docs/{page} has no heading #{anchor}")
-                elif not anchor and page in ANCHORED_PAGES:
+                elif not anchor and page in ANCHORED_PAGES and f.suffix != ".md":  # a page may link a whole page
                     problems.append(f"{where}: docs/{page} cited without a section (#anchor)")
     return problems
 
@@ -123,6 +125,33 @@ def test_the_code_cites_the_reference_pages():
     assert ANCHORED_PAGES <= cited
 
 
+MD_LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")
+README_MAX_LINES = 150
+
+
+def link_problems(page: Path, root: Path = ROOT) -> list[str]:
+    """Relative links of a Markdown file whose target (file or folder, and heading if one is named) does not
+    exist; web links are not followed."""
+    problems = []
+    for where, line in _lines(page):
+        for target in MD_LINK.findall(line):
+            if re.match(r"[a-z]+:", target) or target.startswith("#"):
+                continue
+            path, _, anchor = target.partition("#")
+            dest = (page.parent / path).resolve()
+            if not dest.exists() or not dest.is_relative_to(root):
+                problems.append(f"{where}: {target} does not exist in the repository")
+            elif anchor and dest.suffix == ".md" and anchor not in anchors(dest):
+                problems.append(f"{where}: {path} has no heading #{anchor}")
+    return problems
+
+
+def test_the_readme_is_short_and_its_links_resolve():
+    readme = ROOT / "README.md"
+    assert len(readme.read_text(encoding="utf-8").splitlines()) <= README_MAX_LINES
+    assert link_problems(readme) == []
+
+
 def test_planted_bad_references_are_caught(tmp_path):
     docs = tmp_path / "docs"
     docs.mkdir()
@@ -137,6 +166,12 @@ def test_planted_bad_references_are_caught(tmp_path):
         "docs/nowhere.md does not exist"]
     for what, pattern in OUTSIDE.items():
         assert outside_citations([code], pattern), what
+    readme = tmp_path / "README.md"
+    readme.write_text("[ok](docs/models.md#kernel-stdp) [web](https://x.org) ![no](docs/fig.png) "
+                      "[bad](docs/models.md#nowhere) [up](../outside.md)\n")
+    assert [p.split(": ", 1)[1] for p in link_problems(readme, tmp_path)] == [
+        "docs/fig.png does not exist in the repository", "docs/models.md has no heading #nowhere",
+        "../outside.md does not exist in the repository"]
     code.write_text("# artefacts and the facts of life; a spec; docs/models.md#kernel-stdp\n")
     assert not citation_problems([code], docs)
     assert not any(outside_citations([code], pattern) for pattern in OUTSIDE.values())
