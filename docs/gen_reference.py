@@ -75,6 +75,10 @@ def options_page() -> str:
            "with its fields, and every preset of every config group, cerebx's and each installed plugin's. "
            "`cerebx validate +task=NAME ...` prints a composed configuration.", "",
            "## The experiment", "", "Top-level keys of every experiment:", "", *fields_table(experiment_model()), ""]
+    for name, field in experiment_model().model_fields.items():  # nested blocks that are not kinds: recording, live
+        block = field.annotation
+        if isinstance(block, type) and issubclass(block, BaseModel):
+            out += [f"### `{name}` {{#experiment-{name}}}", "", summary(block), "", *fields_table(block), ""]
     for group, reg in registry.GROUPS.items():
         out += [f"## Kinds: {group}", "", GROUP_TEXT.get(group, ""), "",
                 "| kind | plugin | what it is |", "|---|---|---|"]

@@ -6,9 +6,9 @@ zstd chunks of 256 kB, every step recorded):
 ===========================================  ======================  ==========================
 run                                          run.mcap per sim. s     wall
 ===========================================  ======================  ==========================
-planar2 + PD (``+experiment=demo``)          113 kB                  README bench
-Baxter + PD                                  288 kB                  README bench
-Baxter + SNN ``small`` / ``full``      285 kB / 320 kB         README bench
+planar2 + PD (``+experiment=demo``)          113 kB                  docs/guide/speed.md
+Baxter + PD                                  288 kB                  docs/guide/speed.md
+Baxter + SNN ``small`` / ``full``      285 kB / 320 kB         docs/guide/speed.md
 ===========================================  ======================  ==========================
 
 hence about 25 kB/s plus 44 kB/s per joint for the joint and control channels, and 32 kB/s for the

@@ -1,4 +1,4 @@
-"""Per-trial metrics (SPEC §6): position MAE per joint and mean (Eq. 2.21-2.22 with |.|),
+"""Per-trial metrics (docs/models.md#metrics): position MAE per joint and mean (Eq. 2.21-2.22 with |.|),
 velocity MAE, torque variability (Eq. 3.14-3.15, absolute step differences, N·m/ms),
 end-effector Cartesian error; and learning-curve summaries over trial windows."""
 
@@ -64,7 +64,7 @@ def final_mae(mae_per_trial: list[float]) -> float | None:
 
 
 def window_stats(mae_per_trial: list[float], start: int, stop: int) -> tuple[float, float] | None:
-    """Mean and std of trials [start, stop) as in Tables 2.3 / 2.4."""
+    """Mean and std of trials [start, stop) (docs/models.md#learning-curve-summaries)."""
     w = np.asarray(mae_per_trial[start:stop])
     if w.size == 0:
         return None
@@ -72,14 +72,14 @@ def window_stats(mae_per_trial: list[float], start: int, stop: int) -> tuple[flo
 
 
 def trials_to_threshold(mae_per_trial: list[float], threshold: float) -> int | None:
-    """First trial whose MAE is at or below ``threshold`` (Fig. 4.5 B)."""
+    """First trial whose MAE is at or below ``threshold`` (docs/models.md#learning-curve-summaries)."""
     for i, v in enumerate(mae_per_trial):
         if v <= threshold:
             return i
     return None
 
 
-# ---- learning estimators over a MAE curve (one value per trial; docs/models.md) ----------------------
+# ---- learning estimators over a MAE curve (one value per trial; docs/models.md#learning-estimators) ----------
 
 def final_error(mae_per_trial: list[float], n: int = 30) -> float:
     """Eq. 9: mean MAE of the last ``n`` trials."""
@@ -103,7 +103,7 @@ def convergence_speed(mae_per_trial: list[float], n: int = 30) -> int:
 
 
 def improvement_pct(mae_per_trial: list[float], at_trial: int, n: int = 30) -> float:
-    """Error reduction in % by ``at_trial`` (Fig. 11/12): 100 (1 - mean MAE of the ``n`` trials before it /
-    MAE of the first trial)."""
+    """Error reduction in % by ``at_trial``: 100 (1 - mean MAE of the ``n`` trials before it / MAE of the
+    first trial) (docs/models.md#learning-estimators)."""
     mae = np.asarray(mae_per_trial, float)
     return float(100.0 * (1.0 - mae[max(0, at_trial - n):at_trial].mean() / mae[0]))

@@ -1,7 +1,7 @@
 """Three moving joints of a KUKA LWR 4+ (A1, A2, A4), torque-driven, with an object at the hand.
 
 The MJCF beside this file (``lwr3.xml``) carries the URDF kinematics and inertias of the LWR 4+ of
-kuka-isir/rtt_lwr (facts luque2011_capolei2020.md §1: 0.102 m base, 0.2085/0.1915 m segments, 2.3 kg
+kuka-isir/rtt_lwr (docs/provenance.md#lightweight-arm: 0.102 m base, 0.2085/0.1915 m segments, 2.3 kg
 links); the DLR LWR-III of Luque et al. 2011 has the same layout but its parameters are not
 published. Constructed here: which three joints move (A1 yaw, A2 shoulder pitch, A4 elbow pitch;
 A3, A5-A7 are fixed at 0), the object's place (a sphere whose centre is 4 cm beyond the flange) and

@@ -2,7 +2,7 @@
 arm, the eight-shaped joint trajectory, and the crude inverse dynamics model (the arm without the object).
 
 Numbers from the paper (IEEE TSMC-B 2011) are marked *paper*; numbers it does not give are *constructed*
-(chosen here; see the package's README section)."""
+(chosen here; docs/models.md#luque-eight, docs/provenance.md#lwr-differences)."""
 
 from __future__ import annotations
 
@@ -17,14 +17,15 @@ from cerebx.signals import Signal, StageIO
 
 class LWR3Config(PlantSchema):
     """Three joints (A1, A2, A4) of a KUKA LWR 4+ as a stand-in for the DLR LWR-III of Luque et al. 2011;
-    link masses, lengths and inertias from a published URDF (docs/provenance.md, lightweight arm), the other
+    link masses, lengths and inertias from a published URDF (docs/provenance.md#lightweight-arm), the other
     joints fixed at 0. An object can hang at the end of the last segment (``object_mass_kg`` from the start,
     or the ``attach_payload`` event)."""
 
     kind: Literal["lwr3"] = "lwr3"
     physics_dt_ms: PhysicsStepMs = 0.5
     torque_limit_Nm: tuple[PositiveFloat, PositiveFloat, PositiveFloat] = Field(
-        (176.0, 176.0, 100.0), description="actuator saturation of A1, A2, A4 (LWR 4+ limits, facts §1.2)"
+        (176.0, 176.0, 100.0),
+        description="actuator saturation of A1, A2, A4 (LWR 4+ limits, docs/provenance.md#lwr-kinematics)",
     )
     damping_Nms_per_rad: NonNegFloat = Field(1.0, description="viscous joint damping (the Gazebo URDF's 1.0)")
     stiffness_Nm_per_rad: tuple[NonNegFloat, NonNegFloat, NonNegFloat] = Field(

@@ -109,6 +109,8 @@ INVALID = [
       "+controller.mf.ranges={kind: given, q_min: [0,0,0,0,0,0], q_max: [1,1,1,1,1,0], "
       "qd_des_min: [0,0,0,0,0,0], qd_des_max: [1,1,1,1,1,1], qd_min: [0,0,0,0,0,0], qd_max: [1,1,1,1,1,1]}"],
      "controller.mf.ranges: q_min must be below q_max (empty range at joint 5)"),
+    (["+experiment=demo", "robot=[{kind: hold}, {kind: mean}]"],
+     "robot.1: 'mean' is a receiver, which can only be the first robot stage"),
 ]
 
 
@@ -130,6 +132,14 @@ def test_sweep_is_checked_before_any_job(in_tmp, capsys):
     err = capsys.readouterr().err
     assert code == 2
     assert "plant.physics_dt_ms=0.3" in err and "does not divide" in err
+    assert not (in_tmp / "runs").exists()
+
+
+def test_a_sweep_cannot_print_its_config(in_tmp, capsys):
+    code = main(["run", "-m", "+experiment=demo", "seed=1,2", "--cfg", "job"])
+    assert code == 2
+    assert capsys.readouterr().err.strip().splitlines() == ["--cfg: cannot be combined with -m (drop -m to see one "
+                                                            "job's config)"]
     assert not (in_tmp / "runs").exists()
 
 

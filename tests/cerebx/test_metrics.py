@@ -1,4 +1,4 @@
-"""Learning-curve summaries with known answers (SPEC §6, Tables 2.3/2.4)."""
+"""Learning-curve summaries with known answers (docs/models.md#learning-curve-summaries)."""
 
 from __future__ import annotations
 

@@ -23,6 +23,7 @@ PASS_THROUGH = ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i", "
                 "--package", "-p", "-sc", "--shell-completion", "--config-dir", "-cd",
                 "--config-name", "-cn", "--config-path", "-cp", "--experimental-rerun")
 INFO = ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i", "-sc", "--shell-completion")
+NOT_WITH_MULTIRUN = ("--cfg", "-c", "--info", "-i", "-sc", "--shell-completion")  # Hydra does one of these or -m
 
 def main(args: list[str]) -> int:
     problems = check_args(args)  # before Hydra reads any of it, whatever the flags
@@ -33,6 +34,9 @@ def main(args: list[str]) -> int:
     if problems:
         return fail(problems)
     multirun = any(a in ("-m", "--multirun") for a in args)
+    exclusive = [a.split("=")[0] for a in args if a.split("=")[0] in NOT_WITH_MULTIRUN]
+    if multirun and exclusive:
+        return fail([f"{exclusive[0]}: cannot be combined with -m (drop -m to see one job's config)"])
     runs = not any(a.split("=")[0] in INFO for a in args)  # --help, --cfg ... make no folder
     if runs:
         problems = check_output_dir(args, multirun)

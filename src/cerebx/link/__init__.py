@@ -1,4 +1,4 @@
-"""The real link between the brain side and the robot side (SPEC §5.1).
+"""The real link between the brain side and the robot side (docs/guide/links.md).
 
 In simulated time the link is the tick-grid delay channel of ``loop/link.py``. With a real link the
 two sides are separate processes joined by a registered transport (``zenoh``, ``udp``; a plugin may

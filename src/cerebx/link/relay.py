@@ -1,5 +1,5 @@
 """The delay relay: a separate process on the real path that holds each data packet for a delay drawn
-from a cerebx delay model, as the original's delay-generator nodes did (facts §7).
+from a cerebx delay model, as the original's delay-generator nodes did (docs/provenance.md#original-delays).
 
 It receives hop 0 of both paths and sends hop 1. Each SENSOR (``r2c``) and COMMAND (``c2r``) packet is
 held for ``delay.r2c.next_ms()`` / ``delay.c2r.next_ms()`` (the samplers ``delay=`` builds, seeded from

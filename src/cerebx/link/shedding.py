@@ -1,5 +1,5 @@
 """The brain side's watchdog: sheds work in steps as the brain side falls behind the wall clock, after
-the original implementation's real-time restriction (facts §9).
+the original implementation's real-time restriction (docs/provenance.md#edlut-watchdog).
 
 The original let the network run ahead of the wall clock by at most ``0.9 x`` the pathway delay and
 measured how much of that lead was left. Here the lead of a tick is that maximum less how late the

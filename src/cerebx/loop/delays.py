@@ -45,8 +45,8 @@ class Gamma:
 
 
 class HalfRoundTrip:
-    """The original symmetric delay (facts §7): one limited round-trip sample per step, half on
-    each path. The R2C message of a step is sent first and draws; the C2R one reuses the draw."""
+    """The original symmetric delay (docs/provenance.md#original-delays): one limited round-trip sample
+    per step, half on each path. The R2C message of a step is sent first and draws; the C2R one reuses the draw."""
 
     def __init__(self, round_trip: Gamma):
         self.round_trip = round_trip

@@ -1,7 +1,7 @@
 """The link between the brain side and the robot side: one delay channel each way.
 
 A message sent at tick k with sampled delay d is released at the first tick whose time is at
-least stamp + d; a later message is never released before an earlier one (facts §7). The link is
+least stamp + d; a later message is never released before an earlier one (docs/models.md#delays). The link is
 simulated on the tick grid; a real transport would offer the same four calls.
 """
 

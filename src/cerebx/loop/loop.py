@@ -1,4 +1,4 @@
-"""The closed loop: one tick order for every experiment (SPEC §1), stepped by ``cerebx run``,
+"""The closed loop: one tick order for every experiment, stepped by ``cerebx run``,
 ``cerebx tune`` and ``cerebx bench`` alike.
 
 One tick (2 ms, integer tick counter, simulated time = tick x control step):

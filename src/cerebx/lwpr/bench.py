@@ -1,5 +1,5 @@
 """Speed and accuracy of LWPR on the reference library's own examples (Klanke & Vijayakumar, LWPR v1.2;
-docs/provenance.md, LWPR): the 2-D cross of ``example_c/cross.c`` and the 1-D function of
+docs/provenance.md#lwpr-benchmark): the 2-D cross of ``example_c/cross.c`` and the 1-D function of
 ``matlab/test_lwpr_1D.m``, each with that example's parameters, noise and number of samples."""
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ class Task(NamedTuple):
 
 
 def cross(x: np.ndarray) -> np.ndarray:
-    """The 2-D "cross" test function of the LWPR library (facts §3.2)."""
+    """The 2-D "cross" test function of the LWPR library (docs/provenance.md#lwpr-benchmark)."""
     return np.maximum.reduce([np.exp(-10 * x[..., 0] ** 2), np.exp(-50 * x[..., 1] ** 2),
                               1.25 * np.exp(-5 * (x[..., 0] ** 2 + x[..., 1] ** 2))])
 

@@ -1,5 +1,5 @@
 """numba kernels of LWPR (Vijayakumar, D'Souza & Schaal 2005; update order of the reference
-library, docs/provenance.md, LWPR). One output dimension = one sub-model. A whole model
+library, docs/provenance.md#lwpr-algorithm). One output dimension = one sub-model. A whole model
 lives in one flat float64 buffer (:func:`regions` gives the offsets); RF ``k`` of output ``d`` is row
 ``[d, k]`` of the views of its :class:`Store`:
 

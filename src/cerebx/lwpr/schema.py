@@ -1,5 +1,5 @@
 """Parameters of an LWPR model. Defaults are those of the reference library (Klanke & Vijayakumar,
-LWPR v1.2, ``lwpr_init_model``; docs/provenance.md, LWPR)."""
+LWPR v1.2, ``lwpr_init_model``; docs/provenance.md#lwpr-defaults)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""MuJoCo model of the Baxter robot's left arm (SPEC §3.1), built from facts/baxter_left_arm.md.
+"""MuJoCo model of the Baxter robot's left arm, built from its URDF (docs/provenance.md#baxter-left-arm; what differs
+from the URDF and why: docs/provenance.md#baxter-model-differences).
 
 The MJCF beside this file (``baxter.xml``) is the robot: URDF kinematics and inertias, seven joints.
 The simulation removes w2 (the wrist and hand become rigid children of the lower forearm at w2 = 0)

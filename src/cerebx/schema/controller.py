@@ -56,7 +56,7 @@ class ControllerConfig(Strict):
 
 
 class PDController(ControllerConfig):
-    """tau = kp (q_d - q) + kd (qd_d - qd), saturated at +-tau_max (facts §6)."""
+    """tau = kp (q_d - q) + kd (qd_d - qd), saturated at +-tau_max (docs/models.md#pd)."""
 
     kind: Literal["pd"] = "pd"
     kp: tuple[float, ...] = (45.0, 50.0, 17.0, 50.0, 22.0, 27.0)
@@ -139,7 +139,8 @@ def muscle_command_signals(n_joints: int) -> tuple[Signal, Signal]:
 
 
 class GivenRanges(Strict):
-    """Encoder ranges per joint for each of the four MF signals (facts §3 launch-file tables)."""
+    """Encoder ranges per joint for each of the four MF signals (the original launch files:
+    docs/provenance.md#original-mf-ranges)."""
 
     kind: Literal["given"] = "given"
     q_min: tuple[float, ...]

@@ -47,7 +47,8 @@ class GammaParams(Strict):
 
 
 class GammaDelay(Strict):
-    """A new gamma-distributed delay each step per direction, with the monotonic limiter (facts §7)."""
+    """A new gamma-distributed delay each step per direction, with the monotonic limiter
+    (docs/models.md#delay-gamma)."""
 
     kind: Literal["gamma"] = "gamma"
     r2c: GammaParams

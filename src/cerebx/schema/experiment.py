@@ -115,8 +115,9 @@ class _ExperimentBase(Strict):
         0, ge=0, description="the first trials let a learned controller settle onto the path; they are run and "
         "logged like the others, and the report leaves them out of its statistics")
     link: Plugin("link") = Field(
-        {"kind": "sim"}, description="the link between the brain side and the robot side: sim (the tick-grid link of "
-        "one simulated-time process) or a transport between processes (zenoh, udp; see SPEC §5.1)")
+        {"kind": "sim"}, description="the link between the brain side and the robot side: sim (the tick-grid link "
+        "of one simulated-time process) or a transport between processes (zenoh, udp; see "
+        "docs/guide/links.md)")
     clock: Literal["sim", "wall"] = Field(
         "sim", description="sim: simulated time, deterministic; wall: the robot side paced by the wall clock at the "
         "control rate (needs a real link)")
@@ -147,7 +148,7 @@ class _ExperimentBase(Strict):
                 if side not in st.sides:
                     problems.append(f"{side}.{i}: stage {st.kind!r} runs on the {' or '.join(st.sides)} side")
                 elif st.receiver and not (side == "robot" and i == 0):
-                    problems.append(f"{side}.{i}: {st.kind!r} is a receiver; it can only be the first robot stage")
+                    problems.append(f"{side}.{i}: {st.kind!r} is a receiver, which can only be the first robot stage")
         for slot in BODY_SLOTS:
             st = getattr(self, slot)
             if st is None:

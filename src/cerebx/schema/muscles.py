@@ -1,4 +1,4 @@
-"""Muscle schemas: the Ekeberg antagonist muscle pair per joint (docs/models.md)
+"""Muscle schemas: the Ekeberg antagonist muscle pair per joint (docs/models.md#ekeberg)
 and the brain-side ``muscle_rest`` controller that gives the muscles no active command."""
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ class EkebergConfig(StageConfig):
     tau_j = alpha_j (M_ag - M_at) + beta_j [(M_ag + c_j) + (M_at + c_j) + gamma_j] (Q_r,j - Q_j) + delta_j Qd_j
 
     with c_j = ``cocontraction`` x ``cocontraction_base``_j. M_ag and M_at (in [0, 1]) come through the
-    link; the joint state is the robot's own reading, with no delay. Defaults: Table 4.1 and §4.6."""
+    link; the joint state is the robot's own reading, with no delay. Defaults: docs/models.md#ekeberg."""
 
     sides: ClassVar[tuple[str, ...]] = ("robot",)
     kind: Literal["ekeberg"] = "ekeberg"

@@ -31,7 +31,7 @@ class Planar2Config(PlantSchema):
 class SEAConfig(Strict):
     """Series elastic actuators (Spong flexible-joint model): each actuator drives a rotor joint with
     inertia ``rotor_inertia_kgm2`` that is coupled to its link joint by a torsional spring-damper.
-    No published Baxter SEA stiffness exists (facts §3); the defaults are assumptions."""
+    No published Baxter SEA stiffness exists (docs/provenance.md#baxter-springs); the defaults are assumptions."""
 
     enabled: bool = True
     stiffness_Nm_per_rad: tuple[PositiveFloat, ...] = Field(
@@ -129,7 +129,8 @@ MUSCLES_UPPER_LIMB = ("deltoid", "biceps_long", "biceps_short", "brachialis", "t
 class UpperLimbConfig(PlantSchema):
     """Human arm, shoulder and elbow flexion-extension in a vertical plane, 7 Hill-type muscles on
     spatial tendons (OpenSim Arm26, Holzbaur et al. 2005, + MoBL-ARMS anterior deltoid).
-    Commanded with the muscles' neural excitations; MuJoCo integrates the activation dynamics (docs/models.md)."""
+    Commanded with the muscles' neural excitations; MuJoCo integrates the activation dynamics
+    (docs/models.md#activation-dynamics)."""
 
     kind: Literal["upper_limb"] = "upper_limb"
     physics_dt_ms: PhysicsStepMs = 0.5

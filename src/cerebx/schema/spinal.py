@@ -19,7 +19,7 @@ from cerebx.signals import Signal, StageIO
 JOINTS = {"deltoid": (0,), "biceps_long": (0, 1), "biceps_short": (1,), "brachialis": (1,),
           "triceps_long": (0, 1), "triceps_lateral": (1,), "triceps_medial": (1,)}
 FLEXORS = ("deltoid", "biceps_long", "biceps_short", "brachialis")
-# Antagonist pairs (constructed one-to-one; docs/models.md): each muscle's MN is
+# Antagonist pairs (constructed one-to-one; docs/models.md#spinal-cord): each muscle's MN is
 # inhibited by the mean of its antagonists' Ia interneurons.
 ANTAGONISTS = {"deltoid": ("triceps_long",), "biceps_long": ("triceps_long",),
                "biceps_short": ("triceps_lateral",), "brachialis": ("triceps_medial",),
@@ -59,7 +59,7 @@ class DirectMusclesConfig(_MuscleMap):
 
 
 class SpinalCordConfig(_MuscleMap):
-    """Spinal cord (docs/models.md): per muscle one motor neuron (MN) and one Ia interneuron
+    """Spinal cord (docs/models.md#spinal-cord): per muscle one motor neuron (MN) and one Ia interneuron
     (Ia IN), leaky rate neurons tau_m dr/dt = -r + sigma(sum w_i r_i), sigma(x) = 1/(1 + exp(-k (x - x0))).
     MN input: w_exc (command + own Ia afferent) - w_inh (mean of the antagonists' Ia INs); Ia IN input:
     w_exc own Ia afferent. Ia afferent r = a |v|^p sign(v) + b l + c of the length/velocity measured

@@ -43,7 +43,8 @@ class MeanFilterConfig(StageConfig):
 
 
 class FuturePastFilterConfig(StageConfig):
-    """Mean over future and past stamped samples with a decaying safe stop (Eq. 3.6, facts §7)."""
+    """Mean over future and past stamped samples with a decaying safe stop
+    (Eq. 3.6; docs/models.md#receiver-future-past)."""
 
     sides: ClassVar[tuple[str, ...]] = ("robot",)
     receiver: ClassVar[bool] = True
@@ -54,7 +55,7 @@ class FuturePastFilterConfig(StageConfig):
 
 
 class SupervisorConfig(StageConfig):
-    """Watchdog PD acting only outside the joint bounds (docs/models.md):
+    """Watchdog PD acting only outside the joint bounds (docs/models.md#supervisor):
     tau = kp (bound - q) - s kd qd, s ramping by ``ramp_per_step`` to 1 while outside; added to the
     joint torque command."""
 

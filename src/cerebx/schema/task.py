@@ -1,4 +1,4 @@
-"""Task schemas. Baxter tasks are Cartesian paths of the left end-effector (SPEC §2), turned into
+"""Task schemas. Baxter tasks are Cartesian paths of the left end-effector (docs/models.md#cartesian-tasks), turned into
 joint paths by inverse kinematics on the plant model; ``joint_sine`` is a joint-space task for
 small plants."""
 
@@ -33,7 +33,7 @@ class JointSineTask(Strict):
 
 
 class _CartesianTask(Strict):
-    """Common fields of the Cartesian Baxter tasks (docs/models.md, tasks)."""
+    """Common fields of the Cartesian Baxter tasks (docs/models.md#cartesian-tasks)."""
 
     period_s: PositiveFloat = Field(2.0, description="one trial")
     radius_m: PositiveFloat = Field(0.12, description="circle radius / eight half-height")
@@ -72,7 +72,8 @@ class CircleEightTask(_CartesianTask):
 class ReachingTask(_CartesianTask):
     """Eight targets on the circle every pi/4; out and back; random order. Each leg follows
     ``profile``: ``min_jerk`` (bell-shaped velocity) or ``ramp_linear`` (the original's "smooth ramp
-    then linear segment", facts §5: velocity rises over ``ramp_fraction`` of the leg, then is constant)."""
+    then linear segment", docs/provenance.md#original-trajectories: velocity rises over ``ramp_fraction``
+    of the leg, then is constant)."""
 
     kind: Literal["reaching"] = "reaching"
     targets: int = Field(8, gt=0)

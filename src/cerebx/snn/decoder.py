@@ -1,4 +1,4 @@
-"""Spike-to-torque decoder (docs/models.md): per joint,
+"""Spike-to-torque decoder (docs/models.md#dcn-decoder): per joint,
 tau_j = alpha_j (agonist - antagonist DCN spikes in the 2 ms bin), no offset, no memory.
 For a muscle stage the two sides are kept apart: M_ag,j and M_at,j = the side's
 spikes in the bin / full scale, each in [0, 1] when the full scale is the most the side can fire,

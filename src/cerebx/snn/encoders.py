@@ -1,4 +1,4 @@
-"""Analog-to-spike encoders (docs/models.md).
+"""Analog-to-spike encoders (docs/models.md#mf-box-coding, docs/models.md#cf-error-coding).
 
 MF box coding: per joint and signal (q_d, q, qd_d, qd), ``F`` fibres with centres evenly spaced
 over [r_min, r_max] and half-width step * width_factor; the input is clipped to the range and

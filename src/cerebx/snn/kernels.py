@@ -5,7 +5,7 @@ at substep boundaries, exactly ``delay`` substeps after the presynaptic spike. S
 integers in substeps (t = 0 is the start of the run). Spikes produced while integrating the
 substep t carry time t + 1 and live in ring slot (t + 1) % R until every projection has read them.
 
-Integration (docs/models.md): conductances decay exactly (g <- g e^(-h/tau)). Each LIF
+Integration (docs/models.md#lif-integration): conductances decay exactly (g <- g e^(-h/tau)). Each LIF
 population has its own step h = ratio * dt and method (``LIFNeuron.integration``: RK4, RK2 = Heun,
 or Euler; default RK4 at dt). A population integrated with ratio > 1 advances at the end of the
 substeps t with (t + 1) % ratio == 0; input that arrives in the middle of one of its steps takes

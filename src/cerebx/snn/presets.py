@@ -10,7 +10,8 @@ from typing import Any
 
 from cerebx.snn.schema import NetworkConfig
 
-# GC integration as EDLUT's GPU granule model (facts §2): RK2 with a 1 ms step, 3 sub-steps once V
+# GC integration as EDLUT's GPU granule model (docs/provenance.md#original-neurons): RK2 with a 1 ms step,
+# 3 sub-steps once V
 # is above (E_rest + V_th)/2. GC_RK4 is the same neuron with the default RK4 at the network dt.
 GC_RK4 = dict(kind="lif_cond", C_m_pF=2.0, g_L_nS=1.0, E_L_mV=-65.0, E_AMPA_mV=0.0, tau_AMPA_ms=1.0,
               V_thr_mV=-50.0, t_ref_ms=1.0, clamp_at_rest=True)

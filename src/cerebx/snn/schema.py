@@ -36,7 +36,7 @@ class Integration(Strict):
 
 
 class LIFNeuron(Strict):
-    """Conductance-based leaky integrate-and-fire neuron (docs/models.md)."""
+    """Conductance-based leaky integrate-and-fire neuron (docs/models.md#conductance-lif)."""
 
     kind: Literal["lif_cond"] = "lif_cond"
     C_m_pF: PositiveFloat = Field(description="membrane capacitance")
@@ -103,7 +103,7 @@ class OneToOne(Strict):
 
 
 class JointCombinations(Strict):
-    """Granular-layer state coding (facts §1): per joint, the pre population holds ``signals``
+    """Granular-layer state coding (docs/models.md#network): per joint, the pre population holds ``signals``
     subgroups of ``fibers_per_signal`` fibres; each post neuron takes one fibre from every subgroup
     of its joint, and the post population enumerates all fibers_per_signal**signals combinations.
     """
@@ -118,7 +118,7 @@ Rule = Annotated[AllToAll | OneToOne | JointCombinations, Field(discriminator="k
 
 
 class KernelSTDP(Strict):
-    """PF-PC plasticity (docs/models.md).
+    """PF-PC plasticity (docs/models.md#kernel-stdp).
 
     LTP: +ltp_nS per presynaptic spike. LTD: at each teacher (CF) spike, ltd_nS * k(t_CF - t_PF)
     for every buffered PF spike, with k = 0 before the onset and k = (t'/tau) e^(1 - t'/tau),

@@ -1,4 +1,4 @@
-"""Muscles between the cerebellum's commands and the joints (docs/models.md).
+"""Muscles between the cerebellum's commands and the joints (docs/models.md#ekeberg).
 
 :class:`Ekeberg` is one antagonist muscle pair per joint (Eq. 4.6): an active torque set by the
 agonist/antagonist commands, and a passive spring towards the resting pose, whose stiffness grows

@@ -2,7 +2,7 @@
 
 ``hold`` applies the newest sample, ``mean`` the mean of the last n samples (Eq. 2.18), and
 ``future_past`` the mean of the nearest future and past stamped samples with a decaying safe stop
-(Eq. 3.6, facts §7). Each works on every signal the brain side sends.
+(Eq. 3.6). Each works on every signal the brain side sends (docs/models.md#receivers).
 """
 
 from __future__ import annotations
@@ -74,7 +74,7 @@ class MeanFilter(Receiver):
 
 
 class FuturePastFilter(Receiver):
-    """Eq. 3.6 with the original's safe stop (facts §7).
+    """Eq. 3.6 with the original's safe stop (docs/models.md#receiver-future-past).
 
     Samples are stamped with their application time. Each tick, F = min(#future, n + 1); with
     F >= min_future + 1 the output is the mean of the F nearest future samples and the

@@ -1,4 +1,4 @@
-"""The upper limb's stages between the cerebellum and the muscles (docs/models.md).
+"""The upper limb's stages between the cerebellum and the muscles (docs/models.md#spinal-cord).
 
 ``spinal_cord``: one motor neuron (MN) and one Ia interneuron (Ia IN) per muscle, leaky rate neurons
 (Eq. 4.1-4.2) updated exactly for an input held over the 2 ms step: r <- s + (r - s) exp(-dt / tau_m),
@@ -18,7 +18,8 @@ Shortening (v < 0) lowers the rate (odd extension of v^0.6; the source gives the
 The MN rates are the muscle excitations: the plant's MuJoCo muscles integrate the activation dynamics
 (Eq. 4.4-4.5) once.
 
-``direct_muscles``: without the spinal cord the commands are the excitations directly (Fig. 4.3B).
+``direct_muscles``: without the spinal cord the commands are the excitations directly
+(docs/models.md#direct-muscles).
 ``split_pairs``: brain side, a joint torque as agonist/antagonist commands.
 """
 

@@ -1,4 +1,5 @@
-"""The safety supervisor: a watchdog PD that acts only while a joint is outside its bounds (facts §4)."""
+"""The safety supervisor: a watchdog PD that acts only while a joint is outside its bounds
+(docs/models.md#supervisor)."""
 
 from __future__ import annotations
 

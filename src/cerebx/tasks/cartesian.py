@@ -1,9 +1,10 @@
-"""Cartesian Baxter tasks (SPEC §2): end-effector paths turned into joint paths by inverse kinematics.
+"""Cartesian Baxter tasks (docs/models.md#cartesian-tasks): end-effector paths turned into joint paths by
+inverse kinematics.
 
 The end-effector is the Baxter model's ``end_effector`` site (origin of the URDF ``left_hand`` frame,
 base frame). The path is centred on the end-effector position of the home pose; the orientation is
-held at the home orientation. As in the original (facts §5: MoveIt on the 7-joint arm, then w2 held
-at 0 by the supervisor), IK solves the 7-joint chain including the wrist roll w2 and the task keeps
+held at the home orientation. As in the original (docs/provenance.md#original-trajectories: MoveIt on the 7-joint
+arm, then w2 held at 0 by the supervisor), IK solves the 7-joint chain including the wrist roll w2 and the task keeps
 s0..w1: the end-effector lies on the w2 axis, so dropping w2 keeps the position exactly and turns
 the hand about that axis only. The redundancy is resolved towards the home pose (w2 = 0), a
 *constructed* choice (MoveIt's is not recorded) that reproduces the original paths' joint envelopes
@@ -47,7 +48,8 @@ def min_jerk(s: np.ndarray) -> np.ndarray:
 
 def ramp_linear(s: np.ndarray, ramp: float) -> np.ndarray:
     """Position profile 0 -> 1 on s in [0, 1] whose velocity rises smoothly (half cosine) over the
-    first ``ramp`` of the way, then stays constant to the end ("smooth ramp then linear", facts §5)."""
+    first ``ramp`` of the way, then stays constant to the end ("smooth ramp then linear",
+    docs/provenance.md#original-trajectories)."""
     s = np.clip(s, 0.0, 1.0)
     if ramp <= 0:
         return s
@@ -155,7 +157,8 @@ def solve_paths(cfg: Any, offsets_of: Offsets) -> dict[str, np.ndarray]:
 
 def solve_reaching(cfg: Any) -> dict[str, np.ndarray]:
     """Reaching paths: straight Cartesian legs (``space: cartesian``, IK at every sample), or, as the
-    original (facts §5: joint-space targets, joint-space ramps), IK at the targets only and the joints
+    original (docs/provenance.md#original-trajectories: joint-space targets, joint-space ramps), IK at the targets
+    only and the joints
     interpolated from the home pose (``space: joint``; the hand then moves on a slightly curved line)."""
     if cfg.space == "cartesian":
         return solve_paths(cfg, reaching_offsets)

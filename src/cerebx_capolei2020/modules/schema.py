@@ -50,7 +50,7 @@ _MTD = ((1e-4, 1e-5), (1e-4, 1e-4), (1e-5, 1e-5))
 FORWARD_IO_DCN = _k(_MTP, _MTD, ((1000.0, 100.0), (600.0, 100.0), (300.0, 1000.0)))
 INVERSE_IO_DCN = _k(_MTP, _MTD, ((100.0, 100.0), (100.0, 200.0), (500.0, 200.0)))
 
-# granular layer: the authors' NRP controller (facts §3.1 [E] controller.py)
+# granular layer: the authors' NRP controller (docs/provenance.md#lwpr-group-settings)
 GRANULAR = LWPRParams(init_D=10.0, init_alpha=180.0, w_gen=0.4, w_prune=0.95, update_D=False)
 
 

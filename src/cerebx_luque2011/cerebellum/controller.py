@@ -3,7 +3,7 @@
 Each 2 ms tick: the desired q and qd of the three joints are RBF-encoded into the 120 input cells'
 drive (Eq. 2); the newest joint measurement that has arrived through the link is compared with the
 desired state of its own time stamp (Eq. 7) and the IO cells fire with a probability that grows with
-the error (0-10 Hz); the network (``snn/luque.py``) advances 2 ms with PF-PC plasticity; the DCN spikes
+the error (0-10 Hz); the network (``cerebellum/kernels.py``) advances 2 ms with PF-PC plasticity; the DCN spikes
 of the last ``buffer_ms`` give the corrective torque, rate(+ group) - rate(- group) per joint. The
 teaching delay is the link's: a measurement that arrives at t was caused by torques sent about one
 round trip earlier, which is where the LTD kernel peaks.

@@ -2,7 +2,8 @@
 feed-forward torque, ``cerebx_luque2011.schema``).
 
 Numbers from the paper (IEEE TSMC-B 2011, Sections II-C/D/E, Table I) are marked *paper*; numbers it
-does not give are *constructed* (chosen here; see the README section "Luque 2011")."""
+does not give are *constructed* (chosen here; docs/models.md#luque-lif, docs/models.md#luque-plasticity
+and the sections after it)."""
 
 from __future__ import annotations
 
@@ -67,7 +68,8 @@ class LTDLTP(Strict):
     ltp_nS: NonNegFloat = Field(0.01, description="paper: below 0.015 for LTD 0.075 (Fig. 8)")
     kernel_peak_ms: PositiveFloat = Field(100.0, description="paper: 100 ms, the loop's teaching delay")
     arm_lag_ms: NonNegFloat = Field(
-        70.0, description="constructed: the lwr3 arm's own lag, added to the kernel's peak (README, Luque 2011)"
+        70.0,
+        description="constructed: the lwr3 arm's own lag, added to the kernel's peak (docs/models.md#luque-plasticity)",
     )
     weight_max_nS: PositiveFloat = Field(30.0, description="upper weight bound (constructed: twice the start)")
 

@@ -1,4 +1,5 @@
-"""The rate-based (analog) cerebellum: the ANN baseline of thesis §3.2.6 / Annex S6 (facts §6).
+"""The rate-based (analog) cerebellum: the ANN baseline of thesis §3.2.6 / Annex S6
+(docs/models.md#ann-plasticity; the original code: docs/provenance.md#original-ann).
 
 Each step, per joint j with agonist/antagonist cells s in {ag, an}:
 

@@ -15,8 +15,8 @@ CIRCLE_GAIN_NM = (10.0, 22.0, 3.0, 15.0, 2.0, 3.5)
 
 
 class ANNController(ControllerConfig):
-    """Analog cerebellum (facts §6): a state-table granular layer, PC/IO/DCN agonist-antagonist pairs
-    per joint and PF-PC plasticity dw = (LTP (1 - IO) - LTD IO) |e|.
+    """Analog cerebellum (docs/models.md#ann-state-coding): a state-table granular layer, PC/IO/DCN
+    agonist-antagonist pairs per joint and PF-PC plasticity dw = (LTP (1 - IO) - LTD IO) |e|.
 
     Per joint the four MF signals (q_d, q, qd_d, qd) are each quantised into ``bins`` bins; the
     granule cells are the bins**4 combinations and 4 * bins of them are active at a time (every bin

@@ -67,4 +67,5 @@ def test_symmetric_gamma_sends_half_of_one_round_trip_each_way():
     assert all(a == b for a, b in pairs)
     rt = np.array([a + b for a, b in pairs])
     assert np.all(np.diff(rt) >= -2.0 - 1e-12)  # the limiter acts on the round trip
-    assert rt.mean() == pytest.approx(42.8, abs=1.0)  # facts §7: 37.25 nominal -> 42.8 with the limiter
+    # docs/provenance.md#original-delays: 37.25 ms nominal -> 42.8 ms with the limiter
+    assert rt.mean() == pytest.approx(42.8, abs=1.0)

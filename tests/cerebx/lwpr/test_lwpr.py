@@ -9,7 +9,7 @@ from cerebx.lwpr.bench import cross
 
 
 def test_cross_function_matches_reference_library():
-    """example_c/cross.c protocol (facts §3.2): reference nMSE 0.021-0.025 with 53-61 RFs."""
+    """example_c/cross.c protocol (docs/provenance.md#lwpr-benchmark): reference nMSE 0.021-0.025 with 53-61 RFs."""
     rng = np.random.default_rng(1)
     model = LWPR(2, 1, init_D=50.0, init_alpha=250.0, w_gen=0.2)
     for _ in range(20):

@@ -1,4 +1,5 @@
-"""Behavioural tests of the MuJoCo Baxter left arm against the numbers in facts/baxter_left_arm.md §5."""
+"""Behavioural tests of the MuJoCo Baxter left arm against the reference values in
+docs/provenance.md#baxter-gravity-torques."""
 
 from __future__ import annotations
 
@@ -74,7 +75,7 @@ def test_model_layout_per_option(overrides, pendulum, counts, mass):
     assert kinematic_model(w2=True).nq == 7 and kinematic_model().nq == 6
 
 
-def test_holding_torques_match_facts_table():
+def test_holding_torques_match_the_reference_table():
     np.testing.assert_allclose(
         make().gravity_torque(REF), [0, -45.065, 0.026, -11.022, 0.150, -0.883], atol=0.01
     )
@@ -89,7 +90,7 @@ def test_zero_torque_arm_falls_without_gravity_compensation():
         plant.apply(np.zeros(6))
         plant.step()
     dq = plant.true_state()[0] - REF
-    assert dq[1] == pytest.approx(0.495, abs=0.03)  # s1 positive = down (facts §6.12)
+    assert dq[1] == pytest.approx(0.495, abs=0.03)  # s1 positive = down (docs/provenance.md#baxter-limits)
     assert dq[3] == pytest.approx(-0.394, abs=0.03)
 
 

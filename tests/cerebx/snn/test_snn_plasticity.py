@@ -1,4 +1,4 @@
-"""PF-PC kernel STDP (facts §2): LTP per PF spike, LTD at CF spikes weighted by the kernel."""
+"""PF-PC kernel STDP (docs/models.md#kernel-stdp): LTP per PF spike, LTD at CF spikes weighted by the kernel."""
 
 from __future__ import annotations
 
@@ -43,7 +43,7 @@ def test_kernel_table_shape():
     assert k[240] == 0.0 and k[241] > 0  # zero up to the onset (120 ms)
     assert k[300] == pytest.approx(1.0)  # peak
     assert k.argmax() == 300
-    assert 0.34 < len(k) * 0.5 / 1000 < 0.36  # window about 0.35 s (facts §2)
+    assert 0.34 < len(k) * 0.5 / 1000 < 0.36  # window about 0.35 s (docs/provenance.md#original-learning-rule)
 
 
 def test_pf_then_cf_at_kernel_peak_changes_weight_by_beta_plus_alpha():

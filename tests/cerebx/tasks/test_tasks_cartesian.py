@@ -1,4 +1,4 @@
-"""Cartesian Baxter tasks: IK joint paths reproduce their Cartesian paths (SPEC §2)."""
+"""Cartesian Baxter tasks: IK joint paths reproduce their Cartesian paths (docs/models.md#cartesian-tasks)."""
 
 from __future__ import annotations
 
@@ -72,7 +72,7 @@ def test_joint_paths_reproduce_cartesian_paths(kind, tasks, fk, fk7):
         assert np.all(q >= LO) and np.all(q <= HI)
 
 
-# facts/original_implementation.md §5: per-joint min/max (s0..w1) of the original's joint paths
+# docs/provenance.md#original-trajectories: per-joint min/max (s0..w1) of the original's joint paths
 FACTS_ENVELOPE = {
     "circle": ([-0.9645, -0.4745, 0.0101, 0.5934, -0.0652, 0.2496], [-0.5591, -0.0393, 0.0352, 1.7914, 0.0180, 1.0145]),
     "eight": ([-0.9495, -0.4231, -0.0220, 1.0062, -0.0185, 0.4140], [-0.5446, -0.2194, 0.0105, 1.5791, 0.0361, 0.7834]),

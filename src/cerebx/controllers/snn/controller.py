@@ -1,6 +1,7 @@
-"""The cerebellar spiking-network torque controller (docs/models.md).
+"""The cerebellar spiking-network torque controller (docs/models.md#network).
 
-Pathway delay model (facts §7 "Spike timestamps"): the original stamps MF/CF spikes with the
+Pathway delay model (docs/models.md#pathway-delay; the original's spike time stamps:
+docs/provenance.md#original-spike-timestamps): the original stamps MF/CF spikes with the
 sample time + D and the DCN output with the network time + D. Here both are FIFOs of
 round(D / 2 ms) control steps: spikes encoded from the sample of step n enter the network at step
 n + k (afferent), and the torque the network decodes at step m is returned at step m + k

@@ -32,7 +32,7 @@ class BoxEncoder(Strict):
 
 
 class CFEncoder(Strict):
-    """CF stochastic error coding (facts §3): agonist/antagonist split by error sign;
+    """CF stochastic error coding (docs/models.md#cf-error-coding): agonist/antagonist split by error sign;
     rate = r_min + (r_max - r_min)(tanh((|e| - c_k)/w) + 1)/2, Bernoulli per 2 ms, bursts."""
 
     role: ClassVar[str] = "climbing"
@@ -83,7 +83,7 @@ class DCNDecoderConfig(Strict):
 class SNNController(ControllerConfig):
     """The cerebellar spiking controller: MF and CF encoders feed a spiking ``network``, whose DCN output
     is decoded into a joint torque (or agonist/antagonist muscle commands); the PF-PC synapses learn from
-    the CF error (docs/models.md). The network comes from the ``network`` config group."""
+    the CF error (docs/models.md#kernel-stdp). The network comes from the ``network`` config group."""
 
     added_without_effect: ClassVar[dict[str, Any]] = {"output": "torque", "decoder.spikes_full_scale": 100.0}
 
