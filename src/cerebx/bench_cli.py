@@ -1,4 +1,5 @@
-"""``cerebx bench``: speed of the plant with PD, of each network alone, and of the closed loop.
+"""``cerebx bench``: speed of the plant with PD, of each network alone, of the closed loop, and of learning runs
+as users make them (``bench_learning.py``).
 
 Each network is measured in a fresh subprocess so build time (numba cache warm) and peak RSS
 belong to that network alone. Output is JSON. Numbers are simulated seconds per wall second.
@@ -15,6 +16,7 @@ import time
 from typing import Any
 
 from cerebx.bench import bench_network, peak_rss_mb
+from cerebx.bench_learning import bench_learning
 from cerebx.config import load
 from cerebx.loop.timing import closed_loop_rt
 from cerebx.lwpr.bench import bench_lwpr
@@ -53,11 +55,18 @@ def main(argv: list[str]) -> dict[str, Any]:
     ap.add_argument("--serial", action="store_true", help="one thread in the network kernels")
     ap.add_argument("--lwpr", action="store_true", help="only LWPR on the reference library's 2-D cross and 1-D "
                     "examples (updates, predictions per second, nMSE, receptive fields)")
+    ap.add_argument("--learning", default=None, help="comma-separated learning runs to time (default: every "
+                    "registered one, e.g. make_run; '' for none)")
+    ap.add_argument("--trials", type=int, default=20, help="trials of each learning run")
+    ap.add_argument("--rounds", type=int, default=1, help="rounds of learning runs and their closed loops (medians)")
     ap.add_argument("--one", help=argparse.SUPPRESS)
+    ap.add_argument("--loop", help=argparse.SUPPRESS)
     ap.add_argument("--started", type=float, default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.lwpr:
         return {"lwpr": bench_lwpr()}
+    if args.loop:
+        return closed_loop_rt(json.loads(args.loop), seconds=args.seconds, warmup_s=args.warmup)
     if args.one:
         return _one_network(args.one, args.seconds, args.warmup, not args.serial, args.started or time.time())
     report: dict[str, Any] = {"cpus": os.cpu_count(), "plant_pd": _plant_pd(args.seconds), "networks": {}}
@@ -69,4 +78,7 @@ def main(argv: list[str]) -> dict[str, Any]:
             report["networks"][name] = {"error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}
         else:
             report["networks"][name] = json.loads(proc.stdout)
+    if args.learning != "":
+        names = [n for n in (args.learning or "").split(",") if n]
+        report["learning"] = bench_learning(names, args.trials, args.rounds, args.seconds, args.warmup)
     return report

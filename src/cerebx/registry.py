@@ -132,6 +132,9 @@ config_sources: list[Source] = []
 report_modules: list[Source] = []
 """Modules that register figures and studies (imported by the report engine only)."""
 
+bench_runs: dict[str, tuple[str, ...]] = {}
+"""Learning runs ``cerebx bench`` times as users run them (name -> ``cerebx run`` overrides)."""
+
 
 def add_config_source(package: str) -> None:
     """Add the presets in ``package`` (a Python package holding config-group folders, e.g.
@@ -142,6 +145,14 @@ def add_config_source(package: str) -> None:
 def add_report(module: str) -> None:
     """Name the module whose import registers this plugin's figures and studies (``cerebx.report``)."""
     report_modules.append(Source(_loading or "<direct>", module))
+
+
+def add_bench_run(name: str, overrides: list[str]) -> None:
+    """Have ``cerebx bench`` time ``cerebx run OVERRIDES`` (recording and checkpoints as configured) under
+    ``name``; a name already taken is refused."""
+    if name in bench_runs:
+        raise ValueError(f"bench run {name!r} is already registered")
+    bench_runs[name] = tuple(overrides)
 
 
 _loaded: list[str] = []

@@ -13,3 +13,6 @@ def register() -> None:
     registry.controllers.register(ANNController, "cerebx_thesis.ann.controller:ANN")
     registry.add_config_source("cerebx_thesis.conf")
     registry.add_report("cerebx_thesis.report")
+    # learning runs as users make them, timed by `cerebx bench`: what `make run` runs, and chapter 3's
+    registry.add_bench_run("make_run", ["+experiment=default"])
+    registry.add_bench_run("learn_circle_ch3", ["+experiment=learn_circle_ch3"])

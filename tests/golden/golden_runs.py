@@ -38,7 +38,7 @@ RUNS: dict[str, list[str]] = {
 }
 
 # summary fields that depend on the machine (clock, process), not on the simulation
-WALL_CLOCK = {"wall_seconds", "rt_factor", "started_at", "controller_info", "pid", "host"}
+WALL_CLOCK = {"wall_seconds", "rt_factor", "cpu_seconds", "started_at", "controller_info", "pid", "host"}
 # per-trial metrics (lists) compared with a tolerance; every other summary field must be equal
 METRICS = ("mae_per_trial", "mae_per_joint_per_trial", "vel_mae_per_trial", "torque_variability_per_trial",
            "ee_error_per_trial", "final_mae")

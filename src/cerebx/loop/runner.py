@@ -14,11 +14,12 @@ from typing import Any
 
 from tqdm import tqdm
 
-from cerebx import __version__, runfiles
+from cerebx import __version__, phases, runfiles
 from cerebx.build import build_components
 from cerebx.errors import CerebxError, outcome
 from cerebx.loop import resume
 from cerebx.loop.brain_side import run_brain_side
+from cerebx.loop.instrument import instrument
 from cerebx.loop.loop import ClosedLoop
 from cerebx.recording import live as live_view
 from cerebx.recording.recorder import Recorder
@@ -63,6 +64,9 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
     run_dir.mkdir(parents=True, exist_ok=True)
     started = time.time()
     wall0 = time.perf_counter()
+    cpu0 = time.process_time()
+    clock = phases.PhaseClock("open") if cfg.recording.phase_times else None
+    phases.activate(clock)
     summary = new_summary(cfg, version=__version__, overrides=list(overrides or []), started_at=started,
                           presets=dict(choices or {}))
     write_summary(run_dir, summary)
@@ -77,9 +81,10 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
     wall_before = 0.0  # spent by the run this one continues
     try:
         with _sigterm_as_interrupt():
-            if cfg.resume is not None:
-                loop, wall_before = resume.load(cfg, run_dir, rec)
-            ctx = loop.ctx if loop is not None else build_components(cfg, run_dir)
+            with phases.span("build"):
+                if cfg.resume is not None:
+                    loop, wall_before = resume.load(cfg, run_dir, rec)
+                ctx = loop.ctx if loop is not None else build_components(cfg, run_dir)
             rec.joint_names = tuple(ctx.plant.joint_names)
             if cfg.init_from and loop is None:
                 state = Path(cfg.init_from) / runfiles.STATE
@@ -89,6 +94,9 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             if loop is None:
                 loop = ClosedLoop(ctx, rec)
                 loop.start()
+            if clock is not None:
+                instrument(loop, clock)
+                clock.switch("loop")
             loop.scene = scene_writer(cfg, ctx.plant, rec, live)
             summary["controller_info"] = ctx.brain[0].describe()
             bar = _progress(cfg, cfg.trials)
@@ -97,19 +105,23 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             for trial in range(loop.trials_done, cfg.trials):
                 m = loop.run_trial(trial)
                 if resume.due(loop):
-                    resume.save(loop, run_dir, wall_before + time.perf_counter() - wall0)
+                    with phases.span("checkpoint"):
+                        resume.save(loop, run_dir, wall_before + time.perf_counter() - wall0)
                 if bar is not None:
                     bar.set_postfix_str(f"trial {trial + 1}/{cfg.trials}  MAE {m.mae:.4f} rad")
                     bar.update(1)
-                summary.update(trial_fields(loop.metrics, loop.sim_seconds),
-                               wall_seconds=wall_before + time.perf_counter() - wall0)
-                write_summary(run_dir, summary)
+                with phases.span("summary"):
+                    summary.update(trial_fields(loop.metrics, loop.sim_seconds),
+                                   wall_seconds=wall_before + time.perf_counter() - wall0)
+                    write_summary(run_dir, summary)
             summary["status"] = "completed"
     except BaseException as err:  # recorded in the log and summary.json; the caller's exit code follows it
         summary.update(outcome(err))
         if not isinstance(err, (Exception, KeyboardInterrupt)):
             raise
     finally:
+        if clock is not None:
+            clock.switch("finish")
         if bar is not None:
             bar.close()
         if summary["status"] == "running":  # left by an exception that is not an Exception (SystemExit)
@@ -119,11 +131,16 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             summary.update(trial_fields(loop.metrics, loop.sim_seconds))
             if cfg.recording.save_state and loop.trials_done > 0:
                 try:
-                    loop.controller.save_state(run_dir / runfiles.STATE)
+                    with phases.span("save_state"):
+                        loop.controller.save_state(run_dir / runfiles.STATE)
                 except Exception as err:  # the state is a bonus; the log must still be finished
                     log.error("could not save controller state: %s", err)
         summary["wall_seconds"] = wall
         summary["rt_factor"] = summary["sim_seconds"] / wall if wall > 0 else None
+        summary["cpu_seconds"] = time.process_time() - cpu0
+        if clock is not None:
+            summary["phase_times"] = clock.report()  # closing the log comes after: untimed
+            phases.activate(None)
         try:
             finish_run(rec, run_dir, summary, sentinel)
         finally:

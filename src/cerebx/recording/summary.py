@@ -45,6 +45,8 @@ class RunSummary(BaseModel):
     sim_seconds: float = Field(0.0, ge=0, description="simulated time, s")
     wall_seconds: float = Field(0.0, ge=0, description="wall-clock time, s")
     rt_factor: float | None = Field(None, description="simulated seconds per wall second")
+    cpu_seconds: float | None = Field(None, ge=0, description="CPU time of the run's process from the run's start, "
+                                      "all threads, s (a continued run: of its last process)")
     error: str | None = None
     mae_per_joint_per_trial: list[list[float]] = Field(default_factory=list, description="rad, per trial and joint")
     vel_mae_per_trial: list[float] = Field(default_factory=list, description="rad/s")

@@ -48,6 +48,9 @@ class RecordingConfig(Strict):
     checkpoint_every: int = Field(
         10, ge=0, description="trials between checkpoints of the whole loop (resume=RUN_DIR continues from the "
         "last one; a completed run deletes it); 0: none")
+    phase_times: bool = Field(
+        False, description="add where the run's wall and CPU time went, per phase, to summary.json (phase_times); "
+        "cerebx bench's learning runs turn it on (a few microseconds per control step)")
     scene_every: int | None = Field(
         None, ge=0, description="control steps between frames of the plant's 3-D scene in run.mcap (/scene/*); "
         "null: every 10 steps when live.enabled, else none; 0: none")

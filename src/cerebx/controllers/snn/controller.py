@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx import registry
+from cerebx import phases, registry
 from cerebx.controllers.base import CommandMsg, ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
 from cerebx.controllers.snn.schema import SNNController
@@ -169,11 +169,16 @@ class SNNControllerImpl(Controller):
         first = self._net_step  # no chunk is in flight when a new one starts
         box: dict[str, Any] = {}
 
+        clock = phases.active()
+
         def work() -> None:
+            t0, c0 = (time.perf_counter(), time.thread_time()) if clock is not None else (0.0, 0.0)
             try:
                 box["out"] = self._simulate(chunk, first)
             except BaseException as exc:  # re-raised in the loop's thread by _join
                 box["err"] = exc
+            if clock is not None:
+                clock.add_background("network", time.perf_counter() - t0, time.thread_time() - c0)
 
         self._worker = (threading.Thread(target=work, name="cerebx-snn", daemon=True), box)
         self._worker[0].start()
@@ -183,7 +188,8 @@ class SNNControllerImpl(Controller):
         if worker is None:
             return
         thread, box = worker
-        thread.join()
+        with phases.charge("wait"):
+            thread.join()
         self._worker = None
         if "err" in box:
             raise box["err"]
