@@ -42,6 +42,7 @@ from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
 from cerebx.snn.decoder import DCNDecoder
 from cerebx.snn.network import Network
+from cerebx.snn.weight_stats import weight_stats
 
 STEP_S = 0.002
 STATE_VERSION = 1
@@ -279,11 +280,8 @@ class SNNControllerImpl(Controller):
         every = self.cfg.weight_summary_every_trials
         if every and trial % every == 0 and self._summaries and self._shed < 3:
             for name in self.net.plastic_projections:
-                w = self.net.weights(name)
-                out[f"w_{name}_mean"] = float(w.mean(dtype=np.float64))
-                out[f"w_{name}_std"] = float(w.std(dtype=np.float64))
-                out[f"w_{name}_min"] = float(w.min())
-                out[f"w_{name}_max"] = float(w.max())
+                stats = weight_stats(self.net.weights(name))
+                out.update(zip((f"w_{name}_mean", f"w_{name}_std", f"w_{name}_min", f"w_{name}_max"), stats))
         lost = int(self.net.pf_lost.sum())
         if lost:
             out["ltd_pf_spikes_dropped"] = float(lost)
