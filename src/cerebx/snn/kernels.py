@@ -139,6 +139,7 @@ class Plasticity(NamedTuple):
     pf_j: np.ndarray  # int32 [rule, cap]: its presynaptic index
     pf_head: np.ndarray  # int64 [rule]: PF spikes buffered so far
     pf_lost: np.ndarray  # int64 [rule]: overwritten while still inside the kernel window
+    dirty: np.ndarray  # uint8 [rule, n_pre]: rows (presynaptic neurons) whose weights changed (checkpoints)
 
 
 class Buffers(NamedTuple):
@@ -552,6 +553,7 @@ def _ltd(plast, pl, w, n_post, n_col, t, buf):
     pf_t, pf_j, pf_head = plast.pf_t[pl], plast.pf_j[pl], plast.pf_head[pl]
     lo_w, ltd = np.float32(plast.pl_f[pl, 2]), plast.pl_f[pl, 1]
     col, acc, acc_j = buf.col_buf, buf.acc, buf.acc_j
+    dirty = plast.dirty[pl]
     cap = pf_t.shape[0]
     klen = kern.shape[0]
     h = pf_head
@@ -575,6 +577,7 @@ def _ltd(plast, pl, w, n_post, n_col, t, buf):
         j = acc_j[a]
         dw = np.float32(ltd * acc[j])
         acc[j] = 0.0
+        dirty[j] = 1
         base = j * n_post
         for q in range(n_col):
             k = base + col[q]
@@ -721,6 +724,7 @@ def run_step(t0, n_sub, inputs, learn, par, net):
                         for q in range(n_post):
                             x = ws[q] + ltp
                             ws[q] = x if x < hi_w else hi_w
+                        plast.dirty[pl, j] = 1
                     if pl >= 0:
                         cap = pf_t.shape[1]
                         e = pf_head[pl] % cap

@@ -109,6 +109,8 @@ class Network:
         self.pf_j = np.zeros((len(pl), pf_ring), dtype=np.int32)
         self.pf_head = np.zeros(len(pl), dtype=np.int64)
         self.pf_lost = np.zeros(len(pl), dtype=np.int64)
+        n_pre = [int(self.de_i[r.dense, 1]) for r in pl]
+        self.pl_dirty = np.zeros((len(pl), max(n_pre + [1])), dtype=np.uint8)
         self.kernel_window_sub = longest
         self.col_buf = np.zeros(n, dtype=np.int64)
         self.acc = np.zeros(n, dtype=np.float64)
@@ -126,6 +128,7 @@ class Network:
         self.scr_i = np.zeros(n, dtype=np.int64)
         self.learn = True
         self.t_sub = 0
+        self._all_changed = True  # every weight counts as changed until the first changed_ranges()
         self.arrays = self._kernel_arrays()
         self._state = kernels.kernel_state(self.arrays)
         self.reset_state()
@@ -141,7 +144,7 @@ class Network:
             delivery=kernels.Delivery(self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
                                       self.sp_c, self.c_k, self.c_q, self.c_l, self.de_i, self.dense_w),
             plasticity=kernels.Plasticity(self.pl_i, self.pl_f, self.kern, self.pf_t, self.pf_j, self.pf_head,
-                                          self.pf_lost),
+                                          self.pf_lost, self.pl_dirty),
             buffers=kernels.Buffers(self.col_buf, self.acc, self.acc_j, self.out_idx, self.out_t, self.scr_f,
                                     self.scr_i),
         )
@@ -225,12 +228,37 @@ class Network:
                 getattr(self, k)[...] = arrays[k]
         self._set_neurons(arrays["V"], arrays["g"], arrays["ref"])
         self.t_sub = int(arrays["t_sub"])
+        self._all_changed = True
+
+    def changed_ranges(self) -> list[tuple[np.ndarray, np.ndarray, int]]:
+        """The weights written since the last call, as (array, start offsets, length) ranges: the rows of
+        the plastic projections the kernels marked (LTP, LTD), or all of ``dense_w`` after a load. Lets a
+        checkpoint rewrite only those (``loop/checkpoint.py``); the call starts a new interval."""
+        if self._all_changed:
+            self._all_changed = False
+            self.pl_dirty[:] = 0
+            return [(self.dense_w, np.zeros(1, np.int64), self.dense_w.size)]
+        out = []
+        for r, d in enumerate(self.pl_i[:, 0]):
+            n_pre, n_post, w_off = (int(x) for x in self.de_i[d, [1, 3, 4]])
+            rows = np.flatnonzero(self.pl_dirty[r, :n_pre])
+            out.append((self.dense_w, w_off + rows.astype(np.int64) * n_post, n_post))
+        self.pl_dirty[:] = 0
+        return out
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()
+        state.pop("_chunk_idx", None)  # step_many's output scratch (rebuilt on use)
+        return state
+
     # ------------------------------------------------------------------ access
     def index(self, pop: str) -> slice:
         return self.topo.slice(pop)
 
     def weights(self, projection: str) -> np.ndarray:
-        """Weights of an all-to-all projection as a [n_pre, n_post] view (float32, nS)."""
+        """Weights of an all-to-all projection as a [n_pre, n_post] view (float32, nS). Set weights with
+        :meth:`load_arrays` once a run has checkpointed: checkpoints rewrite only the rows the kernels
+        marked as changed (:meth:`changed_ranges`)."""
         for d in self.topo.dense:
             if d.name == projection:
                 return self.topo.dense_block(d)
