@@ -8,7 +8,9 @@ A run folder (Hydra's output directory) holds:
 ``controller_state.npz`` the learned state at the end (``init_from`` starts from it); parts of a
                          composite controller keep ``controller_state.part<i>.npz`` beside it
 ``checkpoint.pkl``       the whole live loop every ``checkpoint_every`` trials (``resume``), with a
-                         small JSON head ``checkpoint.pkl.json``; deleted when the run completes
+                         small JSON head ``checkpoint.pkl.json``, its large learned arrays in
+                         ``checkpoint.<n>.arrays`` and the last changes to them in ``checkpoint.journal``
+                         (``loop/checkpoint.py``); all deleted when the run completes
 ``error.txt``            a sweep job refused before its run started: why
 ``robot/``, ``relay/``   a wall-clock run over a real link: the robot side's run folder and the delay
                          relay's counts and drawn delays (``injected.csv``)

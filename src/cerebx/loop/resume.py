@@ -1,14 +1,14 @@
 """Checkpoints and resumption of a run (``recording.checkpoint_every``, ``resume=RUN_DIR``).
 
-Every ``checkpoint_every`` trials the run writes, into its folder,
+Every ``checkpoint_every`` trials the run writes, into its folder, the whole live loop (plant, task, stages,
+link with the messages in flight, every random generator, the tick and trial counters, the per-trial metrics
+so far): ``checkpoint.pkl`` with its head (also copied to ``checkpoint.pkl.json``), and the large learned
+arrays beside it (``loop/checkpoint.py``: written by a thread of its own while the run goes on, atomically,
+only what changed since the last checkpoint). The learned state itself (``controller_state.npz``, what
+``init_from`` starts from) is written when the run ends, also when it is interrupted or fails; a run killed
+outright (SIGKILL, OOM) is continued from its checkpoint instead.
 
-- the learned state, as at the end of a run (``controller_state.npz``, each stage's ``save_state``), so
-  ``init_from`` may start from it, and
-- ``checkpoint.pkl``: the whole live loop (plant, task, stages, link with the messages in flight, every
-  random generator, the tick and trial counters, the per-trial metrics so far), pickled with cloudpickle,
-  written atomically.
-
-``resume=RUN_DIR`` rebuilds the loop from that file and continues with the next trial; the recorder is
+``resume=RUN_DIR`` rebuilds the loop from the checkpoint and continues with the next trial; the recorder is
 not in the pickle (the continuation logs into a new segment, ``recording/segments.py``), so everything
 logged before stays as it was. Because the generators and the messages in flight are restored too, the
 continued trials equal those of a run that was never interrupted (same code, same seed).
@@ -21,15 +21,14 @@ from __future__ import annotations
 import json
 import logging
 import os
-import pickle
 from pathlib import Path
 from typing import Any
 
-import cloudpickle
 import yaml
 
 from cerebx import __version__, runfiles
 from cerebx.errors import CerebxError, ConfigError
+from cerebx.loop import checkpoint
 from cerebx.loop.loop import ClosedLoop
 from cerebx.recording.reader import read_metadata
 from cerebx.recording.recorder import Recorder
@@ -53,53 +52,48 @@ def same_config(cfg: Any) -> dict:
     return cfg.model_dump(mode="json", exclude=set(NOT_SHARED))
 
 
-class _Pickler(cloudpickle.Pickler):
-    def persistent_id(self, obj: Any) -> str | None:
-        return _RECORDER if isinstance(obj, Recorder) else None
-
-
-class _Unpickler(pickle.Unpickler):
-    def __init__(self, fh, recorder: Recorder | None):
-        super().__init__(fh)
-        self.recorder = recorder
-
-    def persistent_load(self, pid: str) -> Any:
-        if pid != _RECORDER:
-            raise pickle.UnpicklingError(f"unknown persistent id {pid!r}")
-        return self.recorder
-
-
 def recorder_path(cfg: Any, run_dir: Path) -> Path:
     """The file this run logs into: ``run.mcap``, or the next segment when it continues a run."""
     if cfg.resume is None:
         return run_dir / FIRST
-    return add_segment(run_dir, _checkpoint_head(run_dir)["start_ns"])
+    return add_segment(run_dir, checkpoint_head(run_dir)["start_ns"])
 
 
-def _checkpoint_head(run_dir: Path) -> dict:
+def checkpoint_head(run_dir: Path) -> dict:
+    """The head of the checkpoint in ``run_dir`` (version, config, trials done, tick, ...)."""
     try:
-        return json.loads((run_dir / runfiles.CHECKPOINT_HEAD).read_text())
+        return checkpoint.read_head(run_dir)
     except FileNotFoundError:
         raise CerebxError(f"resume: {run_dir / CHECKPOINT} does not exist (the run saved no checkpoint)") from None
+    except (OSError, ValueError) as err:
+        raise CerebxError(f"resume: {run_dir / CHECKPOINT} cannot be read ({type(err).__name__})") from None
+
+
+class Checkpointer:
+    """Writes a run's checkpoints: the loop's thread pickles the state and copies what changed, a thread of
+    its own writes it (``loop/checkpoint.py``); :meth:`close` waits until the last one is on the disk."""
+
+    def __init__(self, run_dir: Path):
+        self.run_dir = Path(run_dir)
+        self.store = checkpoint.ArrayStore()
+        self.writer = checkpoint.Writer()
+
+    def save(self, loop: ClosedLoop, wall_seconds: float) -> None:
+        self.writer.wait()  # the previous checkpoint first (and its error, if it failed)
+        head = {"version": __version__, "config": same_config(loop.cfg), "trials_done": loop.trials_done,
+                "tick": loop.tick, "start_ns": int(round(loop.tick * loop.dt_s * 1e9)), "wall_seconds": wall_seconds}
+        state = {"ctx": loop.ctx, "loop": {f: getattr(loop, f) for f in _LOOP_FIELDS}}
+        self.writer.submit(checkpoint.prepare(self.run_dir, head, state, self.store, {Recorder: _RECORDER}))
+
+    def close(self) -> None:
+        self.writer.wait()
 
 
 def save(loop: ClosedLoop, run_dir: Path, wall_seconds: float) -> None:
-    """Write the checkpoint (pickle + a small JSON head naming its trial) and the learned state."""
-    state = {"version": __version__, "config": same_config(loop.cfg), "ctx": loop.ctx,
-             "loop": {f: getattr(loop, f) for f in _LOOP_FIELDS}, "wall_seconds": wall_seconds}
-    tmp = run_dir / (CHECKPOINT + ".tmp")
-    with open(tmp, "wb") as fh:
-        _Pickler(fh, protocol=pickle.HIGHEST_PROTOCOL).dump(state)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, run_dir / CHECKPOINT)
-    head = {"version": __version__, "config": state["config"], "trials_done": loop.trials_done, "tick": loop.tick,
-            "start_ns": int(round(loop.tick * loop.dt_s * 1e9)), "wall_seconds": wall_seconds}
-    tmp_head = run_dir / (CHECKPOINT + ".json.tmp")
-    tmp_head.write_text(json.dumps(head))
-    os.replace(tmp_head, run_dir / (CHECKPOINT + ".json"))
-    if loop.cfg.recording.save_state:
-        loop.controller.save_state(run_dir / runfiles.STATE)
+    """Write a checkpoint of ``loop`` into ``run_dir`` and wait until it is on the disk."""
+    ckpt = Checkpointer(run_dir)
+    ckpt.save(loop, wall_seconds)
+    ckpt.close()
 
 
 def due(loop: ClosedLoop) -> bool:
@@ -111,8 +105,7 @@ def load(cfg: Any, run_dir: Path, recorder: Recorder) -> tuple[ClosedLoop, float
     """The loop of the checkpoint in ``run_dir``, logging into ``recorder``; and the wall time spent so far."""
     path = run_dir / CHECKPOINT
     try:
-        with open(path, "rb") as fh:
-            state = _Unpickler(fh, recorder).load()
+        head, state = checkpoint.load(run_dir, {_RECORDER: recorder})
     except FileNotFoundError:
         raise CerebxError(f"resume: {path} does not exist (the run saved no checkpoint)") from None
     except Exception as err:  # any unpickling problem: a file from other code or a damaged one
@@ -124,13 +117,13 @@ def load(cfg: Any, run_dir: Path, recorder: Recorder) -> tuple[ClosedLoop, float
     for f, v in state["loop"].items():
         setattr(loop, f, v)
     log.info("resuming %s at trial %d (tick %d)", run_dir, loop.trials_done, loop.tick)
-    return loop, float(state["wall_seconds"])
+    return loop, float(head["wall_seconds"])
 
 
 def check(cfg: Any, run_dir: Path) -> None:
     """Refuse (one line) a continuation that cannot continue the checkpoint in ``run_dir``: another cerebx
     version, another config, or no trial left to run."""
-    head = _checkpoint_head(run_dir)
+    head = checkpoint_head(run_dir)
     if head.get("version") != __version__:
         raise ConfigError(f"resume: {run_dir / CHECKPOINT} was written by cerebx {head.get('version')}, "
                           f"this is {__version__}")
@@ -167,8 +160,7 @@ def _check_same(old: Any, new: Any, where: str = "", whose: str = "the resumed r
 
 def finish(run_dir: Path) -> None:
     """The run completed: its checkpoint is no longer needed."""
-    for name in (CHECKPOINT, runfiles.CHECKPOINT_HEAD):
-        (run_dir / name).unlink(missing_ok=True)
+    checkpoint.remove(run_dir)
 
 
 def requeued_dir(run_dir: Path) -> Path | None:
@@ -248,6 +240,6 @@ def _completed(run_dir: Path) -> dict | None:
 
 def _clear(run_dir: Path) -> None:
     """Drop what an unfinished attempt without a usable checkpoint left (a fresh run writes it anew)."""
-    for p in [*run_dir.glob("run.*.mcap"), run_dir / runfiles.SEGMENTS, run_dir / CHECKPOINT,
-              run_dir / runfiles.CHECKPOINT_HEAD, run_dir / runfiles.SUMMARY]:
+    for p in [*run_dir.glob("run.*.mcap"), run_dir / runfiles.SEGMENTS, run_dir / runfiles.SUMMARY]:
         p.unlink(missing_ok=True)
+    checkpoint.remove(run_dir)

@@ -77,6 +77,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
     rec.metadata("cerebx", {"version": __version__, "overrides": json.dumps(list(overrides or []))})
     rec.metadata("config", {"json": json.dumps(resolved if resolved is not None else cfg.model_dump(mode="json"))})
     loop: ClosedLoop | None = None
+    ckpt = resume.Checkpointer(run_dir)
     bar = None
     wall_before = 0.0  # spent by the run this one continues
     try:
@@ -106,7 +107,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
                 m = loop.run_trial(trial)
                 if resume.due(loop):
                     with phases.span("checkpoint"):
-                        resume.save(loop, run_dir, wall_before + time.perf_counter() - wall0)
+                        ckpt.save(loop, wall_before + time.perf_counter() - wall0)
                 if bar is not None:
                     bar.set_postfix_str(f"trial {trial + 1}/{cfg.trials}  MAE {m.mae:.4f} rad")
                     bar.update(1)
@@ -122,6 +123,10 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
     finally:
         if clock is not None:
             clock.switch("finish")
+        try:
+            ckpt.close()  # the last checkpoint on the disk (or the previous one, whole, if writing it failed)
+        except Exception as err:
+            log.error("could not write the last checkpoint: %s", err)
         if bar is not None:
             bar.close()
         if summary["status"] == "running":  # left by an exception that is not an Exception (SystemExit)

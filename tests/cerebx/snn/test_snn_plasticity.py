@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from cerebx.loop import checkpoint
 from cerebx.snn.network import Network
 from cerebx.snn.presets import PC
 from cerebx.snn.schema import NetworkConfig
@@ -95,3 +96,29 @@ def test_plasticity_off_freezes_weights():
     net.learn = False
     run(net, {0: [("pf", 1)], 75: [("cf", 2)]}, 80)
     np.testing.assert_array_equal(net.weights("pf_pc"), W0)
+
+
+def test_checkpoints_rewrite_the_rows_learning_changed(tmp_path):
+    net = plastic_net(n_pf=30, n_pc=4)
+    rng = np.random.default_rng(0)
+
+    def learn(n_steps, n_pf):  # PF and CF spikes; LTD also reaches PFs of the previous interval
+        run(net, {k: [("pf", int(i)) for i in rng.choice(n_pf, 2, replace=False)]
+                  + ([("cf", int(rng.integers(4)))] if k % 7 == 0 else []) for k in range(0, n_steps, 5)}, n_steps)
+
+    store = checkpoint.ArrayStore()
+    learn(200, 30)
+    run(net, {}, 300)  # past the kernel window of those spikes
+    run(net, {0: [("pf", 25)]}, 40)  # LTD after the checkpoint (CF at step 35 next)
+    checkpoint.prepare(tmp_path, {"trials_done": 1}, {"net": net}, store, {}).write()  # whole
+    before = net.weights("pf_pc").copy()
+    learn(60, 10)
+    changed = np.flatnonzero((net.weights("pf_pc") != before).any(axis=1))
+    ckpt = checkpoint.prepare(tmp_path, {"trials_done": 2}, {"net": net}, store, {})
+    assert ckpt.whole is None and 25 in changed and len(changed) < 30
+    (_, starts, length, _), = ckpt.changes
+    assert length == 4 and set(changed.tolist()) <= set((starts // 4).tolist())
+    ckpt.write()
+    _, state = checkpoint.load(tmp_path, {})
+    np.testing.assert_array_equal(state["net"].dense_w, net.dense_w)
+    np.testing.assert_array_equal(state["net"]._state.arrays.delivery.dense_w, net.dense_w)
