@@ -36,7 +36,7 @@ from typing import Any
 import cloudpickle
 import numpy as np
 
-from cerebx import phases, runfiles
+from cerebx import phase_clock, runfiles
 
 CHECKPOINT = runfiles.CHECKPOINT
 JOURNAL = "checkpoint.journal"
@@ -287,7 +287,7 @@ class Writer:
 
     def submit(self, ckpt: Checkpoint) -> None:
         self.wait()
-        clock = phases.active()
+        clock = phase_clock.active()
 
         def work() -> None:
             t0, c0 = time.perf_counter(), time.thread_time()
@@ -304,7 +304,7 @@ class Writer:
     def wait(self) -> None:
         """Until the checkpoint being written is on the disk (raises what writing it raised)."""
         if self._thread is not None:
-            with phases.charge("checkpoint_wait"):
+            with phase_clock.charge("checkpoint_wait"):
                 self._thread.join()
             self._thread = None
         if self._error is not None:

@@ -1,5 +1,5 @@
 """Per-tick phases of a timed run (``recording.phase_times``): the loop's parts behind thin proxies that
-switch the :class:`~cerebx.phases.PhaseClock` around each call, so the loop itself is not touched.
+switch the :class:`~cerebx.phase_clock.PhaseClock` around each call, so the loop itself is not touched.
 
 ========== =====================================================================================
 phase      what is charged to it
@@ -25,7 +25,7 @@ from collections.abc import Callable
 from typing import Any
 
 from cerebx.loop.loop import ClosedLoop
-from cerebx.phases import PhaseClock
+from cerebx.phase_clock import PhaseClock
 
 PLANT_CALLS = ("sense", "actuate", "true_state", "end_effector", "step", "is_diverged")
 RECORDER_CALLS = ("write", "joint_states", "spikes")

@@ -14,7 +14,7 @@ from typing import Any
 
 from tqdm import tqdm
 
-from cerebx import __version__, phases, runfiles
+from cerebx import __version__, phase_clock, runfiles
 from cerebx.build import build_components
 from cerebx.errors import CerebxError, outcome
 from cerebx.loop import resume
@@ -65,8 +65,8 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
     started = time.time()
     wall0 = time.perf_counter()
     cpu0 = time.process_time()
-    clock = phases.PhaseClock("open") if cfg.recording.phase_times else None
-    phases.activate(clock)
+    clock = phase_clock.PhaseClock("open") if cfg.recording.phase_times else None
+    phase_clock.activate(clock)
     summary = new_summary(cfg, version=__version__, overrides=list(overrides or []), started_at=started,
                           presets=dict(choices or {}))
     write_summary(run_dir, summary)
@@ -82,7 +82,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
     wall_before = 0.0  # spent by the run this one continues
     try:
         with _sigterm_as_interrupt():
-            with phases.span("build"):
+            with phase_clock.span("build"):
                 if cfg.resume is not None:
                     loop, wall_before = resume.load(cfg, run_dir, rec)
                 ctx = loop.ctx if loop is not None else build_components(cfg, run_dir)
@@ -106,12 +106,12 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             for trial in range(loop.trials_done, cfg.trials):
                 m = loop.run_trial(trial)
                 if resume.due(loop):
-                    with phases.span("checkpoint"):
+                    with phase_clock.span("checkpoint"):
                         ckpt.save(loop, wall_before + time.perf_counter() - wall0)
                 if bar is not None:
                     bar.set_postfix_str(f"trial {trial + 1}/{cfg.trials}  MAE {m.mae:.4f} rad")
                     bar.update(1)
-                with phases.span("summary"):
+                with phase_clock.span("summary"):
                     summary.update(trial_fields(loop.metrics, loop.sim_seconds),
                                    wall_seconds=wall_before + time.perf_counter() - wall0)
                     write_summary(run_dir, summary)
@@ -136,7 +136,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             summary.update(trial_fields(loop.metrics, loop.sim_seconds))
             if cfg.recording.save_state and loop.trials_done > 0:
                 try:
-                    with phases.span("save_state"):
+                    with phase_clock.span("save_state"):
                         loop.controller.save_state(run_dir / runfiles.STATE)
                 except Exception as err:  # the state is a bonus; the log must still be finished
                     log.error("could not save controller state: %s", err)
@@ -145,7 +145,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
         summary["cpu_seconds"] = time.process_time() - cpu0
         if clock is not None:
             summary["phase_times"] = clock.report()  # closing the log comes after: untimed
-            phases.activate(None)
+            phase_clock.activate(None)
         try:
             finish_run(rec, run_dir, summary, sentinel)
         finally:

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx import phases, registry
+from cerebx import phase_clock, registry
 from cerebx.controllers.base import CommandMsg, ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
 from cerebx.controllers.snn.schema import SNNController
@@ -170,7 +170,7 @@ class SNNControllerImpl(Controller):
         first = self._net_step  # no chunk is in flight when a new one starts
         box: dict[str, Any] = {}
 
-        clock = phases.active()
+        clock = phase_clock.active()
 
         def work() -> None:
             t0, c0 = (time.perf_counter(), time.thread_time()) if clock is not None else (0.0, 0.0)
@@ -189,7 +189,7 @@ class SNNControllerImpl(Controller):
         if worker is None:
             return
         thread, box = worker
-        with phases.charge("wait"):
+        with phase_clock.charge("wait"):
             thread.join()
         self._worker = None
         if "err" in box:

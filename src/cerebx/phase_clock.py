@@ -1,4 +1,5 @@
 """Where a run's time goes, for ``cerebx bench`` (``recording.phase_times=true``; off otherwise, at no cost).
+Not to be confused with ``loop/phases.py``, the parts of one tick: this module only times them.
 
 A :class:`PhaseClock` charges the main thread's wall time to the phase it is in. Code switches phase at a
 boundary, so every second lands in exactly one phase: phases nest exclusively (the wait for the network

@@ -8,8 +8,10 @@ import time
 
 import pytest
 
-from cerebx import phases
-from cerebx.phases import PhaseClock
+from cerebx import phase_clock
+from cerebx.loop.runner import run_experiment
+from cerebx.phase_clock import PhaseClock
+from cerebx.recording.reader import read_messages
 
 
 def test_phases_nest_exclusively_and_add_up_to_the_wall_time():
@@ -37,15 +39,12 @@ def test_background_work_is_reported_apart():
 
 
 def test_no_active_clock_costs_a_shared_no_op():
-    phases.activate(None)
-    assert phases.span("x") is phases.charge("y")
+    phase_clock.activate(None)
+    assert phase_clock.span("x") is phase_clock.charge("y")
 
 
 @pytest.mark.integration
 def test_a_timed_run_records_the_same_data_and_says_where_its_time_went(tmp_path, load):
-    from cerebx.loop.runner import run_experiment
-    from cerebx.recording.reader import read_messages
-
     runs = {}
     for timed in (False, True):
         run_dir = tmp_path / str(timed)
@@ -61,4 +60,4 @@ def test_a_timed_run_records_the_same_data_and_says_where_its_time_went(tmp_path
     wall = report["wall_s"]
     assert {"build", "plant", "brain", "robot", "recording", "loop", "checkpoint", "summary", "finish"} <= set(wall)
     assert sum(wall.values()) == pytest.approx(timed["wall_seconds"], rel=0.05)
-    assert phases.active() is None  # the run leaves no clock behind
+    assert phase_clock.active() is None  # the run leaves no clock behind
