@@ -6,27 +6,35 @@
 
 Every registered figure (report/registry.py) is drawn from the runs it finds; one whose runs are
 missing, and any run that is missing or unreadable, gives one line and the rest is still built.
+Besides index.html and the tables, ``figures.json`` holds every drawn figure (title, caption, table,
+notes, files) and how the report was made (command, profile, cerebx version, the runs' count and dates),
+for tools that publish a report elsewhere.
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import dataclasses
 import html
+import json
+import shlex
 import sys
 import time
 from collections import defaultdict
+from datetime import datetime, timezone
 from pathlib import Path
+from typing import Any
 
-from cerebx import runfiles
+from cerebx import __version__, runfiles
 from cerebx.config import estimate_jobs
 from cerebx.errors import CerebxError
 from cerebx.report import figures
 from cerebx.report.delays import delay_rows
 from cerebx.report.plot import fmt
-from cerebx.report.registry import Figure, MissingRuns, all_figures
+from cerebx.report.registry import Figure, FigureSpec, MissingRuns, all_figures
 from cerebx.report.runs import RunSet, find_run_dirs, load_runs
-from cerebx.report.studies import execute, group, plan, study_runner
+from cerebx.report.studies import execute, group, plan, profile_of, study_runner
 
 MAX_TRACKING_RUNS = 12  # per-run joint-tracking figures only for small run sets
 
@@ -81,15 +89,52 @@ def _general_figures(runs: RunSet, fig_dir: Path, problems: list[str]) -> list[s
     return sections
 
 
+def _iso(t: float) -> str:
+    return datetime.fromtimestamp(t, timezone.utc).isoformat(timespec="seconds")
+
+
+def provenance(runs: RunSet, command: str | None, profile: str | None) -> dict[str, Any]:
+    """How a report was made: the command, the profile, this cerebx's version, when, and the runs it drew
+    from (how many, the first and last start time their summaries record, the versions that ran them)."""
+    started = sorted(float(t) for r in runs if isinstance(t := r.summary.get("started_at"), int | float))
+    return {
+        "command": command,
+        "profile": profile,
+        "cerebx_version": __version__,
+        "built_at": _iso(time.time()),
+        "runs": {
+            "count": len(runs),
+            "first_started_at": _iso(started[0]) if started else None,
+            "last_started_at": _iso(started[-1]) if started else None,
+            "versions": sorted({str(v) for r in runs if (v := r.summary.get("version"))}),
+        },
+    }
+
+
+def figure_entry(spec: FigureSpec, fig: Figure, out: Path) -> dict[str, Any]:
+    """One drawn figure as JSON: its spec (name, title, studies, the module that draws it) and every field
+    of its :class:`Figure`, files as paths relative to the report folder."""
+    entry: dict[str, Any] = {"name": spec.name, "title": spec.title, "studies": list(spec.studies),
+                             "module": getattr(spec.draw, "__module__", None)}
+    for f in dataclasses.fields(fig):
+        value = getattr(fig, f.name)
+        if f.name == "files":
+            value = [p.relative_to(out).as_posix() if p.is_relative_to(out) else p.name for p in value]
+        entry[f.name] = value
+    return entry
+
+
 def _img(png: Path, caption: str) -> str:
     return (f"<figure><a href='figures/{png.name}'><img src='figures/{png.name}'></a>"
             f"<figcaption>{html.escape(caption)} <a href='figures/{png.with_suffix('.svg').name}'>SVG</a>"
             "</figcaption></figure>")
 
 
-def build(run_dirs: list[Path], out: Path, names: list[str] | None = None,
-          log=lambda line: None) -> tuple[Path, list[str], int]:
-    """Draw every figure (or the named ones) from ``run_dirs`` into ``out``; returns (index, problems, runs)."""
+def build(run_dirs: list[Path], out: Path, names: list[str] | None = None, log=lambda line: None,
+          command: str | None = None, profile: str | None = None) -> tuple[Path, list[str], int]:
+    """Draw every figure (or the named ones) from ``run_dirs`` into ``out``; returns (index, problems, runs).
+    ``command`` and ``profile`` are recorded in figures.json (the profile is read from the runs' folders
+    when not given)."""
     runs, problems = load_runs(run_dirs)
     out.mkdir(parents=True, exist_ok=True)
     fig_dir = out / "figures"
@@ -133,6 +178,10 @@ def build(run_dirs: list[Path], out: Path, names: list[str] | None = None,
     _write_table(out, "runs", runs_rows)
     _write_table(out, "paper_vs_cerebx", paper_rows)
     _write_table(out, "delays", delay_rows(runs))
+    made = provenance(runs, command, profile or profile_of([r.dir for r in runs]))
+    (out / "figures.json").write_text(json.dumps(
+        {**made, "figures": [figure_entry(spec, fig, out) for spec, fig in drawn], "not_drawn": missing},
+        indent=1, ensure_ascii=False, default=str) + "\n")
     miss = "".join(f"<li>{html.escape(m)}</li>" for m in missing)
     probs = "".join(f"<li>{html.escape(p)}</li>" for p in problems)
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>cerebx report</title>
@@ -142,6 +191,8 @@ table{{border-collapse:collapse;font-size:13px}}td,th{{border:1px solid #ccc;pad
 .cap{{font-size:14px;color:#333}}.runs{{font-size:12px;color:#777}}section{{border-top:1px solid #ddd;
 margin-top:2em}}</style></head><body>
 <h1>cerebx report</h1>
+<p class='runs'>{html.escape(made["built_at"])}: <code>{html.escape(made["command"] or "cerebx report")}</code>,
+cerebx {html.escape(made["cerebx_version"])}</p>
 <p>{len(runs)} runs, {len(drawn)} of {len(chosen)} figures drawn from their logs. Each figure is shown
 with the paper's numbers beside cerebx's (all numbers in paper_vs_cerebx.csv). Absolute numbers depend on the
 plant (a real robot vs a MuJoCo model); the shapes and orderings are what should hold.</p>
@@ -210,7 +261,8 @@ def main(argv: list[str]) -> int:
             dirs = []
             for p in a.runs or [Path("runs")]:
                 dirs.extend(find_run_dirs(p) if p.is_dir() and not (p / runfiles.SUMMARY).exists() else [p])
-        index, problems, n = build(dirs, a.out, names, log=print)
+        index, problems, n = build(dirs, a.out, names, log=print, command=shlex.join(["cerebx", "report", *argv]),
+                                   profile=a.profile)
     except CerebxError as err:
         for line in str(err).splitlines():
             print(line, file=sys.stderr)

@@ -91,6 +91,12 @@ def load_studies(*paths: Path) -> dict[str, StudySpec]:
     return studies
 
 
+def profile_of(run_dirs: list[Path]) -> str | None:
+    """The profile whose folder (``<root>/<profile>/<study>/<job>``) holds every one of ``run_dirs``, if one does."""
+    found = {Path(d).parent.parent.name for d in run_dirs}
+    return found.pop() if len(found) == 1 and found <= set(PROFILES) else None
+
+
 def _read_studies(path: Path) -> dict[str, StudySpec]:
     try:
         raw = yaml.safe_load(Path(path).read_text())

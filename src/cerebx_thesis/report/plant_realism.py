@@ -73,10 +73,10 @@ def plant_realism(runs: RunSet, stem: Path) -> Figure:
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, axis="y")
     fig.tight_layout()
-    caption = ("Plant realism study (issue #11, not a thesis figure): MAE on the circle (mean of the "
-               "measured trials) of PD (original PD_circle gains) and of the SNN (the chapter 3 learned "
-               "circle, 10 more learning trials on each plant, delay-robust default controller) on each "
-               "plant variant: the default rigid arm, series elastic actuators, sensor noise (0.5 mrad, "
-               "5 mrad/s), a 5 / 10 ms first-order torque lag, and the URDF's armature (none). "
+    caption = ("Plant realism study (not a thesis figure: does a feature of the real arm change the ordering?): "
+               "MAE on the circle (mean of the measured trials) of PD (original PD_circle gains) and of the SNN "
+               "(the chapter 3 learned circle, 10 more learning trials on each plant, delay-robust default "
+               "controller) on each plant variant: the default rigid arm, series elastic actuators, sensor noise "
+               "(0.5 mrad, 5 mrad/s), a 5 / 10 ms first-order torque lag, and the URDF's armature (none). "
                "Constructed noise and lag levels; 0 and 50 ms constant round trips.")
     return Figure([save(fig, stem)], caption, table, notes)

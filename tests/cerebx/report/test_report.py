@@ -57,6 +57,10 @@ def test_every_figure_is_drawn_from_fixture_runs(fixture_runs, tmp_path, monkeyp
     for name in figures:
         assert f"\n{name}," in paper, f"{name}: no paper-vs-cerebx rows"
     assert "0.019" in page and "0.000106" in page  # the paper's numbers beside ours
+    made = json.loads((out / "figures.json").read_text())  # the same figures, machine-readable
+    assert [e["name"] for e in made["figures"]] == list(figures) and made["runs"]["count"] > 0
+    assert all((out / f).is_file() for e in made["figures"] for f in e["files"])
+    assert made["command"].startswith("cerebx report ") and made["profile"] == "quick"
 
 
 def test_report_replots_given_runs_and_survives_unreadable_ones(fixture_runs, tmp_path, monkeypatch, capsys):

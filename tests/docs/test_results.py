@@ -1,0 +1,161 @@
+"""The published report in docs/results: every registered figure is published and shown on its paper's
+reproduction page, the published files are exactly what the publishing step makes from the report they came
+from, and the publishing step turns a report built from synthetic runs into the expected snippets."""
+
+from __future__ import annotations
+
+import csv
+import importlib.util
+import json
+import re
+import time
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import pytest
+
+from cerebx.report.build import build
+from cerebx.report.plot import save
+from cerebx.report.registry import FIGURES, Figure, FigureSpec, all_figures
+
+ROOT = Path(__file__).resolve().parents[2]
+RESULTS = ROOT / "docs" / "results"
+PAGES = ROOT / "docs" / "reproductions"
+# the reproduction page of each plugin package; the thesis's figures go to the chapter their name carries
+PAGE_OF_PACKAGE = {"cerebx_luque2011": "luque2011.md", "cerebx_capolei2020": "capolei2020.md"}
+MACHINE_PATH = re.compile(r"(?<![\w.~])/(?:work|tmp|home|root|Users|mnt|opt|var)/")
+
+
+def _publisher():
+    spec = importlib.util.spec_from_file_location("publish_report", ROOT / "scripts" / "publish_report.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+publisher = _publisher()
+
+
+def _published() -> dict:
+    return json.loads((RESULTS / "figures.json").read_text())
+
+
+def _page_of(spec: FigureSpec) -> list[str]:
+    """The page(s) a figure belongs on: its plugin's page; a thesis figure on its chapter's page (one without a
+    chapter number, a study of the thesis that is no figure of it, on any thesis page)."""
+    package = spec.draw.__module__.split(".")[0]
+    if package == "cerebx_thesis":
+        chapter = re.search(r"(\d)_", spec.name)
+        return [f"thesis-ch{chapter.group(1)}.md"] if chapter else [p.name for p in PAGES.glob("thesis-ch*.md")]
+    assert package in PAGE_OF_PACKAGE, f"{spec.name}: figures of {package} have no reproduction page (add one)"
+    return [PAGE_OF_PACKAGE[package]]
+
+
+def test_every_registered_figure_is_published_and_on_its_page():
+    published = {e["name"]: e for e in _published()["figures"]}
+    pages = {p.name: p.read_text() for p in PAGES.glob("*.md")}
+    for name, spec in all_figures().items():
+        assert name in published, f"{name}: not in docs/results (publish a report that draws it)"
+        assert (RESULTS / f"{name}.md").is_file(), f"{name}: docs/results/{name}.md missing"
+        for f in published[name]["files"]:
+            assert (RESULTS / "figures" / Path(f).name).is_file(), f"{name}: image {f} not published"
+        include = f'--8<-- "docs/results/{name}.md"'
+        on = [page for page, text in pages.items() if include in text]
+        assert len(on) == 1, f"{name}: included on {on or 'no page'}; it belongs on one of {_page_of(spec)}"
+        assert on[0] in _page_of(spec), f"{name}: on {on[0]}, but it belongs on one of {_page_of(spec)}"
+        assert re.search(rf"^#+ .*\{{ *#{name} *\}}", pages[on[0]], re.M), f"{name}: no heading {{ #{name} }}"
+        assert f"#{name})" in pages["index.md"], f"{name}: not linked from the reproductions index"
+
+
+def test_published_files_are_what_the_publishing_step_makes_of_their_report():
+    report = _published()
+    expected = publisher.render(report)
+    assert expected["figures.json"] == (RESULTS / "figures.json").read_text()
+    for name, text in expected.items():
+        assert (RESULTS / name).read_text() == text, f"docs/results/{name} differs from its report: publish again"
+    made_by_hand = {p.name for p in RESULTS.glob("*") if p.is_file()} - set(expected)
+    assert not made_by_hand, f"docs/results holds files the publishing step does not make: {made_by_hand}"
+    images = {Path(f).name for e in report["figures"] for f in e["files"]}
+    assert {p.name for p in (RESULTS / "figures").iterdir()} == images
+
+
+def test_pages_describe_the_profile_that_is_published():
+    profile = _published()["profile"]
+    for page in PAGES.glob("*.md"):
+        for said in re.findall(r"published runs \((\w+) profile\)", page.read_text()):
+            assert said == profile, f"{page.name} describes {said}-profile runs; docs/results holds {profile}"
+
+
+def test_no_machine_path_in_the_published_results_or_the_pages():
+    for path in [*RESULTS.glob("*.md"), RESULTS / "figures.json", *PAGES.glob("*.md")]:
+        hit = MACHINE_PATH.search(path.read_text())
+        assert hit is None, f"{path.relative_to(ROOT)}: machine path at {hit.start()}"
+
+
+def _synthetic_runs(root: Path, started: list[float]) -> list[Path]:
+    dirs = []
+    for i, t in enumerate(started):
+        d = root / "runs" / "report" / "quick" / "toy_study" / f"seed={i}"
+        d.mkdir(parents=True)
+        (d / "summary.json").write_text(json.dumps({
+            "status": "completed", "task": "circle", "controller": "pd", "plant": "baxter", "delay": "none",
+            "seed": i, "trials": 3, "trials_completed": 0, "mae_per_trial": [0.3, 0.2, 0.1 + i / 100],
+            "final_mae": 0.1 + i / 100, "sim_seconds": 6.0, "wall_seconds": 1.0, "started_at": t,
+            "version": "0.0.toy"}))
+        dirs.append(d)
+    return dirs
+
+
+def _toy_figure(runs, stem: Path) -> Figure:
+    fig, ax = plt.subplots()
+    ax.plot([r.summary["final_mae"] for r in runs])
+    rows = [["quantity", "paper", "cerebx", "runs"], ["final MAE | mean (rad)", "0.1", "0.11", str(len(runs))],
+            ["a row <shorter>", "–"]]
+    return Figure([save(fig, stem)], "Toy caption with *stars* and a <tag>.", rows, ["a note"])
+
+
+@pytest.mark.integration
+def test_publishing_a_report_built_from_synthetic_runs(tmp_path, monkeypatch):
+    started = [time.mktime((2025, 3, 1, 12, 0, 0, 0, 0, -1)), time.mktime((2025, 3, 4, 12, 0, 0, 0, 0, -1))]
+    dirs = _synthetic_runs(tmp_path, started)
+    all_figures()  # the plugins' figures first, so the toy one is not overwritten by their registration
+    monkeypatch.setitem(FIGURES, "toy_fig1", FigureSpec("toy_fig1", "Toy figure", ("toy_study",), _toy_figure))
+    report = tmp_path / "reports"
+    command = f"cerebx report {tmp_path}/runs/report/quick --figures=toy_fig1 --out {report}"
+    build(dirs, report, ["toy_fig1"], command=command)
+
+    made = json.loads((report / "figures.json").read_text())
+    assert made["profile"] == "quick" and made["runs"]["count"] == 2 and made["runs"]["versions"] == ["0.0.toy"]
+    assert (made["runs"]["first_started_at"][:10], made["runs"]["last_started_at"][:10]) == ("2025-03-01", "2025-03-04")
+    (entry,) = made["figures"]
+    assert entry["files"] == ["figures/toy_fig1.png"] and entry["studies"] == ["toy_study"]
+    # a newer report may add fields to a figure and columns to its CSV tables: both are carried along
+    entry["converged"] = False
+    (report / "figures.json").write_text(json.dumps(made))
+    with open(report / "paper_vs_cerebx.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    with open(report / "paper_vs_cerebx.csv", "w", newline="") as fh:
+        csv.writer(fh).writerows([[*r, "extra"] for r in rows])
+
+    out = tmp_path / "docs" / "results"
+    assert publisher.publish(report, out) == ["toy_fig1"]
+    snippet = (out / "toy_fig1.md").read_text()
+    assert "| quantity | paper | cerebx | runs |\n|---|---|---|---|\n" in snippet
+    assert "| final MAE \\| mean (rad) | 0.1 | 0.11 | 2 |\n| a row &lt;shorter> | – |  |  |\n" in snippet
+    assert "[![Toy figure](../results/figures/toy_fig1.png)](../results/figures/toy_fig1.png)" in snippet
+    assert "Toy caption with \\*stars\\* and a &lt;tag>." in snippet and "- a note" in snippet
+    assert "- converged: False" in snippet
+    stamp = (out / "stamp.md").read_text()
+    assert "`cerebx report runs/report/quick --figures=toy_fig1 --out reports`" in stamp
+    assert "2 runs of the quick profile" in stamp and "between 2025-03-01 and 2025-03-04" in stamp
+    assert MACHINE_PATH.search(stamp + (out / "figures.json").read_text()) is None
+    assert (out / "figures" / "toy_fig1.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # publishing again gives the same files; a folder that is no published report is not replaced
+    first = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    publisher.publish(report, out)
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == first
+    (tmp_path / "docs" / "page.md").write_text("mine")
+    with pytest.raises(publisher.PublishError, match="not a published report"):
+        publisher.publish(report, tmp_path / "docs")
+    with pytest.raises(publisher.PublishError, match="figures.json: not found"):
+        publisher.publish(tmp_path / "runs", tmp_path / "elsewhere")
