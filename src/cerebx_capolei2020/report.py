@@ -15,9 +15,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from cerebx.report.convergence import Convergence, plateau  # noqa: E402
 from cerebx.report.plot import save  # noqa: E402
-from cerebx.report.registry import Figure, MissingRuns, figure, studies  # noqa: E402
+from cerebx.report.registry import Check, Figure, MissingRuns, figure, studies  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
+from cerebx.report.studies import study_plateau  # noqa: E402
 
 studies(Path(__file__).with_name("studies.yaml"))
 
@@ -64,6 +66,17 @@ def receptive_fields(r: Run) -> dict[str, float]:
         if module is not None and f"{i}.rf_created" in last:
             out[module] = float(last[f"{i}.rf_created"])
     return out
+
+
+def convergence(g: dict[tuple[str, str], list[Run]]) -> Convergence:
+    """The plateau test of each learning architecture's (II-IV) mean MAE per trial over its repetitions, in each
+    case, against the paper's trial count (the full profile's)."""
+    curves = []
+    for (label, case), rs in sorted(g.items()):
+        if label != "I":  # architecture I is the PID alone: nothing learns
+            curves.append(plateau(mae_per_joint(rs).mean(axis=(0, 2)), study_plateau(f"capolei2020_case{case}"),
+                                  f"{label}{case}"))
+    return Convergence(tuple(curves))
 
 
 def _correct_from(rs: list[Run]) -> int:
@@ -117,22 +130,33 @@ def fig5(runs: RunSet, stem: Path) -> Figure:
     png = save(fig, stem)
 
     table = [["claim (paper)", "paper", "cerebx"]]
+    checks = []
     k5 = k_corr + 5  # 0-based index of the trial 5 trials after the first corrected one
     for j, paper in ((0, "12 %"), (1, "90 %")):
         d = _drop(g, j, k5, k5 + 1)
         table.append([f"IV vs I, joint {j + 1}: MAE drop at trial {k5 + 1} (corrections from trial {k_corr + 1})",
                       paper, "–" if d is None else f"{d:.0f} %"])
+        if d is not None:
+            checks.append(Check(f"IV below I on joint {j + 1} at trial {k5 + 1}", bool(d > 0),
+                                f"{d:.0f} % lower (paper {paper})"))
     late = {label: mae_per_joint(rs)[:, k_corr:k_corr + 8, 2].mean() for (label, case), rs in g.items()
             if case == "A" and mae_per_joint(rs).shape[1] >= k_corr + 8}
     if late:
         vals = ", ".join(f"{label} {v:.4f}" for label, v in sorted(late.items()))
         table.append([f"joint 3 deviation corrected in trials {k_corr + 1}-{k_corr + 8} (mean MAE, case A, rad)",
                       "only IV", f"lowest: {min(late, key=late.get)} ({vals})"])
+        checks.append(Check(f"IV corrects joint 3's deviation best in trials {k_corr + 1}-{k_corr + 8} (case A)",
+                            min(late, key=late.get) == "IV", vals + " rad"))
     noisy = {label: mae_per_joint(rs)[:, -5:].mean((0, 1)) for (label, case), rs in g.items() if case == "B"}
     if noisy:
         table.append(["case B: MAE per joint of the last 5 trials (rad)", "I degrades; III, IV filter the noise",
                       "; ".join(f"{label} " + "/".join(f"{v:.3f}" for v in vals)
                                 for label, vals in sorted(noisy.items()))])
+        if "I" in noisy and {"III", "IV"} & set(noisy):
+            checks.append(Check("with sensor noise (case B) III and IV below I on every joint (last 5 trials)",
+                                all((noisy[a] < noisy["I"]).all() for a in ("III", "IV") if a in noisy),
+                                "; ".join(f"{a} " + "/".join(f"{v:.3f}" for v in noisy[a])
+                                          for a in ("I", "III", "IV") if a in noisy)))
     for label in ("I", "II", "III", "IV"):
         if (label, "A") in g and (label, "B") in g:
             a = mae_per_joint(g[(label, "A")])[:, -5:].mean((0, 1))
@@ -142,7 +166,8 @@ def fig5(runs: RunSet, stem: Path) -> Figure:
                                for j, (aj, bj) in enumerate(zip(a, b)))
             table.append([f"{label}: MAE of the last 5 trials, B vs A", paper, change])
     return Figure([png], "MAE per joint and trial: mean over the repetitions (line) and mean ± 3 SD (99.7 % band); "
-                  f"green line: corrections start (trial {k_corr + 1}).", table)
+                  f"green line: corrections start (trial {k_corr + 1}).", table, checks=checks,
+                  convergence=convergence(g))
 
 
 @figure("capolei2020_table2", "Capolei et al. 2020 Table II: LWPR receptive fields created", STUDIES)
@@ -162,4 +187,5 @@ def table2(runs: RunSet, stem: Path) -> Figure:
     ax.axis("off")
     ax.table(cellText=rows[1:], colLabels=rows[0], loc="center").auto_set_font_size(True)
     png = save(fig, stem)
-    return Figure([png], "Receptive fields created by each module's LWPR (the paper: one count per module).", rows)
+    return Figure([png], "Receptive fields created by each module's LWPR (the paper: one count per module).", rows,
+                  convergence=convergence(g))

@@ -11,15 +11,20 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np
 
 from cerebx import metrics
+from cerebx.report.convergence import Convergence, learning_convergence
 from cerebx.report.plot import fmt, panel_letter, save
-from cerebx.report.registry import Figure, MissingRuns, figure, studies
+from cerebx.report.registry import Check, Figure, MissingRuns, figure, studies
 from cerebx.report.runs import Run, RunSet
+from cerebx.report.studies import study_plateau
 from cerebx_luque2011.cerebellum.schema import Luque2011Cerebellum
 
 studies(Path(__file__).with_name("studies.yaml"))
 
 HEADER = ["quantity", "paper", "cerebx"]
 N_JOINTS = 3
+FINAL_TRIALS = 30  # the paper's final error: the last 30 trials (Eq. 9)
+NEARLY_CONSTANT = 1.5  # Fig. 9: "nearly constant" final error, the largest at most this times the smallest
+UNSTABLE = 1.05  # Fig. 10: unstable, the final error this much above the lowest it had reached
 # Fig. 11 caption: error reduction after 200 / 400 trials, by object mass (kg)
 PAPER_IMPROVEMENT = {0.5: (40.4, 49.0), 1.0: (64.6, 64.5), 1.5: (72.5, 74.4), 2.0: (78.6, 79.3)}
 
@@ -51,6 +56,12 @@ def _default_plasticity(r: Run) -> bool:
     """LTD, LTP and arm lag at the preset's values (the runs of Fig. 9-12, not the Fig. 8 grid)."""
     return (_cer(r, "plasticity.ltd_nS") == DEFAULT.ltd_nS and _cer(r, "plasticity.ltp_nS") == DEFAULT.ltp_nS
             and _default_arm_lag(r))
+
+
+def _learnt(runs: RunSet, curves: dict, label, study: str) -> Convergence:
+    """The plateau tests of the learning curves of ``curves`` (key -> run), against the full profile's trials of
+    ``study`` (the paper's trial count)."""
+    return learning_convergence([(label(k), r, study_plateau(study)) for k, r in curves.items()], runs)
 
 
 def _mae_sum(r: Run) -> np.ndarray:
@@ -107,6 +118,9 @@ def fig8(runs: RunSet, stem: Path) -> Figure:
     best = min(cells, key=lambda k: _estimators(cells[k])["final error (rad)"])
     table = [HEADER, ["balanced point", "LTD 0.075 with LTP < 0.015", f"lowest final error at LTD {best[0]:g}, "
                       f"LTP {best[1]:g}"]]
+    checks = [Check("balanced point: the lowest final error at LTD 0.075 with LTP < 0.015",
+                    best[0] == 0.075 and best[1] < 0.015, f"lowest at LTD {best[0]:g}, LTP {best[1]:g} "
+                    f"({_estimators(cells[best])['final error (rad)']:.3f} rad)")]
     for (ltd, ltp), r in cells.items():
         e = _estimators(r)
         table.append([f"LTD {ltd:g}, LTP {ltp:g}", "–", f"final {e['final error (rad)']:.3f}, std "
@@ -115,7 +129,8 @@ def fig8(runs: RunSet, stem: Path) -> Figure:
     caption = (f"The four estimators (Eq. 8-11, last 30 trials) over the LTD x LTP grid, 1 kg object, {trials} "
                "trials per point. Paper: LTP-dominated points saturate (high, flat error: low stability "
                "estimate), LTD-dominated points reach low error but are unstable; LTD 0.075 needs LTP < 0.015.")
-    return Figure([png], caption, table)
+    conv = _learnt(runs, cells, lambda k: f"LTD {k[0]:g}, LTP {k[1]:g}", "luque2011_fig8")
+    return Figure([png], caption, table, checks=checks, convergence=conv)
 
 
 # ---- Fig. 9 / 10 -------------------------------------------------------------------------------------------------
@@ -154,9 +169,13 @@ def fig9(runs: RunSet, stem: Path) -> Figure:
     finals = [float(r.split()[0]) for _, _, r in rows]
     table = [HEADER, ["final error across delays", "nearly constant", f"{min(finals):.3f} - {max(finals):.3f} rad"],
              *rows]
+    checks = [Check(f"final error nearly constant across delays (largest within {NEARLY_CONSTANT:g}× the smallest)",
+                    max(finals) <= NEARLY_CONSTANT * min(finals),
+                    ", ".join(f"{d:g} ms {f:.3f}" for d, f in zip(by_delay, finals)) + " rad")]
+    conv = _learnt(runs, by_delay, lambda d: f"delay {d:g} ms", "luque2011_fig9")
     return Figure([png], "MAE per trial and final error for round-trip delays with the LTD kernel peak at the "
                   f"delay + the arm's own lag ({DEFAULT.arm_lag_ms:g} ms, constructed; 1 kg object). Paper: the "
-                  "delay hardly changes the final error.", table)
+                  "delay hardly changes the final error.", table, checks=checks, convergence=conv)
 
 
 @figure("luque2011_fig10", "Luque 2011 Fig. 10: kernel peak vs delay mismatch", studies=("luque2011_fig10",))
@@ -169,9 +188,39 @@ def fig10(runs: RunSet, stem: Path) -> Figure:
     png, rows = _curves_and_final(by_dev, stem, "kernel peak - delay (ms)", lambda d: f"mismatch {d:+g} ms")
     table = [HEADER, ["mismatch 50-70 ms", "still learns, final error constant", "see rows"],
              ["mismatch > 70 ms", "unstable", "see rows"], *rows]
+    checks = _fig10_checks(by_dev)
+    conv = _learnt(runs, by_dev, lambda d: f"mismatch {d:+g} ms", "luque2011_fig10")
     return Figure([png], "Kernel peak moved away from the 100 ms teaching delay (1 kg object; the kernel peaks at "
                   f"the setting + the arm's own lag, {DEFAULT.arm_lag_ms:g} ms, constructed). Paper: 50-70 ms of "
-                  "mismatch still learn; beyond about 70 ms learning becomes unstable.", table)
+                  "mismatch still learn; beyond about 70 ms learning becomes unstable.", table, checks=checks,
+                  convergence=conv)
+
+
+def _fig10_checks(by_dev: dict[float, Run]) -> list[Check]:
+    """Fig. 10's shapes: the matched kernel learns best; 50-70 ms of mismatch still learns (the final error below
+    half the first trials'); beyond 70 ms learning is unstable (the error rises again after its lowest)."""
+    m = {d: _mae_sum(r) for d, r in by_dev.items()}
+    final = {d: metrics.final_error(list(v)) for d, v in m.items()}
+    checks = [Check("the matched kernel (mismatch 0) gives the lowest final error", min(final, key=final.get) == 0,
+                    ", ".join(f"{d:+g} ms {v:.3f}" for d, v in final.items()) + " rad")]
+    still = {d: (float(v[:FINAL_TRIALS].mean()), final[d]) for d, v in m.items() if 50 <= abs(d) <= 70}
+    if still:
+        checks.append(Check("50-70 ms of mismatch still learns (final error below half the first trials')",
+                            all(b < 0.5 * a for a, b in still.values()),
+                            ", ".join(f"{d:+g} ms {a:.3f} → {b:.3f}" for d, (a, b) in still.items()) + " rad"))
+    beyond = {d: (_lowest(v), final[d]) for d, v in m.items() if abs(d) > 70}
+    if beyond:
+        checks.append(Check(f"beyond 70 ms of mismatch learning is unstable (the final error over {UNSTABLE:g}× the "
+                            "lowest running mean)", all(b > UNSTABLE * a for a, b in beyond.values()),
+                            ", ".join(f"{d:+g} ms lowest {a:.3f}, final {b:.3f}" for d, (a, b) in beyond.items())
+                            + " rad"))
+    return checks
+
+
+def _lowest(mae: np.ndarray) -> float:
+    """The lowest mean over FINAL_TRIALS consecutive trials."""
+    w = min(FINAL_TRIALS, mae.size)
+    return float(np.convolve(mae, np.ones(w) / w, mode="valid").min())
 
 
 # ---- Fig. 11 / 12 and Fig. 7c ---------------------------------------------------------------------------------------
@@ -213,8 +262,12 @@ def fig12(runs: RunSet, stem: Path) -> Figure:
     png = _finish(fig, stem, [ax_a, ax_b])
     ordered = all(a[1] < b[1] for a, b in zip(gains, gains[1:]))
     table.insert(1, ["accuracy gain grows with the mass", "yes", "yes" if ordered else "no"])
+    checks = [Check("accuracy gain grows with the mass", ordered,
+                    ", ".join(f"{g[0]:g} kg {g[1]:.3f}" for g in gains) + " rad")]
+    conv = _learnt(runs, by_mass, lambda m: f"{m:g} kg", "luque2011_fig12")
     return Figure([png], "MAE per trial with objects of 0.5-2 kg held at the hand; the crude inverse dynamics "
-                  "ignores the object. Paper: heavier objects start worse and gain more.", table)
+                  "ignores the object. Paper: heavier objects start worse and gain more.", table, checks=checks,
+                  convergence=conv)
 
 
 @figure("luque2011_fig7c", "Luque 2011 Fig. 7c: learned PF-PC weights", studies=("luque2011_fig12",))
@@ -237,4 +290,5 @@ def fig7c(runs: RunSet, stem: Path) -> Figure:
     table = [HEADER, ["weights after learning", "six column blocks x six row blocks, dark at the inputs' edges",
                       f"{fmt(float(w.min()), 2)} - {fmt(float(w.max()), 2)} nS after {r.trials} trials"]]
     return Figure([png], f"PF-PC weights after {r.trials} trials (1 kg object; dark = low weight = more DCN "
-                  "activity for that output group).", table)
+                  "activity for that output group).", table, convergence=_learnt(runs, {1.0: r}, lambda m: "1 kg",
+                                                                                 "luque2011_fig12"))

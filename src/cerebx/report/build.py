@@ -6,9 +6,12 @@
 
 Every registered figure (report/registry.py) is drawn from the runs it finds; one whose runs are
 missing, and any run that is missing or unreadable, gives one line and the rest is still built.
-Besides index.html and the tables, ``figures.json`` holds every drawn figure (title, caption, table,
-notes, files) and how the report was made (command, profile, cerebx version, the runs' count and dates),
-for tools that publish a report elsewhere.
+``index.html`` opens with a table of every figure: whether the paper's shapes hold in these runs, whether
+the learning behind it has converged (``report/convergence.py``) and the command that makes it converge;
+an unconverged figure carries a badge on its images and in its caption. Besides index.html and the tables,
+``figures.json`` holds every drawn figure (title, caption, table, notes, shape checks, convergence, files)
+and how the report was made (command, profile, cerebx version, the runs' count and dates), for tools that
+publish a report elsewhere.
 """
 
 from __future__ import annotations
@@ -30,11 +33,13 @@ from cerebx import __version__, runfiles
 from cerebx.config import estimate_jobs
 from cerebx.errors import CerebxError
 from cerebx.report import figures
+from cerebx.report.badge import stamp
 from cerebx.report.delays import delay_rows
 from cerebx.report.plot import fmt
 from cerebx.report.registry import Figure, FigureSpec, MissingRuns, all_figures
 from cerebx.report.runs import RunSet, find_run_dirs, load_runs
 from cerebx.report.studies import execute, group, plan, profile_of, study_runner
+from cerebx.report.summary import checks_list, shape_rows, summary_table
 
 MAX_TRACKING_RUNS = 12  # per-run joint-tracking figures only for small run sets
 
@@ -49,6 +54,21 @@ def _html_table(rows: list[list[str]]) -> str:
     head = "".join(f"<th>{html.escape(str(c))}</th>" for c in rows[0])
     body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>" for r in rows[1:])
     return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def _converged(fig: Figure, quantity: str) -> str:
+    """The ``converged`` cell of one paper-vs-cerebx row: yes, no (why), or – when nothing learns."""
+    return "–" if fig.convergence is None else fig.convergence.flag(quantity)
+
+
+def _badge(fig: Figure) -> str | None:
+    """Badge an unconverged figure: a band on each image, the same words ahead of its caption; the badge."""
+    badge = fig.convergence.badge if fig.convergence is not None else None
+    if badge:
+        for png in fig.files:
+            stamp(png, badge)
+        fig.caption = f"[{badge}] {fig.caption}"
+    return badge
 
 
 def _write_table(out: Path, name: str, rows: list[list[str]]) -> None:
@@ -120,6 +140,10 @@ def figure_entry(spec: FigureSpec, fig: Figure, out: Path) -> dict[str, Any]:
         value = getattr(fig, f.name)
         if f.name == "files":
             value = [p.relative_to(out).as_posix() if p.is_relative_to(out) else p.name for p in value]
+        elif f.name == "checks":
+            value = [dataclasses.asdict(c) for c in value]
+        elif f.name == "convergence" and value is not None:
+            value = value.as_json()
         entry[f.name] = value
     return entry
 
@@ -136,6 +160,15 @@ def build(run_dirs: list[Path], out: Path, names: list[str] | None = None, log=l
     ``command`` and ``profile`` are recorded in figures.json (the profile is read from the runs' folders
     when not given)."""
     runs, problems = load_runs(run_dirs)
+    return build_from(runs, out, names, log, problems, command, profile)
+
+
+def build_from(runs: RunSet, out: Path, names: list[str] | None = None, log=lambda line: None,
+               problems: list[str] | None = None, command: str | None = None,
+               profile: str | None = None) -> tuple[Path, list[str], int]:
+    """Draw every figure (or the named ones) from ``runs`` into ``out``; ``problems``: lines already found
+    (unreadable runs); the rest as :func:`build`."""
+    problems = list(problems or [])
     out.mkdir(parents=True, exist_ok=True)
     fig_dir = out / "figures"
     specs = all_figures()
@@ -143,9 +176,9 @@ def build(run_dirs: list[Path], out: Path, names: list[str] | None = None, log=l
     if unknown:
         raise CerebxError(f"--figures: unknown figure(s) {', '.join(unknown)} (known: {', '.join(specs)})")
     chosen = [specs[n] for n in names] if names else list(specs.values())
-    drawn: list[tuple] = []
+    drawn: list[tuple[FigureSpec, Figure]] = []
     missing: list[str] = []
-    paper_rows = [["figure", "quantity", "paper", "cerebx"]]
+    paper_rows = [["figure", "quantity", "paper", "cerebx", "converged"]]
     for spec in chosen:
         t0 = time.monotonic()
         try:
@@ -156,10 +189,12 @@ def build(run_dirs: list[Path], out: Path, names: list[str] | None = None, log=l
         except Exception as err:  # one broken figure must not cost the others
             problems.append(f"{spec.name}: could not be drawn ({type(err).__name__}: {err})")
             continue
-        log(f"  {spec.name}: {len(fig.files)} image(s) in {time.monotonic() - t0:.1f} s")
+        badge = _badge(fig)
+        took = f"  {spec.name}: {len(fig.files)} image(s) in {time.monotonic() - t0:.1f} s"
+        log(took + (f"; {badge}" if badge else ""))
         drawn.append((spec, fig))
         for row in fig.table[1:]:
-            paper_rows.append([spec.name, *row])
+            paper_rows.append([spec.name, *row, _converged(fig, str(row[0]))])
     toc, sections = [], []
     for spec, fig in drawn:
         toc.append(f"<li><a href='#{spec.name}'>{html.escape(spec.title)}</a></li>")
@@ -168,15 +203,21 @@ def build(run_dirs: list[Path], out: Path, names: list[str] | None = None, log=l
         table = (f"<div class='side'><h4>Paper beside cerebx</h4>{_html_table(fig.table)}</div>"
                  if len(fig.table) > 1 else "")
         notes = "".join(f"<li>{html.escape(n)}</li>" for n in fig.notes)
+        checks = checks_list(fig.checks)
+        plateaus = "".join(f"<li>{html.escape(line)}</li>" for line in
+                           (fig.convergence.describe() if fig.convergence is not None else []))
         sections.append(
             f"<section id='{spec.name}'><h2>{html.escape(spec.title)}</h2><div class='row'><div class='imgs'>{imgs}"
             f"<p class='cap'>{html.escape(fig.caption)} ({svgs})</p>"
+            f"{'<h4>Shape checks</h4><ul class=checks>' + checks + '</ul>' if checks else ''}"
+            f"{'<h4>Plateau tests</h4><ul class=plateaus>' + plateaus + '</ul>' if plateaus else ''}"
             f"{'<ul class=notes>' + notes + '</ul>' if notes else ''}</div>{table}</div>"
             f"<p class='runs'>studies: {html.escape(', '.join(spec.studies))}</p></section>")
     general = _general_figures(runs, fig_dir, problems) if runs else []
     runs_rows = _runs_table(runs)
     _write_table(out, "runs", runs_rows)
     _write_table(out, "paper_vs_cerebx", paper_rows)
+    _write_table(out, "shapes", shape_rows(drawn))
     _write_table(out, "delays", delay_rows(runs))
     made = provenance(runs, command, profile or profile_of([r.dir for r in runs]))
     (out / "figures.json").write_text(json.dumps(
@@ -189,13 +230,23 @@ def build(run_dirs: list[Path], out: Path, names: list[str] | None = None, log=l
 .row{{display:flex;gap:1.5em;align-items:flex-start}}.imgs{{flex:3}}.side{{flex:1.3;font-size:13px}}
 table{{border-collapse:collapse;font-size:13px}}td,th{{border:1px solid #ccc;padding:3px 6px;vertical-align:top}}
 .cap{{font-size:14px;color:#333}}.runs{{font-size:12px;color:#777}}section{{border-top:1px solid #ddd;
-margin-top:2em}}</style></head><body>
+margin-top:2em}}.summary td{{font-size:13px}}.ok{{color:#1b5e20}}.bad{{color:#b71c1c}}.na{{color:#777}}
+ul.checks,ul.plateaus{{margin:2px 0;padding-left:1.1em;font-size:13px}}
+ul.checks li{{list-style:none;text-indent:-1em}}
+td.ok,td.bad{{background:none}}code{{font-size:12px}}.summary{{width:100%}}.summary td:last-child{{width:24em}}
+</style></head><body>
 <h1>cerebx report</h1>
 <p class='runs'>{html.escape(made["built_at"])}: <code>{html.escape(made["command"] or "cerebx report")}</code>,
 cerebx {html.escape(made["cerebx_version"])}</p>
-<p>{len(runs)} runs, {len(drawn)} of {len(chosen)} figures drawn from their logs. Each figure is shown
-with the paper's numbers beside cerebx's (all numbers in paper_vs_cerebx.csv). Absolute numbers depend on the
-plant (a real robot vs a MuJoCo model); the shapes and orderings are what should hold.</p>
+<p>{len(runs)} runs, {len(drawn)} of {len(chosen)} figures drawn from their logs. For each figure: whether
+the paper's shapes (orderings, trends) hold in these runs, and whether the learning behind it has levelled off
+(the plateau test of each learning curve, set by its study: by default the means of its last two windows of a
+tenth of the paper's learning trials within 10 %). A figure that has not converged carries a red badge: its
+numbers are not yet a reproduction.</p>
+{summary_table(chosen, {s.name: f for s, f in drawn})}
+<p>Each figure is shown with the paper's numbers beside cerebx's (all numbers in paper_vs_cerebx.csv, with a
+column <i>converged</i>; the shape checks in shapes.csv). Absolute numbers depend on the plant (a real robot vs
+a MuJoCo model); the shapes and orderings are what should hold.</p>
 <ul>{''.join(toc)}</ul>
 {'<h3>Not drawn (runs missing)</h3><ul>' + miss + '</ul>' if miss else ''}
 {''.join(sections)}

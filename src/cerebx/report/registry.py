@@ -4,8 +4,9 @@ studies (experiment presets run once or as a sweep) whose runs it needs.
 Figures and studies come from plugins: a plugin names its report module (``registry.add_report``), whose
 import registers figures with :func:`figure` and its studies file with :func:`studies`. A figure function
 takes the run set and an output stem (``reports/figures/<name>``), draws from the logs, saves PNG + SVG
-(``report.plot.save``) and returns a :class:`Figure` with its caption and a table of the paper's numbers
-beside cerebx's. When no run it needs is there it raises :class:`MissingRuns`.
+(``report.plot.save``) and returns a :class:`Figure` with its caption, a table of the paper's numbers
+beside cerebx's, the paper's shapes tested on the runs (:class:`Check`) and the convergence of the learning
+behind it (``report.convergence``). When no run it needs is there it raises :class:`MissingRuns`.
 """
 
 from __future__ import annotations
@@ -16,11 +17,22 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from cerebx import registry
+from cerebx.report.convergence import Convergence
 from cerebx.report.runs import RunSet
 
 
 class MissingRuns(Exception):
     """The runs a figure needs are not in the run set (the message says which)."""
+
+
+@dataclass(frozen=True)
+class Check:
+    """One shape of the paper tested on the runs (an ordering, a trend): the claim in the paper's terms,
+    whether it holds in these runs (None: they cannot tell) and the numbers it was decided on."""
+
+    claim: str
+    holds: bool | None
+    numbers: str = ""
 
 
 @dataclass
@@ -30,6 +42,15 @@ class Figure:
     # header row + rows, typically [quantity, paper, cerebx]
     table: list[list[str]] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    checks: list[Check] = field(default_factory=list)
+    # the plateau tests of the learning behind the figure; None: nothing learns in its runs
+    convergence: Convergence | None = None
+
+    @property
+    def shape_holds(self) -> bool | None:
+        """Whether every shape check holds (None: no check could tell)."""
+        told = [c.holds for c in self.checks if c.holds is not None]
+        return all(told) if told else None
 
 
 @dataclass(frozen=True)

@@ -101,6 +101,14 @@ class Run:
     def learned_from(self) -> str | None:
         return self.get("init_from")
 
+    def learned_from_dirs(self) -> list[Path]:
+        """Where the run folder it started from may be: ``init_from`` as recorded, or, when relative (to
+        where the run was started), below each folder above this run, nearest first."""
+        if not self.learned_from:
+            return []
+        p = Path(self.learned_from)
+        return [p] if p.is_absolute() else [*(a / p for a in self.dir.absolute().parents), p]
+
     @property
     def events(self) -> list[dict[str, Any]]:
         return self.get("events", []) or []
@@ -173,6 +181,31 @@ class RunSet(list):
         def ok(r: Run) -> bool:
             return all(getattr(r, k) == v for k, v in eq.items()) and (pred is None or pred(r))
         return RunSet(r for r in self if ok(r))
+
+    def origin(self, run: Run, depth: int = 8) -> Run | None:
+        """The run that learned ``run``'s state from scratch: ``run`` itself when it started from scratch, else
+        the origin of the run it started from (a run of this set, else read from disk); None when that run
+        cannot be found."""
+        for _ in range(depth):
+            if not run.learned_from:
+                return run
+            run = self._find(run.learned_from_dirs())
+            if run is None:
+                return None
+        return None
+
+    def _find(self, candidates: list[Path]) -> Run | None:
+        """The first of ``candidates`` that is a run of this set or a readable run folder."""
+        mine = {r.dir.absolute(): r for r in self}
+        for c in candidates:
+            if c.absolute() in mine:
+                return mine[c.absolute()]
+            if (c / runfiles.SUMMARY).exists():
+                try:
+                    return Run.load(c)
+                except CerebxError:
+                    return None
+        return None
 
     def best(self) -> Run | None:
         """The run to show when several match: completed first, then the most trials, then the newest."""

@@ -37,6 +37,7 @@ from cerebx.errors import CerebxError, ConfigError
 from cerebx.loop.resume import stale
 from cerebx.loop.runner import run_experiment
 from cerebx.recording.summary import read_summary
+from cerebx.report.convergence import MIN_WINDOW, TOLERANCE, WINDOW_FRACTION, PlateauRule
 from cerebx.report.registry import STUDY_FILES, load_reports
 from cerebx.schema.base import Strict
 from cerebx.schema.experiment import format_errors, validate
@@ -52,6 +53,17 @@ class ProfileSpec(Strict):
     init_from: str | None = Field("inherit", description="start from this study's run instead (null: scratch)")
 
 
+class PlateauSpec(Strict):
+    """The plateau test of a learning study's curves (``report.convergence``): the window is a fraction of the
+    full profile's trials (where the paper's shape appears); the last window may fall this much below the one
+    before."""
+
+    window_fraction: float = Field(WINDOW_FRACTION, gt=0, le=0.5, description="window, a fraction of the full "
+                                   "profile's trials")
+    min_window: int = Field(MIN_WINDOW, ge=1, description="window at least this many trials")
+    tolerance: float = Field(TOLERANCE, ge=0, description="largest relative fall from the window before to the last")
+
+
 class StudySpec(Strict):
     """One experiment preset run once or as a sweep."""
 
@@ -63,6 +75,8 @@ class StudySpec(Strict):
         "sweep (each job then starts from the job of the same sweep values)")
     quick: ProfileSpec = Field(description="the quick profile (< 30 min on 2 cores in all)")
     full: ProfileSpec = Field(description="the full profile (the paper's trial counts)")
+    plateau: PlateauSpec = Field(default_factory=PlateauSpec, description="when a run of this study that learns "
+                                 "has levelled off (the report's convergence badge)")
 
 
 class StudiesFile(Strict):
@@ -95,6 +109,22 @@ def profile_of(run_dirs: list[Path]) -> str | None:
     """The profile whose folder (``<root>/<profile>/<study>/<job>``) holds every one of ``run_dirs``, if one does."""
     found = {Path(d).parent.parent.name for d in run_dirs}
     return found.pop() if len(found) == 1 and found <= set(PROFILES) else None
+
+
+def study_plateau(name: str) -> PlateauRule:
+    """The plateau test of study ``name``'s learning curves, from the plugins' studies files: its full profile's
+    trials (where the paper's shape appears) and its ``plateau`` settings."""
+    load_reports()
+    for path in STUDY_FILES:
+        spec = _read_studies_cached(path).get(name)
+        if spec is not None:
+            return PlateauRule(spec.full.trials, **spec.plateau.model_dump())
+    raise ConfigError(f"study {name!r}: no plugin defines it")
+
+
+@functools.lru_cache(maxsize=32)
+def _read_studies_cached(path: Path) -> dict[str, StudySpec]:
+    return _read_studies(path)
 
 
 def _read_studies(path: Path) -> dict[str, StudySpec]:

@@ -14,9 +14,9 @@ import numpy as np  # noqa: E402
 
 from cerebx.plants.interaction import grab_anchor, half_sine  # noqa: E402
 from cerebx.report.plot import mean_std, save  # noqa: E402
-from cerebx.report.registry import Figure, MissingRuns, figure  # noqa: E402
+from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
-from cerebx_thesis.report.common import TASK_NAMES, short_path, trial_range  # noqa: E402
+from cerebx_thesis.report.common import LEARN_STUDY, TASK_NAMES, learnt, short_path, trial_range  # noqa: E402
 
 # event kind -> (condition, switched on)
 CONDITIONS = {"attach_payload": ("payload", True), "detach_payload": ("payload", False),
@@ -52,6 +52,7 @@ def phases(events: list[tuple[float, str]], n: int) -> list[tuple[int, int, str]
 
 
 INTERACTIONS = ("finger_push", "grab")
+RETURNED = 1.25  # back on the path: the MAE two trials after an event within this factor of the trial before
 
 
 def _has_events(run: Run, kinds: tuple[str, ...] | dict) -> bool:
@@ -105,18 +106,26 @@ def interaction_metrics(run: Run) -> list[dict[str, float | str]]:
     return out
 
 
-def _interaction_rows(runs: RunSet) -> tuple[list[list[str]], list[str]]:
-    """Table rows of the push and grab for the SNN, PD and factory position runs, and notes on those missing."""
-    rows, notes = [], []
+def _interaction_runs(runs: RunSet) -> list[tuple[str, Run | None]]:
+    """(controller, its run with human-interaction events) for the SNN, PD and the factory stand-in."""
     inter = runs.where(lambda r: _has_events(r, INTERACTIONS) and r.trials > 0, delay="none")
-    found = [("SNN", inter.where(controller="snn").best()),
-             ("PD", inter.where(controller="pd", controller_preset="pd").best()),
-             ("factory position", inter.where(lambda r: r.is_factory_position).best())]
-    for name, run in found:
+    return [("SNN", inter.where(controller="snn").best()),
+            ("PD", inter.where(controller="pd", controller_preset="pd").best()),
+            ("factory position", inter.where(lambda r: r.is_factory_position).best())]
+
+
+def _interaction_rows(runs: RunSet) -> tuple[list[list[str]], list[str], list[Check]]:
+    """Table rows of the push and grab for the SNN, PD and factory position runs, notes on those missing, and
+    the thesis's shapes: the SNN yields to a low force (more displacement per newton than PD) and returns to
+    its path."""
+    rows, notes = [], []
+    measured = {}
+    for name, run in _interaction_runs(runs):
         if run is None:
             notes.append(f"no {name} run with human-interaction events (studies interaction_*)")
             continue
-        for m in interaction_metrics(run):
+        measured[name] = interaction_metrics(run)
+        for m in measured[name]:
             what = "finger push" if m["kind"] == "finger_push" else "grab (soft spring)"
             claim = ("yields to a very low force, returns to the path" if name == "SNN"
                      else "figure only")
@@ -125,7 +134,23 @@ def _interaction_rows(runs: RunSet) -> tuple[list[list[str]], list[str]]:
             rows.append([f"{name}, {what}: MAE (rad) trial before / of the event / 1 after / 2 after",
                          "returns to the path" if name == "SNN" else "figure only",
                          " / ".join(f"{v:.3f}" for v in m["mae_trials"])])
-    return rows, notes
+    return rows, notes, _interaction_checks(measured)
+
+
+def _interaction_checks(measured: dict[str, list[dict]]) -> list[Check]:
+    checks = []
+    pd = {m["kind"]: m for m in measured.get("PD", [])}
+    for m in measured.get("SNN", []):
+        what = m["kind"].replace("_", " ")
+        if m["kind"] in pd:
+            ours, theirs = m["mm_per_N"], pd[m["kind"]]["mm_per_N"]
+            checks.append(Check(f"{what}: the SNN arm yields more per newton than PD", ours > theirs,
+                                f"{ours:.1f} vs {theirs:.1f} mm/N"))
+        mae = m["mae_trials"]
+        if len(mae) >= 4:
+            checks.append(Check(f"{what}: the SNN returns to its path (MAE 2 trials after within {RETURNED}× the "
+                                "trial before)", mae[3] <= RETURNED * mae[0], f"{mae[0]:.3f} → {mae[3]:.3f} rad"))
+    return checks
 
 
 @figure("fig2_10", "Adaptation to a payload and an elastic band; human interaction (Fig. 2.10)",
@@ -175,9 +200,18 @@ def fig2_10(runs: RunSet, stem: Path) -> Figure:
                           f"{seg[:k].mean():.3f} → {seg[-k:].mean():.3f}"])
         claim = "figure only"
     notes = [] if events else ["the run's events were neither logged nor configured"]
-    rows, more = _interaction_rows(runs)
+    rows, more, checks = _interaction_rows(runs)
     table += rows
     notes += more
+    for a, b, name in parts:
+        seg, k = mae[a:b], max(1, min(3, (b - a) // 3))
+        if name != "before" and not name.startswith("after") and len(seg) >= 2:
+            checks.insert(0, Check(f"adapts to the {name}: MAE of its last {k} trials below its first {k}",
+                                   bool(seg[-k:].mean() < seg[:k].mean()),
+                                   f"{seg[:k].mean():.3f} → {seg[-k:].mean():.3f} rad"))
+    snn_inter = dict(_interaction_runs(runs))["SNN"]
+    conv = learnt(runs, [("circle, SNN", r, LEARN_STUDY["circle"]) for r in (run, snn_inter)],
+                  lambda q: not q.startswith(("PD,", "factory position,")))
     origin = short_path(run.learned_from) if run.learned_from else "scratch"
     caption = (f"Thesis Fig. 2.10: the snn controller, learnt state from {origin}, performing "
                f"the {TASK_NAMES.get(run.task, run.task)} while the plant is disturbed (run {short_path(run)}, "
@@ -186,4 +220,4 @@ def fig2_10(runs: RunSet, stem: Path) -> Figure:
                "Human interaction (iii), in the table: a one-finger push and a grab through a soft spring on the "
                "learned circle (studies interaction_snn / interaction_baselines; constructed forces) for the SNN, "
                "PD and the factory stand-in.")
-    return Figure(files, caption, table, notes)
+    return Figure(files, caption, table, notes, checks, conv)

@@ -16,15 +16,18 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from cerebx.report.plot import fmt, mean_std, panel_letter, save  # noqa: E402
-from cerebx.report.registry import Figure, MissingRuns, figure  # noqa: E402
+from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
 from cerebx.schema.muscles import EkebergConfig  # noqa: E402
+from cerebx_thesis.report.common import learnt  # noqa: E402
 
 # thesis §4.7 (Fig. 4.6): k -> position MAE (mean, std; rad) and payload sag (cm)
 THESIS_MAE = {0: (0.0189, 0.0042), 1: (0.0191, 0.0034), 5: (0.0179, 0.0051), 9: (0.0189, 0.0052),
               10: (0.0240, 0.0052), 12: (0.0508, 0.0075)}
 THESIS_SAG_CM = {0: 9.9, 1: 9.6, 5: 5.8, 9: 4.7, 10: 4.4, 12: 3.9}
 SETTLED_S = 1.0  # the sag is measured over the run's last second
+LEARN_STUDY = "fig4_6a_learn"  # each profile learns from scratch (its full profile: where A's shape appears)
+FLAT_UP_TO = 9.0  # A: flat up to this cocontraction, clearly worse at the highest
 
 
 def _table_4_1(r: Run) -> bool:
@@ -115,6 +118,7 @@ def fig4_6(runs: RunSet, stem: Path) -> Figure:
     png = save(fig, stem)
 
     table = [["quantity", "paper", "cerebx"]]
+    checks = _shape_a(learned)
     for k in ks:
         r = learned.get(float(k))
         table.append([f"A: position MAE at c = x{k} (rad)", f"{THESIS_MAE[k][0]:.4f} ± {THESIS_MAE[k][1]:.4f}",
@@ -132,8 +136,10 @@ def fig4_6(runs: RunSet, stem: Path) -> Figure:
         table.append([f"B: sag Δz with 2 kg at c = x{k} (cm)", f"{THESIS_SAG_CM[k]:.1f}", fmt(v, 1)])
     if len(got) > 1:
         vals = [got[k] for k in sorted(got)]
-        table.append(["B: sag falls monotonically with c", "yes",
-                      "yes" if all(a > b for a, b in zip(vals, vals[1:])) else "no"])
+        falls = all(a > b for a, b in zip(vals, vals[1:]))
+        table.append(["B: sag falls monotonically with c", "yes", "yes" if falls else "no"])
+        checks.append(Check("B: sag falls monotonically with c", falls,
+                            " → ".join(f"x{k:g} {v:.1f}" for k, v in sorted(got.items())) + " cm"))
     caption = ("Fig. 4.6. (A) Position MAE of the cerebellar SNN driving one Ekeberg muscle pair per joint "
                "(Eq. 4.6, Table 4.1) on the eight-like trajectory, each cocontraction profile learnt from scratch "
                "and then evaluated from its learned state"
@@ -143,4 +149,20 @@ def fig4_6(runs: RunSet, stem: Path) -> Figure:
                "payload is attached at the resting pose with no active muscle component (M_ag = M_at = 0), measured "
                f"against the last {SETTLED_S:g} s of the run. The arm's own weight is compensated (plant "
                "baxter_muscles, constructed); the payload is not.")
-    return Figure([png], caption, table, notes)
+    conv = learnt(runs, [(f"x{k:g}", r, LEARN_STUDY) for k, r in learned.items()], lambda q: q.startswith("A:"))
+    return Figure([png], caption, table, notes, checks, conv if learned else None)
+
+
+def _shape_a(learned: dict[float, Run]) -> list[Check]:
+    """Fig. 4.6 A's shape: the MAE flat up to x9 (the spread of its means smaller than the step up to the highest
+    cocontraction), and the highest cocontraction the worst."""
+    m = {k: float(r.mae.mean()) for k, r in learned.items()}
+    flat = {k: v for k, v in m.items() if k <= FLAT_UP_TO}
+    top = max(m, default=None)
+    if top is None or top <= FLAT_UP_TO or len(flat) < 2:
+        return []
+    spread, step = max(flat.values()) - min(flat.values()), m[top] - max(flat.values())
+    return [Check(f"A: MAE flat up to x{FLAT_UP_TO:g} (spread of the means below the step to x{top:g})", spread < step,
+                  f"spread {spread:.4f}, step {step:.4f} rad"),
+            Check(f"A: x{top:g} the least accurate", all(v < m[top] for k, v in m.items() if k != top),
+                  ", ".join(f"x{k:g} {v:.4f}" for k, v in sorted(m.items())))]

@@ -13,14 +13,16 @@ Runs are chosen by content:
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from cerebx.report.convergence import Convergence, learning_convergence
 from cerebx.report.plot import panel_letter, save
 from cerebx.report.runs import Run, RunSet
+from cerebx.report.studies import study_plateau
 
 THESIS_KERNEL_MS = 150.0  # chapter 3 ([D]) kernel peak
 CH2_KERNEL_MS = 100.0  # chapter 2 ([B]) kernel peak
@@ -28,6 +30,13 @@ TASK_NAMES = {"circle": "horizontal circle", "inclined_circle": "inclined circle
               "circle_eight": "circle-Lissajous sequence", "eight": "eight", "reaching": "reaching"}
 CH3_TASKS = ("circle", "inclined_circle", "circle_eight")
 HEADER = ["quantity", "paper", "cerebx"]
+# the study whose runs learn each task from scratch, with chapter 2's network (LEARN_STUDY), chapter 3's
+# (CH3_STUDY) or the ANN (ANN_STUDY): its full profile has the trials where the thesis's shape appears
+LEARN_STUDY = {"circle": "learn_circle", "eight": "learn_eight", "reaching": "learn_reaching"}
+CH3_STUDY = {"circle": "learn_circle_ch3", "inclined_circle": "learn_inclined_circle",
+             "circle_eight": "learn_circle_eight"}
+ANN_STUDY = {"circle": "learn_ann_circle", "inclined_circle": "learn_ann_inclined_circle",
+             "circle_eight": "learn_ann_circle_eight"}
 
 
 def from_scratch(runs: RunSet, task: str, kernel_ms: float = THESIS_KERNEL_MS) -> Run | None:
@@ -36,6 +45,21 @@ def from_scratch(runs: RunSet, task: str, kernel_ms: float = THESIS_KERNEL_MS) -
     return runs.where(lambda r: r.learned_from is None and not r.events and r.trials > 0
                       and r.kernel_peaks_ms == [kernel_ms],
                       task=task, controller="snn", delay="none").best()
+
+
+def learnt(runs: RunSet, curves: Iterable[tuple[str, Run | None, str]],
+           rows: Callable[[str], bool] | None = None, own: bool = False) -> Convergence:
+    """The convergence of the learning behind (label, run, study that learns it) triples (runs that are None
+    left out): the plateau test of each run's learning curve, or of the curve of the run whose state it
+    started from (``own``: of the run itself), against the full profile's trials of that study (where the
+    thesis's shape appears)."""
+    return learning_convergence([(label, r, study_plateau(study)) for label, r, study in curves if r is not None],
+                                runs, rows, own)
+
+
+def snn_rows(quantity: str) -> bool:
+    """The table rows of the SNN (whose numbers depend on its learning; not those of the baselines)."""
+    return "SNN" in quantity
 
 
 def baselines(runs: RunSet, task: str) -> list[tuple[str, Run]]:

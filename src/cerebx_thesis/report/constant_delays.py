@@ -14,16 +14,20 @@ import numpy as np  # noqa: E402
 from matplotlib.colors import to_rgb  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
+from cerebx.report.convergence import Convergence  # noqa: E402
 from cerebx.report.plot import fmt, mean_std, save  # noqa: E402
-from cerebx.report.registry import Figure, MissingRuns, figure  # noqa: E402
+from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
 from cerebx_thesis.report.common import (  # noqa: E402
+    ANN_STUDY,
+    CH3_STUDY,
     CH3_TASKS,
     HEADER,
     TASK_NAMES,
     THESIS_KERNEL_MS,
     delay_sweep,
     finish,
+    learnt,
     mean_and_std,
     origin,
     reference_run,
@@ -102,7 +106,7 @@ def fig3_4(runs: RunSet, stem: Path) -> Figure:
                f"Runs — {counts}. The thesis used 100 trials per δT and stopped PD and ANN at 50 ms; every δT "
                "run is shown here. The dashed grey line is the factory position controller without delay "
                "(where such a run exists).")
-    return Figure([png], caption, table, notes)
+    return Figure([png], caption, table, notes, *_fig3_4_shape(runs, sweeps))
 
 
 def _sample_ee(run: Run, trials: int = FIG3_5_TRIALS) -> tuple[np.ndarray, np.ndarray, int]:
@@ -236,4 +240,46 @@ def fig3_5(runs: RunSet, stem: Path) -> Figure:
                f"{', '.join(counts)} trials, evenly spaced, every 2nd control step); dashed: desired path; green: "
                "last trial of the factory position controller without delay. Circle and circle-Lissajous in the xy "
                "plane, the inclined circle in the principal plane of its desired path.")
-    return Figure([save(fig, stem)], caption, table, notes)
+    return Figure([save(fig, stem)], caption, table, notes, *_fig3_5_shape(runs, slots))
+
+
+def _learnt_rows(quantity: str) -> bool:
+    """Rows whose numbers come from a learned controller (the SNN's or the ANN's)."""
+    return "SNN" in quantity or "ANN" in quantity
+
+
+def _fig3_4_shape(runs: RunSet, sweeps: dict[str, dict[float, Run]]) -> tuple[list[Check], Convergence]:
+    """Fig. 3.4's orderings (the SNN below PD at every delay, and degrading least with the delay) and the
+    convergence of the SNN's and ANN's learning."""
+    mean = {c: {d: float(r.mae.mean()) for d, r in s.items()} for c, s in sweeps.items()}
+    checks = []
+    both = sorted(set(mean["snn"]) & set(mean["pd"]))
+    if both:
+        checks.append(Check("SNN MAE below PD's at every δT", all(mean["snn"][d] < mean["pd"][d] for d in both),
+                            ", ".join(f"{d:g} ms {mean['snn'][d]:.3f} vs {mean['pd'][d]:.3f}" for d in both)))
+    ratio = {c: m[max(m)] / m[0] for c, m in mean.items() if m and 0.0 in m and max(m) > 0}
+    if "snn" in ratio and len(ratio) > 1:
+        others = [c for c in ratio if c != "snn"]
+        checks.append(Check("the SNN degrades least with δT (MAE ratio at the largest δT / 0 ms)",
+                            all(ratio["snn"] < ratio[c] for c in others),
+                            ", ".join(f"{CONTROLLERS[c][0]} {ratio[c]:.2f}" for c in ratio)))
+    curves = [(CONTROLLERS[c][0], r, (CH3_STUDY if c == "snn" else ANN_STUDY)["circle"])
+              for c in ("snn", "ann") for r in sweeps[c].values()]
+    return checks, learnt(runs, curves, _learnt_rows)
+
+
+def _fig3_5_shape(runs: RunSet, slots: dict[tuple[str, str], Run | None]) -> tuple[list[Check], Convergence]:
+    """Fig. 3.5's orderings under the 50 ms delay (the SNN more accurate than PD and the ANN on each task) and
+    the convergence of the SNN's and ANN's learning of each task."""
+    checks = []
+    for task in CH3_TASKS:
+        snn = slots[(task, "snn")]
+        for other in ("pd", "ann"):
+            r = slots[(task, other)]
+            if snn is not None and r is not None:
+                a, b = float(snn.mae.mean()), float(r.mae.mean())
+                checks.append(Check(f"{TASK_NAMES[task]}: SNN MAE below {other.upper()}'s at "
+                                    f"{FIG3_5_DELAY_MS:.0f} ms", a < b, f"{a:.3f} vs {b:.3f} rad"))
+    curves = [(f"{c.upper()} {TASK_NAMES[task]}", slots[(task, c)], (CH3_STUDY if c == "snn" else ANN_STUDY)[task])
+              for task in CH3_TASKS for c in ("snn", "ann")]
+    return checks, learnt(runs, curves, _learnt_rows)

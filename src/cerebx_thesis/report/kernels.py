@@ -13,15 +13,18 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from cerebx.report.convergence import Convergence, combined  # noqa: E402
 from cerebx.report.plot import mean_std  # noqa: E402
-from cerebx.report.registry import Figure, MissingRuns, figure  # noqa: E402
+from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
 from cerebx.snn.schema import KernelSTDP  # noqa: E402
 from cerebx.snn.topology import ltd_kernel_table  # noqa: E402
 from cerebx_thesis.report.common import (  # noqa: E402
+    CH3_STUDY,
     HEADER,
     delay_sweep,
     finish,
+    learnt,
     legend,
     mean_and_std,
     origin,
@@ -117,7 +120,7 @@ def fig3_6(runs: RunSet, stem: Path) -> Figure:
                "vs kernel peak beside the thesis's regression. Kernel peak in ms (trials per run) by how the run "
                f"started — {origin_text}. The thesis learned each kernel from scratch with 100 trials per kernel in "
                "the regression.")
-    return Figure([png], caption, table, notes)
+    return Figure([png], caption, table, notes, *_fig3_6_shape(runs, by_peak, last, fit))
 
 def _common_grid(ks: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
     """Kernels on one time grid (zero past each one's end); returns (t, kernels as rows)."""
@@ -187,5 +190,45 @@ def fig3_10(runs: RunSet, stem: Path) -> Figure:
                "seconds per wall-clock second over the whole run (≥ 1: faster than real time; it depends on the "
                "machine's load); the thesis reports the share of time EDLUT ran at full real-time capacity, a "
                "different measure.")
-    return Figure([png], caption, table, notes)
+    return Figure([png], caption, table, notes, *_fig3_10_shape(runs, multi, mono))
 
+
+
+KERNEL_STUDY = "fig3_6_kernels"  # its full profile learns each kernel from scratch
+MULTIKERNEL_STUDY = "learn_multikernel"
+
+
+def _fig3_6_shape(runs: RunSet, by_peak: dict[float, Run], last: dict[float, int],
+                  fit: np.ndarray | None) -> tuple[list[Check], Convergence]:
+    """Fig. 3.6's shape (the MAE rises with the kernel peak: a positive slope, the shortest peak best) and the
+    convergence of each kernel's learning (or of the run the kernels started from)."""
+    means = {p: float(_mae(r, last[p]).mean()) for p, r in by_peak.items()}
+    checks = [] if fit is None else [Check("MAE rises with the kernel peak (fitted slope > 0)", bool(fit[0] > 0),
+                                           f"slope {fit[0]:.6f} rad/ms")]
+    best = min(means, key=means.get)
+    checks.append(Check("the shortest kernel peak gives the lowest MAE", best == min(means),
+                        f"lowest at {best:g} ms ({means[best]:.3f} rad), {min(means):g} ms: {means[min(means)]:.3f}"))
+    curves = [(f"kernel {p:g} ms", r, KERNEL_STUDY) for p, r in by_peak.items()]
+    # each kernel's own learning (from scratch, or re-learning from a state) and the state's, if any
+    return checks, combined(learnt(runs, curves, _snn_rows, own=True),
+                            learnt(runs, [("SNN", r, KERNEL_STUDY) for r in by_peak.values() if r.learned_from]))
+
+
+def _snn_rows(quantity: str) -> bool:
+    """Rows of the SNN's numbers (not the PD reference)."""
+    return not quantity.startswith("PD")
+
+
+def _fig3_10_shape(runs: RunSet, multi: dict[float, Run], mono: dict[float, Run]) -> tuple[list[Check], Convergence]:
+    """Fig. 3.10's shape (the multikernel network is not better than the monokernel one at any delay) and the
+    convergence of both networks' learning."""
+    both = sorted(set(multi) & set(mono))
+    checks = []
+    if both:
+        m = {d: (float(multi[d].mae.mean()), float(mono[d].mae.mean())) for d in both}
+        checks.append(Check("the multikernel SNN is not better than the monokernel one at any δT",
+                            all(a >= b for a, b in m.values()),
+                            ", ".join(f"{d:g} ms {a:.3f} vs {b:.3f}" for d, (a, b) in m.items())))
+    curves = ([("multikernel", r, MULTIKERNEL_STUDY) for r in multi.values()]
+              + [("monokernel", r, CH3_STUDY["circle"]) for r in mono.values()])
+    return checks, learnt(runs, curves, lambda q: q.startswith("MAE"))

@@ -14,17 +14,21 @@ import numpy as np  # noqa: E402
 
 from cerebx.metrics import final_mae  # noqa: E402
 from cerebx.report.plot import save  # noqa: E402
-from cerebx.report.registry import Figure, MissingRuns, figure  # noqa: E402
+from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
 from cerebx.report.runs import RunSet  # noqa: E402
 from cerebx_thesis.report import stages  # noqa: E402
 from cerebx_thesis.report.common import (  # noqa: E402
     CH2_KERNEL_MS,
+    CH3_STUDY,
     CH3_TASKS,
+    LEARN_STUDY,
     TASK_NAMES,
     baseline_text,
     baselines,
     from_scratch,
+    learnt,
     short_path,
+    snn_rows,
 )
 
 CONVERGENCE_TOL = 0.10
@@ -44,6 +48,7 @@ def _trajectory_learning(runs: RunSet, stem: Path, task: str, fig_no: str, study
     ks = stages.stage_trials(run.trials)
     notes = [] if base else [f"no {task} baseline runs (pd / position_factory without delay): MAE figure without "
                              "baselines"]
+    conv = learnt(runs, [(task, run, LEARN_STUDY[task])], snn_rows)
     total = stages.PAPER_STAGES[task][0]
     caption = (f"Thesis Fig. {fig_no} ({TASK_NAMES[task]}): the snn controller learning from scratch, run "
                f"{short_path(run)} with {run.n_measured} trials of {run.period_s:.0f} s (thesis: {total}). "
@@ -51,7 +56,7 @@ def _trajectory_learning(runs: RunSet, stem: Path, task: str, fig_no: str, study
                "scaled by fraction of the run); end-effector density of the previous 10 trials. "
                "MAE figure (g): MAE per trial of each joint and their mean; shaded: the table windows "
                f"({', '.join(f'{a}–{b}' for a, b in wins)}); {baseline_text(base)}.")
-    return Figure(files, caption, table, notes)
+    return Figure(files, caption, table, notes, stages.stage_checks(run, task, base, wins), conv)
 
 
 @figure("fig2_6", "Circle learnt from scratch: stages and MAE per joint (Fig. 2.6, Table 2.3)",
@@ -80,10 +85,12 @@ def table2_3(runs: RunSet, stem: Path) -> Figure:
                           "learn_eight, learn_reaching)")
     fig, axes = plt.subplots(1, len(found), figsize=(4.6 * len(found), 3.8), squeeze=False)
     table = [["quantity", "paper", "cerebx"]]
+    checks: list[Check] = []
     for ax, (task, run) in zip(axes[0], found.items(), strict=True):
         total, ref, factory = stages.PAPER_STAGES[task]
         base = baselines(runs, task)
         rows, wins = stages.stage_table(run, task, base)
+        checks += stages.stage_checks(run, task, base, wins)
         table += [[f"{task}: {q}", p, c] for q, p, c in rows[1:]]
         x = np.arange(len(ref))
         ours = [run.mae[lo:hi] for lo, hi in wins]
@@ -110,7 +117,8 @@ def table2_3(runs: RunSet, stem: Path) -> Figure:
                "use the same fractions of their length (the window in brackets). Runs: "
                + ", ".join(f"{t} {short_path(r)}" for t, r in found.items()) + ".")
     notes = [f"{t}: no run learning from scratch" for t in stages.PAPER_STAGES if t not in found]
-    return Figure([save(fig, stem)], caption, table, notes)
+    conv = learnt(runs, [(t, r, LEARN_STUDY[t]) for t, r in found.items()], snn_rows)
+    return Figure([save(fig, stem)], caption, table, notes, checks, conv)
 
 
 def convergence_trial(mae: np.ndarray, tol: float = CONVERGENCE_TOL) -> tuple[int | None, int, float | None]:
@@ -140,6 +148,7 @@ def fig3_3(runs: RunSet, stem: Path) -> Figure:
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.3))
     table = [["quantity", "paper", "cerebx"]]
     notes, used = [], []
+    conv = learnt(runs, [(TASK_NAMES[t], r, CH3_STUDY[t]) for t, r in found.items()])
     for ax, letter, task in zip(axes, "ABC", CH3_TASKS, strict=True):
         ax.set_title(f"{letter}  {TASK_NAMES[task]}", loc="left", fontweight="bold", fontsize=10, pad=30)
         run = found[task]
@@ -170,9 +179,11 @@ def fig3_3(runs: RunSet, stem: Path) -> Figure:
                    "not reached" if k is None else f"{k} ({k * period:.0f} s) of {len(mae)}"]]
         used.append(f"{letter}: {short_path(run)}, {len(mae)} trials of {period:.0f} s")
     fig.tight_layout()
+    checks = [Check(f"{c.label}: the MAE levels off (plateau test)", c.level, c.numbers())
+              for c in conv.curves]
     caption = ("Thesis Fig. 3.3: MAE per trial of the snn controller learning from scratch (thesis: stabilization "
                f"after about 500 trials). Runs: {'; '.join(used)}. Stabilization trial: the first trial where the "
                f"trailing running mean (max(5, n/50) trials) is within {CONVERGENCE_TOL:.0%} of the final level "
                "(mean of the last 10 % of trials).")
-    return Figure([save(fig, stem)], caption, table, notes)
+    return Figure([save(fig, stem)], caption, table, notes, checks, conv)
 

@@ -13,8 +13,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from cerebx.report.plot import fmt, save  # noqa: E402
-from cerebx.report.registry import Figure, MissingRuns, figure  # noqa: E402
+from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
+from cerebx_thesis.report.common import CH3_STUDY, learnt  # noqa: E402
 
 REALISM_PLANTS = ("baxter", "baxter_sea", "baxter_noise", "baxter_lag5", "baxter_lag10", "baxter_urdf_armature")
 REALISM_DELAYS_MS = (0.0, 50.0)
@@ -53,6 +54,7 @@ def plant_realism(runs: RunSet, stem: Path) -> Figure:
     width = 0.2
     table = [["quantity", "paper", "cerebx"]]
     notes = []
+    ratios = {}
     for j, (ctrl, d) in enumerate((("pd", 0.0), ("pd", 50.0), ("snn", 0.0), ("snn", 50.0))):
         vals = [float(np.mean(cells[(p, ctrl, d)].mae)) if (p, ctrl, d) in cells else np.nan for p in REALISM_PLANTS]
         ax.bar(np.arange(len(REALISM_PLANTS)) + (j - 1.5) * width, vals, width, label=f"{ctrl.upper()} {d:.0f} ms")
@@ -63,6 +65,8 @@ def plant_realism(runs: RunSet, stem: Path) -> Figure:
             vals[(ctrl, d)] = float(np.mean(r.mae)) if r is not None else None
         pd50, snn50 = vals[("pd", 50.0)], vals[("snn", 50.0)]
         ratio = f"{pd50 / snn50:.1f}" if pd50 and snn50 else "–"
+        if pd50 and snn50:
+            ratios[p] = pd50 / snn50
         table.append([f"{p}: MAE (rad) PD 0 / 50 ms, SNN 0 / 50 ms; PD ÷ SNN at 50 ms",
                       "real robot: PD 0.076 → ~0.12 at 50 ms; SNN flat",
                       " / ".join(fmt(v) for v in vals.values()) + f"; {ratio}"])
@@ -79,4 +83,7 @@ def plant_realism(runs: RunSet, stem: Path) -> Figure:
                "controller) on each plant variant: the default rigid arm, series elastic actuators, sensor noise "
                "(0.5 mrad, 5 mrad/s), a 5 / 10 ms first-order torque lag, and the URDF's armature (none). "
                "Constructed noise and lag levels; 0 and 50 ms constant round trips.")
-    return Figure([save(fig, stem)], caption, table, notes)
+    checks = [Check("SNN below PD at 50 ms on every plant variant", all(v > 1 for v in ratios.values()),
+                    "PD ÷ SNN " + ", ".join(f"{p.replace('baxter_', '')} {v:.1f}" for p, v in ratios.items()))]
+    conv = learnt(runs, [("SNN", r, CH3_STUDY["circle"]) for (_, c, _), r in cells.items() if c == "snn"])
+    return Figure([save(fig, stem)], caption, table, notes, checks if ratios else [], conv)

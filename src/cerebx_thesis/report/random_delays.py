@@ -15,13 +15,16 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from cerebx.report.convergence import Convergence  # noqa: E402
 from cerebx.report.delays import DELAY_TRIALS, delays  # noqa: E402
 from cerebx.report.plot import fmt, mean_std  # noqa: E402
-from cerebx.report.registry import Figure, MissingRuns, figure  # noqa: E402
+from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
 from cerebx_thesis.report.common import (  # noqa: E402
+    CH3_STUDY,
     HEADER,
     finish,
+    learnt,
     origin,
     plain_circle,
     prefer_learned,
@@ -142,11 +145,14 @@ def fig3_7(runs: RunSet, stem: Path) -> Figure:
                       f"{mean_std(d[k][0], 1)} / {mean_std(d[k][1], 1)}"])
         table.append([f"{k}: SNN MAE (rad)", "figure only (coped with the delay)", mean_std(gamma[k].mae)])
     pos = reference_run(runs, "position")
+    checks = []
     if pos is not None:
         worst = max(gamma[k].mae.mean() for k in gamma)
         table.append(["SNN MAE below the no-delay factory position MAE for every preset",
                       "yes (factory position 0.077 rad)",
                       f"{'yes' if worst < pos.mae.mean() else 'no'} (worst {worst:.3f} vs {pos.mae.mean():.3f})"])
+        checks.append(Check("SNN MAE below the no-delay factory position MAE for every preset",
+                            bool(worst < pos.mae.mean()), f"worst {worst:.3f} vs {pos.mae.mean():.3f} rad"))
     else:
         notes.append("no factory position controller circle run without delay for the reference")
     caption = ("Fig. 3.7 — SNN on the horizontal circle under random gamma delays. (A) PDF and (B) CDF of the "
@@ -157,7 +163,7 @@ def fig3_7(runs: RunSet, stem: Path) -> Figure:
                f"({', '.join(sorted({origin(r) for r in gamma.values()}))}); thesis: 100 trials per preset. "
                + ("Dashed lines: " + ", ".join(f"{r.controller_preset} without delay ({r.n_measured} trials)"
                                                for r in refs) + "." if refs else ""))
-    return Figure([png], caption, table, notes)
+    return Figure([png], caption, table, notes, checks, _snn_learning(runs, gamma))
 
 def _load_mbps(name: str) -> int | None:
     """The bandwidth load of a Wi-Fi delay preset (``wifi54`` -> 54), None for another preset."""
@@ -202,7 +208,7 @@ def fig3_8(runs: RunSet, stem: Path) -> Figure:
                f"Runs: {trial_counts(wifi.values())} per load "
                f"({', '.join(sorted({origin(r) for r in wifi.values()}))}); "
                "thesis: 100 trials per load.")
-    return Figure([png], caption, table, notes)
+    return Figure([png], caption, table, notes, _below_factory(runs, wifi, "load"), _snn_learning(runs, wifi))
 
 @figure("fig3_9", "SNN in cloud robotics", studies=("fig3_9_cloud",))
 def fig3_9(runs: RunSet, stem: Path) -> Figure:
@@ -244,4 +250,21 @@ def fig3_9(runs: RunSet, stem: Path) -> Figure:
                "(conf/delay/cloud.yaml, wifi_cloud.yaml). "
                f"Runs: {trial_counts(cloud.values())} per scenario "
                f"({', '.join(sorted({origin(r) for r in cloud.values()}))}); thesis: 100 trials per scenario.")
-    return Figure([png], caption, table, notes)
+    return Figure([png], caption, table, notes, _below_factory(runs, cloud, "scenario"), _snn_learning(runs, cloud))
+
+
+def _snn_learning(runs: RunSet, by_delay: dict[str, Run]) -> Convergence:
+    """The convergence of the learning behind the SNN runs under random delays (the circle they started from)."""
+    return learnt(runs, [("SNN", r, CH3_STUDY["circle"]) for r in by_delay.values()],
+                  lambda q: "MAE" in q)
+
+
+def _below_factory(runs: RunSet, by_delay: dict[str, Run], what: str) -> list[Check]:
+    """The SNN under every delay more accurate than the factory position controller without delay."""
+    pos = reference_run(runs, "position")
+    if pos is None or not pos.mae.size:
+        return []
+    worst = max(by_delay, key=lambda k: by_delay[k].mae.mean())
+    w, p = float(by_delay[worst].mae.mean()), float(pos.mae.mean())
+    return [Check(f"SNN MAE below the no-delay factory position MAE at every {what}", w < p,
+                  f"worst {worst} {w:.3f} vs {p:.3f} rad")]

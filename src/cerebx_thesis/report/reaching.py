@@ -17,10 +17,13 @@ from cerebx.report.runs import Run, RunSet  # noqa: E402
 from cerebx_thesis.report import stages  # noqa: E402
 from cerebx_thesis.report.common import (  # noqa: E402
     CH2_KERNEL_MS,
+    LEARN_STUDY,
     baseline_text,
     baselines,
     from_scratch,
+    learnt,
     short_path,
+    snn_rows,
     trial_range,
 )
 
@@ -151,4 +154,5 @@ def fig2_9(runs: RunSet, stem: Path) -> Figure:
                f"(d–f) speed profile of the starred target at those stages. (g) MAE per trial of each joint and "
                f"their mean; {baseline_text(base)}. Targets from /trial_metrics labels, else from the direction "
                "of the farthest desired point.")
-    return Figure(files, caption, table, notes)
+    conv = learnt(runs, [("reaching", run, LEARN_STUDY["reaching"])], snn_rows)
+    return Figure(files, caption, table, notes, stages.stage_checks(run, "reaching", base, wins), conv)

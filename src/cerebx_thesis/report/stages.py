@@ -16,6 +16,7 @@ from matplotlib.colors import PowerNorm  # noqa: E402
 
 from cerebx.recording.reader import read_messages  # noqa: E402
 from cerebx.report.plot import mean_std, panel_letter, save  # noqa: E402
+from cerebx.report.registry import Check  # noqa: E402
 from cerebx.report.runs import Run  # noqa: E402
 
 # thesis stages for a 500-trial run: t1 = 18-20 s, t2 = 318-320 s, t3 = 998-1000 s
@@ -186,3 +187,19 @@ def stage_table(run: Run, task: str, base: list[tuple[str, Run]]) -> tuple[list[
     if not any(name == "factory position" for name, _ in base):
         rows.append(["factory position MAE (rad), all trials", factory, "not run"])
     return rows, wins
+
+
+def stage_checks(run: Run, task: str, base: list[tuple[str, Run]], wins: list[tuple[int, int]]) -> list[Check]:
+    """The shapes of Tables 2.3 / 2.4 for ``task``: the SNN's MAE falls from stage to stage and its final
+    stage is below the factory position controller's."""
+    means = [float(run.mae[lo:hi].mean()) for lo, hi in wins]
+    checks = [Check(f"{task}: SNN MAE falls from stage to stage", all(a > b for a, b in zip(means, means[1:])),
+                    " → ".join(f"{m:.3f}" for m in means) + " rad")]
+    factory = next((b for name, b in base if name == "factory position"), None)
+    claim = f"{task}: SNN MAE of the final stage below the factory position controller's"
+    if factory is None or not factory.mae.size:
+        checks.append(Check(claim, None, "no factory position run"))
+    else:
+        f = float(factory.mae.mean())
+        checks.append(Check(claim, means[-1] < f, f"{means[-1]:.3f} vs {f:.3f} rad"))
+    return checks

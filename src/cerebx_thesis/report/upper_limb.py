@@ -16,9 +16,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from cerebx.controllers.snn.schema import SNNController  # noqa: E402
+from cerebx.report.convergence import Convergence  # noqa: E402
 from cerebx.report.plot import fmt, mean_std, panel_letter, save  # noqa: E402
-from cerebx.report.registry import Figure, MissingRuns, figure  # noqa: E402
+from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
+from cerebx_thesis.report.common import learnt  # noqa: E402
 
 TASKS = ("flexion_extension", "circle_slow", "circle_fast")
 TASK_LABELS = {"flexion_extension": "flexion–extension", "circle_slow": "slow circle", "circle_fast": "fast circle"}
@@ -35,6 +37,10 @@ CONVERGED_RAD = 0.1  # Fig. 4.5 B threshold
 # panels show these runs; runs with another pathway (study fig4_5_learn_d50) go to the table as sensitivity
 PATHWAY_MS = 20.0
 FINAL_FRACTION = 0.1  # "after learning": the last 10 % of the trials
+SIMILAR_RAD = 0.01  # "a similar final performance in terms of position accuracy": with and without SC this close
+# the study learning each (task, spinal kind) of the panels (its full profile: where the thesis's shape appears)
+LEARN_STUDY = {"circle_fast": {"spinal_cord": "fig4_5_learn_fast_cord", "direct_muscles": "fig4_5_learn_fast_direct"}}
+DEFAULT_LEARN_STUDY = "fig4_5_learn"
 
 
 def task_key(run: Run) -> str | None:
@@ -194,5 +200,43 @@ def fig4_5(runs: RunSet, stem: Path) -> Figure:
     missing = [f"{TASK_LABELS[t]} {SPINAL[s][0]}" for t in TASKS for s in SPINAL if (t, s) not in learn]
     if missing:
         notes.append("missing learning runs: " + ", ".join(missing))
+    checks, conv = _shape(runs, learn, pert)
     return Figure([png], "Upper limb (Arm26 + deltoid, 7 muscles) under the 2-joint cerebellum, with the spinal cord "
-                  "(stretch reflex, reciprocal inhibition) and without (commands = activations).", table, notes)
+                  "(stretch reflex, reciprocal inhibition) and without (commands = activations).", table, notes,
+                  checks, conv)
+
+
+def _shape(runs: RunSet, learn: dict[tuple[str, str], Run],
+           pert: dict[tuple[str, float | None], Run]) -> tuple[list[Check], Convergence]:
+    """Fig. 4.5's shapes (thesis §4.4): with the spinal cord fewer trials to 0.1 rad, a similar final position
+    MAE, a lower velocity MAE, a smaller deviation under pulses; and the convergence of the panels' learning
+    (the sensitivity runs with another pathway are not a reproduction: their rows are left out)."""
+    cord, direct = SPINAL
+    tasks = [t for t in TASKS if (t, cord) in learn and (t, direct) in learn]
+    checks = []
+    if tasks:
+        n = {t: [trials_to(learn[(t, s)]) for s in SPINAL] for t in tasks}
+        checks.append(Check("fewer trials to 0.1 rad with SC on every task",
+                            all(a is not None and (b is None or a < b) for a, b in n.values()),
+                            ", ".join(f"{TASK_LABELS[t]} {a or '–'} vs {b or '–'}" for t, (a, b) in n.items())))
+        for what, key, _ in MEASURES:
+            m = {t: [float(final(learn[(t, s)], key).mean()) for s in SPINAL] for t in tasks}
+            if key == "mae_per_trial":
+                ok = all(abs(a - b) <= SIMILAR_RAD for a, b in m.values())
+                claim = f"similar {what.split(' (')[0]} with and without SC (within {SIMILAR_RAD} rad) on every task"
+            else:
+                ok = all(a < b for a, b in m.values())
+                claim = f"lower {what.split(' (')[0]} with SC on every task"
+            numbers = ", ".join(f"{TASK_LABELS[t]} {a:.3f} vs {b:.3f}" for t, (a, b) in m.items())
+            checks.append(Check(claim, ok, numbers))
+    angles = sorted({a for _, a in pert if a is not None})
+    dev = {s: [deviation(pert[(s, a)], pert.get((s, None))) for a in angles if (s, a) in pert] for s in SPINAL}
+    if dev[cord] and dev[direct]:
+        a, b = float(np.mean(dev[cord])), float(np.mean(dev[direct]))
+        fewer = sum(x < y for x, y in zip(dev[cord], dev[direct]))
+        checks.append(Check("smaller position-MAE deviation under pulses with SC (mean over directions)", a < b,
+                            f"{a:.3f} vs {b:.3f} rad; smaller in {fewer} of {min(len(dev[cord]), len(dev[direct]))} "
+                            "directions"))
+    curves = [(f"{TASK_LABELS[t]} {SPINAL[s][0]}", r, LEARN_STUDY.get(t, {}).get(s, DEFAULT_LEARN_STUDY))
+              for (t, s), r in learn.items()]
+    return checks, learnt(runs, curves, lambda q: not q.startswith("sensitivity"))
