@@ -15,6 +15,8 @@ BENCH_ARGS ?=
 # full: the thesis's trial counts, hours), then draws every figure. REPORT_ARGS e.g. "--figures fig3_4".
 PROFILE ?= quick
 REPORT_ARGS ?=
+# `make test` spreads the tests over this many worker processes (pytest-xdist; 0: all in one process)
+TEST_WORKERS ?= 2
 
 .PHONY: help install run test test-unit test-slow test-full bench report lint docs format clean
 
@@ -37,7 +39,7 @@ run: $(STAMP) ## run the default experiment (RUN_ARGS=... to choose another)
 	$(BIN)/cerebx run $(RUN_ARGS)
 
 test: $(STAMP) ## unit and integration tests, not the slow ones (under 5 minutes on 2 cores)
-	$(BIN)/pytest -m "not slow"
+	$(BIN)/pytest -m "not slow" -n $(TEST_WORKERS)
 
 test-unit: $(STAMP) ## only the unit tests (seconds)
 	$(BIN)/pytest -m unit

@@ -72,6 +72,6 @@ def test_the_report_draws_the_figure_from_its_study(env, tmp_path):
     assert (tmp_path / "reports" / "figures" / "my_lab_rate_limit.png").stat().st_size > 10_000
     assert len(list((tmp_path / "runs" / "report" / "quick" / "my_lab_rate_limits").glob("*/summary.json"))) == 4
     rows = list(csv.reader((tmp_path / "reports" / "paper_vs_cerebx.csv").open()))
-    assert ["my_lab_rate_limit", "the error falls as the limit loosens", "yes", "yes"] in rows
+    assert ["my_lab_rate_limit", "the error falls as the limit loosens", "yes", "yes"] in [r[:4] for r in rows]
     again = _run(env, tmp_path, "-m", "cerebx", "report", "--profile", "quick", "--figures", "my_lab_rate_limit")
     assert "1 reused, 0 to run" in again.stdout  # finished runs are reused

@@ -36,6 +36,7 @@ def _valid_image(png):
     assert png.with_suffix(".svg").read_text().lstrip().startswith("<?xml"), png
 
 
+@pytest.mark.slow  # every study of the quick profile, shortened: about 4 min of CPU
 def test_every_figure_is_drawn_from_fixture_runs(fixture_runs, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert report_main([str(fixture_runs), str(tmp_path / "missing")]) == 0
@@ -63,6 +64,7 @@ def test_every_figure_is_drawn_from_fixture_runs(fixture_runs, tmp_path, monkeyp
     assert made["command"].startswith("cerebx report ") and made["profile"] == "quick"
 
 
+@pytest.mark.slow  # every study of the quick profile, shortened: about 4 min of CPU
 def test_report_replots_given_runs_and_survives_unreadable_ones(fixture_runs, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     broken = tmp_path / "broken"
@@ -81,6 +83,7 @@ def test_report_replots_given_runs_and_survives_unreadable_ones(fixture_runs, tm
     _valid_image(tmp_path / "reports" / "figures" / "fig3_4.png")
 
 
+@pytest.mark.slow  # every study of the quick profile, shortened: about 4 min of CPU
 def test_a_figure_without_its_runs_says_which_study_is_missing(fixture_runs, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert report_main([str(fixture_runs / "fig3_4_pd"), "--figures", "fig3_6,fig3_4"]) == 0
@@ -91,6 +94,7 @@ def test_a_figure_without_its_runs_says_which_study_is_missing(fixture_runs, tmp
     assert "unknown figure" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # every study of the quick profile, shortened: about 4 min of CPU
 def test_every_study_job_is_a_valid_experiment(fixture_runs):
     state = fixture_runs / "learn_circle" / "run"
     studies = load_studies()
