@@ -140,3 +140,46 @@ def test_ann_learns_the_circle(load):
     assert np.mean(mae[-3:]) < 0.6 * mae[1] and np.mean(mae[-3:]) < 0.5 * mae[0]
     frozen = _run(load, 4, "controller.plasticity=false")
     assert frozen[-1] > 2 * np.mean(mae[-3:])
+
+
+def test_delayed_measurement_is_paired_with_the_newest_desired():
+    """As the original analog_cerebellum.py: the newest arrived measurement (stamp t - d) against the
+    newest desired sample (time t), in the error and in the state coding; 'sensor_stamp' aligns them."""
+    ann = _ann(plasticity=False, pc_input="own_joint")
+    aligned = _ann(plasticity=False, pc_input="own_joint", desired="sensor_stamp")
+    z = np.zeros(NJ)
+    old, new = np.full(NJ, -0.5), np.full(NJ, 0.02)
+    for a in (ann, aligned):  # desired sample at tick 0 (t = 0), then at tick 5 (t = 10 ms)
+        a.step(ControlInput(0, 0.0, old, z, None))
+    meas = SensorMsg(0.0, np.zeros(NJ), z)  # measured at t = 0, arrives 10 ms later
+    tau = ann.step(ControlInput(5, 0.010, new, z, meas)).tau
+    e = np.asarray(ann.cfg.k_pos) * new
+    np.testing.assert_allclose(tau, 0.2 * np.asarray(ann.cfg.gain_Nm) * np.clip(e, -1, 1))
+    tau_aligned = aligned.step(ControlInput(5, 0.010, new, z, meas)).tau
+    e_old = np.asarray(ann.cfg.k_pos) * old
+    np.testing.assert_allclose(tau_aligned, 0.2 * np.asarray(ann.cfg.gain_Nm) * np.clip(e_old, -1, 1))
+
+
+def test_weight_change_scales_with_the_granule_cells_joint_error():
+    """The original updates every PC's weights from joint j's listed cells with |e_j| (its loop runs over
+    the granule cells' joint): a PC of a joint without error still learns on another joint's cells."""
+    ann = _ann()
+    e_pos = np.zeros(NJ)
+    e_pos[3] = 0.05  # only joint e1 has an error: e = 8 * 0.05 = 0.4
+    z = np.zeros(NJ)
+    cells = ann.active_cells(e_pos, z, z, z)
+    ann.step(_inp(e_pos, z))
+    c, w0 = ann.cfg, ann.w_init
+    e = c.k_pos[3] * 0.05
+    base = np.bincount(cells[3]).argmax()
+    # PC 0 (s0 agonist, IO = 0) potentiates on e1's cells by LTP |e_e1|, and not at all on s0's own cells
+    assert ann.w[0, base] == pytest.approx(w0 + 4 * c.ltp * e, rel=1e-12)
+    assert np.all(ann.w[:, cells[0]] == w0)
+    assert ann.w[6, base] == pytest.approx(w0 + 4 * (c.ltp * (1 - e) - c.ltd * e) * e, rel=1e-12)
+
+
+def test_ann_preset_runs_without_supervisor_or_filter(load):
+    """The original ANN launches send its torque, delayed, straight to the robot (as the PD's)."""
+    cfg = load(["+task=circle", "controller=ann"])
+    assert [s.kind for s in cfg.robot] == ["hold"]
+    assert cfg.controller.desired == "newest" and cfg.controller.plasticity_error == "granule_joint"

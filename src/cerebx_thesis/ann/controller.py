@@ -8,11 +8,17 @@ Each step, per joint j with agonist/antagonist cells s in {ag, an}:
     e_j       = k_pos (q_d - q) + k_vel (qd_d - qd);  IO_j,ag = clip(e_j, 0, 1), IO_j,an = clip(-e_j, 0, 1)
     DCN_js    = clip(w_mf MF - w_pc PC_js + w_io IO_js, 0, 1)
     tau_j     = gain_j (DCN_j,ag - DCN_j,an)
-    w[js, g] += (LTP (1 - IO_js) - LTD IO_js) |e_j|  for every listed active cell, clipped to [0, w_max]
+    w[js, g] += (LTP (1 - IO_js) - LTD IO_js) |e_k|  for every listed active cell g of joint k, clipped to [0, w_max]
 
-The measured state is paired with the desired state of the sensor message's own stamp, as the
-original's state calculator and the SNN controller do. Every step is a handful of numpy calls on
-arrays of at most 12 x 96 entries; there is no per-cell Python loop.
+As the original ``analog_cerebellum.py`` (docs/provenance.md#original-ann), the newest arrived
+measurement is paired with the newest desired sample (``desired: newest``): under a sensor delay d the
+error and the state coding compare q_d(t) with q(t - d), exactly as the PD does; the original's
+time-aligning full-state node only
+fed its MAE plots, not the ANN. ``desired: sensor_stamp`` pairs the measurement with the desired
+sample of its own stamp instead (what the SNN's CF error does). The |e| factor of a weight change is
+the error of the joint whose granule cell is listed (the original's loop order), not the PC's joint
+(``plasticity_error``). Every step is a handful of numpy calls on arrays of at most 12 x 96 entries;
+there is no per-cell Python loop.
 """
 
 from __future__ import annotations
@@ -124,7 +130,10 @@ class ANN(Controller):
         if s is None:
             return TorqueMsg(inp.t_s, self._zero)
         nj = self.n_ctrl
-        q_d, qd_d = self._desired_at(s.stamp_s, inp)
+        if self.cfg.desired == "newest":
+            q_d, qd_d = inp.q_des[:nj], inp.qd_des[:nj]
+        else:
+            q_d, qd_d = self._desired_at(s.stamp_s, inp)
         q, qd = s.q[:nj], s.qd[:nj]
         e = self.k_pos * (q_d - q) + self.k_vel * (qd_d - qd)
         io = np.empty(2 * nj)
@@ -137,9 +146,14 @@ class ANN(Controller):
         tau = np.zeros(self.n_joints)
         tau[:nj] = self.gain * (dcn[0::2] - dcn[1::2])
         if c.plasticity:
-            dw = (c.ltp * (1.0 - io) - c.ltd * io) * np.abs(e)[self.pc_joint]
             rows = np.broadcast_to(self._rows, cols.shape)
-            np.add.at(self.w, (rows, cols), np.broadcast_to(dw[:, None], cols.shape))
+            rate = c.ltp * (1.0 - io) - c.ltd * io
+            if c.plasticity_error == "granule_joint" and c.pc_input == "all_joints":
+                # columns are joint 0's 4n listed cells, then joint 1's, ...: each scaled by its joint's |e|
+                dw = rate[:, None] * np.repeat(np.abs(e), 4 * self.n_bins)[None, :]
+            else:  # a row's own joint (with 'own_joint' input the granule cell's joint is the PC's)
+                dw = np.broadcast_to((rate * np.abs(e)[self.pc_joint])[:, None], cols.shape)
+            np.add.at(self.w, (rows, cols), dw)
             self.w[rows, cols] = np.clip(self.w[rows, cols], 0.0, self.w_max)
         self._abs_error_sum += np.abs(q_d - q)
         self._steps += 1

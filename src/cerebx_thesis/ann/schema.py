@@ -49,6 +49,17 @@ class ANNController(ControllerConfig):
         description="granule cells each PC sums: 'all_joints' as the original code (and Eq. 3.10, "
         "PC = f(PF)); 'own_joint' only its joint's 4n cells (then PC <= 0.3 and the learned torque is weak)",
     )
+    desired: Literal["newest", "sensor_stamp"] = Field(
+        "newest",
+        description="desired sample the measured one is paired with (error and state coding): 'newest' as the "
+        "original analog_cerebellum.py, which keeps the newest desired and the newest arrived measurement "
+        "(misaligned by the sensor delay, as the PD); 'sensor_stamp' the desired sample of the measurement's own stamp",
+    )
+    plasticity_error: Literal["granule_joint", "pc_joint"] = Field(
+        "granule_joint",
+        description="whose |e| scales a PF-PC weight change: 'granule_joint' (the original: the error of the joint "
+        "the active granule cell codes) or 'pc_joint' (the error of the Purkinje cell's own joint)",
+    )
     joint0_overwrite: bool = Field(
         False,
         description="the original's indexing slip: entries 1-5 of joint 0's active list are overwritten by "
