@@ -1,5 +1,6 @@
 """Per-trial metrics (docs/models.md#metrics): position MAE per joint and mean (Eq. 2.21-2.22 with |.|),
-velocity MAE, torque variability (Eq. 3.14-3.15, absolute step differences, N·m/ms),
+velocity MAE, torque variability (Eq. 3.14-3.15, absolute step differences, N·m/ms; per trial here,
+over the trial-averaged torque in :func:`torque_variability_of_mean`, Eq. 3.13),
 end-effector Cartesian error; and learning-curve summaries over trial windows."""
 
 from __future__ import annotations
@@ -53,6 +54,18 @@ class TrialAccumulator:
             torque_variability_Nm_per_ms=float(dtau),
             ee_error_m=float(np.nanmean(ee)) if k and np.isfinite(ee).any() else None,
         )
+
+
+def torque_variability_of_mean(tau: np.ndarray, step_ms: float = 2.0) -> float:
+    """Eq. 3.13-3.15: average the torque over trials step by step (``tau``: trials x steps x joints,
+    each trial one period of a periodic task), then mean |tau(t) - tau(t - step)| / step over the steps and
+    the joints, N·m/ms. Averaging removes the trial-to-trial part (spike noise, sensor noise), so for a
+    controller whose output is not deterministic this is well below the per-trial value; for a
+    deterministic one on a repeating task the two agree."""
+    tau = np.asarray(tau, float)
+    if tau.ndim != 3 or tau.shape[1] < 2:
+        raise ValueError(f"torque_variability_of_mean: need trials x steps x joints with >= 2 steps, got {tau.shape}")
+    return float(np.abs(np.diff(tau.mean(axis=0), axis=0)).mean() / step_ms)
 
 
 def final_mae(mae_per_trial: list[float]) -> float | None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cerebx.metrics import TrialAccumulator, final_mae, trials_to_threshold, window_stats
+from cerebx.metrics import TrialAccumulator, final_mae, torque_variability_of_mean, trials_to_threshold, window_stats
 
 
 def test_final_mae_is_mean_of_last_ten_percent():
@@ -31,3 +31,18 @@ def test_accumulator_mae_and_torque_variability():
     assert m.mae_per_joint == pytest.approx((0.5, 0.0)) and m.mae == pytest.approx(0.25)
     assert m.vel_mae == pytest.approx(0.1)
     assert m.torque_variability_Nm_per_ms == pytest.approx(0.5)  # |Δτ| = 2 N·m on one of 2 joints per 2 ms
+
+
+def test_torque_variability_of_the_trial_averaged_torque():
+    """Eq. 3.13-3.15: the torque is averaged over trials before differencing, so trial-to-trial noise
+    drops out: a ramp of 0.1 N·m per 2 ms step (0.05 N·m/ms) plus +-1 N·m noise that flips sign from
+    one trial to the next gives 0.05 exactly, where the per-trial value is dominated by the noise."""
+    steps, joints = 50, 2
+    ramp = 0.1 * np.arange(steps)[:, None] * np.ones(joints)
+    noise = np.where(np.arange(steps) % 2, 1.0, -1.0)[:, None] * np.ones(joints)
+    tau = np.stack([ramp + noise, ramp - noise, ramp + noise, ramp - noise])
+    assert torque_variability_of_mean(tau) == pytest.approx(0.05)
+    per_trial = np.mean([np.abs(np.diff(t, axis=0)).mean() / 2.0 for t in tau])
+    assert per_trial == pytest.approx((2.1 + 1.9) / 2 / 2.0)
+    with pytest.raises(ValueError):
+        torque_variability_of_mean(ramp)

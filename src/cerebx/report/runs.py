@@ -17,6 +17,7 @@ import numpy as np
 
 from cerebx import runfiles
 from cerebx.errors import CerebxError
+from cerebx.metrics import torque_variability_of_mean
 from cerebx.recording.reader import read_messages, read_metadata, read_summary
 from cerebx.schema.legacy import upgrade
 
@@ -156,6 +157,28 @@ class Run:
         hi = None if t1 is None else int(round(t1 * 1e9))
         for topic, t, msg in read_messages(self.dir, topics, start_ns=lo, end_ns=hi):
             yield topic, t / 1e9, msg
+
+    def applied_torque(self) -> tuple[np.ndarray, float] | None:
+        """The applied joint torque of the measured trials as trials x steps x joints (from
+        /joint_states/actual), with the recorded step in ms; None when joint states were not recorded."""
+        if self.n_measured == 0:
+            return None
+        t0 = self.warmup * self.period_s
+        rows = [[j["effort"] for j in msg["joints"]] for _, _, msg in
+                self.messages(["/joint_states/actual"], t0 - 1e-6, self.trials * self.period_s - 1e-6)]
+        if not rows or any(v is None for v in rows[0]):
+            return None
+        per_trial = len(rows) // self.n_measured
+        if per_trial < 2:
+            return None
+        tau = np.asarray(rows[: per_trial * self.n_measured], float).reshape(self.n_measured, per_trial, -1)
+        return tau, 1000.0 * self.period_s / per_trial
+
+    def torque_variability_of_mean(self) -> float | None:
+        """Torque variability of the trial-averaged applied torque (Eq. 3.13-3.15, N·m/ms) over this run's
+        measured trials, or None."""
+        got = self.applied_torque()
+        return None if got is None else torque_variability_of_mean(*got)
 
     def control(self, keys: Iterable[str], t0: float | None = None, t1: float | None = None,
                 every: int = 1) -> dict[str, np.ndarray]:

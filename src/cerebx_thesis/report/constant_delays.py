@@ -39,6 +39,20 @@ CONTROLLERS = {"pd": ("PD", "C3"), "ann": ("ANN", "C1"), "snn": ("SNN", "C0")}
 PAPER_FACTORY_CH3 = {"circle": "0.077", "inclined_circle": "0.055", "circle_eight": "0.068"}
 FIG3_5_DELAY_MS = 50.0
 FIG3_5_TRIALS = 16  # trials read per run for the densities (evenly spaced)
+# Torque variability at 50 ms (N·m/ms per joint) as the paper measured it (003 lines 204-236, thesis §3.3.1):
+# SNN and ANN over the 100-trial averaged torque (Eq. 3.13), PD over one trial
+PAPER_TV_50MS = {("pd", "circle"): "0.036", ("pd", "inclined_circle"): "0.051", ("pd", "circle_eight"): "0.037",
+                 ("ann", "circle"): "0.026", ("ann", "inclined_circle"): "0.027", ("ann", "circle_eight"): "0.028",
+                 ("snn", "circle"): "0.012", ("snn", "inclined_circle"): "0.012", ("snn", "circle_eight"): "0.018"}
+
+
+def tv_as_paper(run: Run, controller: str) -> float | None:
+    """Torque variability as the paper computed it (Eq. 3.13-3.15): SNN and ANN over the trial-averaged
+    applied torque (100 iterations in the paper), PD over one iteration (the per-trial value)."""
+    if controller == "pd":
+        tv = run.series("torque_variability_per_trial")
+        return float(tv.mean()) if len(tv) else None
+    return run.torque_variability_of_mean()
 
 
 @figure("fig3_4", "PD, ANN and SNN under constant round-trip delays", studies=("fig3_4_snn", "fig3_4_ann", "fig3_4_pd"))
@@ -59,7 +73,12 @@ def fig3_4(runs: RunSet, stem: Path) -> Figure:
         mae = np.array([mean_and_std(r.mae) for r in sweep.values()])
         tv = np.array([mean_and_std(r.series("torque_variability_per_trial")) for r in sweep.values()])
         ax_a.errorbar(x, mae[:, 0], mae[:, 1], marker="o", capsize=3, color=color, label=name)
-        ax_b.errorbar(x, tv[:, 0], tv[:, 1], marker="o", capsize=3, color=color, label=name)
+        ax_b.errorbar(x, tv[:, 0], tv[:, 1], marker="o", capsize=3, color=color, ls=":", alpha=0.6,
+                      label=f"{name}, per trial")
+        if c != "pd":
+            averaged = [tv_as_paper(r, c) for r in sweep.values()]
+            ax_b.plot(x, [np.nan if v is None else v for v in averaged], marker="s", color=color,
+                      label=f"{name}, trial-averaged torque (Eq. 3.13)")
     pos = reference_run(runs, "position")
     if pos is not None:
         ax_a.axhline(pos.mae.mean(), ls="--", color="0.4", lw=1.1, label="factory position, no delay")
@@ -93,16 +112,24 @@ def fig3_4(runs: RunSet, stem: Path) -> Figure:
             snn = np.concatenate([r.mae for r in sweeps["snn"].values()]).mean()
             table.append([f"{name} average MAE ÷ SNN average MAE", "3 to 4× larger", fmt(pooled.mean() / snn, 2)])
         x = np.array(list(sweep))
-        tv = np.array([r.series("torque_variability_per_trial").mean() for r in sweep.values()])
-        tv50 = np.interp(50.0, x, tv) if x.min() <= 50 <= x.max() else None
         at50 = "" if 50 in sweep else " (50 ms interpolated)"
-        table.append([f"{name} torque variability 0 → 50 ms (N·m/ms){at50}", paper_tv[c],
-                      f"{fmt(tv[0] if x[0] == 0 else None)} → {fmt(tv50)}"])
+        per_trial = [r.series("torque_variability_per_trial").mean() for r in sweep.values()]
+        rows = ([("one trial, as the paper's PD", per_trial)] if c == "pd" else
+                [("per trial", per_trial), ("of the trial-averaged torque, as the paper (Eq. 3.13)",
+                                            [tv_as_paper(r, c) for r in sweep.values()])])
+        for label, values in rows:
+            tv = np.array([np.nan if v is None else v for v in values], float)
+            tv50 = np.interp(50.0, x, tv) if x.min() <= 50 <= x.max() and np.isfinite(tv).all() else None
+            table.append([f"{name} torque variability 0 → 50 ms, {label} (N·m/ms){at50}", paper_tv[c],
+                          f"{fmt(tv[0] if x[0] == 0 and np.isfinite(tv[0]) else None)} → {fmt(tv50)}"])
     counts = "; ".join(f"{CONTROLLERS[c][0]}: δT = {', '.join(f'{d:g}' for d in s)} ms, {trial_counts(s.values())} "
                        f"per δT, {origin(next(iter(s.values())))}" for c, s in sweeps.items() if s)
     caption = ("Fig. 3.4 — controllers under constant round-trip delays δT (split evenly between R2C and C2R), "
-               "horizontal circle. (A) position MAE, mean ± std over each run's trials; (B) torque variability "
-               "(Eq. 3.15: mean |Δτ| per ms over joints), mean ± std over trials. "
+               "horizontal circle. (A) position MAE, mean ± std over each run's trials; (B) torque variability of the "
+               "applied torque (Eq. 3.15: mean |Δτ| per ms over joints): dotted, per trial (mean ± std over trials); "
+               "solid squares, of the torque first averaged over the run's measured trials step by step (Eq. 3.13, "
+               "as the paper computed it for the SNN and ANN over 100 iterations; the paper's PD value is one "
+               "trial's). "
                f"Runs — {counts}. The thesis used 100 trials per δT and stopped PD and ANN at 50 ms; every δT "
                "run is shown here. The dashed grey line is the factory position controller without delay "
                "(where such a run exists).")
@@ -223,8 +250,18 @@ def fig3_5(runs: RunSet, stem: Path) -> Figure:
                 ax.text(0.5, 0.5, "no runs", transform=ax.transAxes, ha="center")
         for c in ("pd", "ann", "snn"):
             r = slots[(task, c)]
-            table.append([f"{TASK_NAMES[task]}, {c.upper()} at {FIG3_5_DELAY_MS:.0f} ms: MAE (rad)", claims[c],
+            at = f"{TASK_NAMES[task]}, {c.upper()} at {FIG3_5_DELAY_MS:.0f} ms"
+            table.append([f"{at}: MAE (rad)", claims[c],
                           f"{mean_std(r.mae)} ({r.n_measured} trials)" if r is not None else "not run"])
+            if r is None:
+                continue
+            per_trial = r.series("torque_variability_per_trial")
+            how = "one trial" if c == "pd" else "trial-averaged torque, Eq. 3.13"
+            table.append([f"{at}: torque variability, {how} (N·m/ms)", PAPER_TV_50MS[(c, task)],
+                          fmt(tv_as_paper(r, c))])
+            if c != "pd":
+                table.append([f"{at}: torque variability per trial (N·m/ms)", "–",
+                              mean_std(per_trial) if len(per_trial) else "–"])
         missing = [c for c in ("pd", "ann", "snn") if slots[(task, c)] is None]
         if missing:
             notes.append(f"no {' / '.join(missing)} run on {task} at {FIG3_5_DELAY_MS:.0f} ms")
@@ -239,7 +276,9 @@ def fig3_5(runs: RunSet, stem: Path) -> Figure:
                f"{FIG3_5_DELAY_MS:.0f} ms round-trip delay (thesis: 100 trials per controller; here the density of "
                f"{', '.join(counts)} trials, evenly spaced, every 2nd control step); dashed: desired path; green: "
                "last trial of the factory position controller without delay. Circle and circle-Lissajous in the xy "
-               "plane, the inclined circle in the principal plane of its desired path.")
+               "plane, the inclined circle in the principal plane of its desired path. Table: torque variability "
+               "of the applied torque as the paper computed it (SNN and ANN: of the torque averaged over the run's "
+               "measured trials, Eq. 3.13; PD: one trial's), beside the paper's value at 50 ms.")
     return Figure([save(fig, stem)], caption, table, notes, *_fig3_5_shape(runs, slots))
 
 

@@ -58,6 +58,7 @@ def test_every_figure_is_drawn_from_fixture_runs(fixture_runs, tmp_path, monkeyp
     for name in figures:
         assert f"\n{name}," in paper, f"{name}: no paper-vs-cerebx rows"
     assert "0.019" in page and "0.000106" in page  # the paper's numbers beside ours
+    assert "trial-averaged torque, as the paper (Eq. 3.13)" in paper  # Fig. 3.4's SNN/ANN torque variability
     made = json.loads((out / "figures.json").read_text())  # the same figures, machine-readable
     assert [e["name"] for e in made["figures"]] == list(figures) and made["runs"]["count"] > 0
     assert all((out / f).is_file() for e in made["figures"] for f in e["files"])
