@@ -13,6 +13,7 @@ from cerebx.build import BuildContext
 from cerebx.guard import conf_roots
 from cerebx.loop.delays import Percentiles
 from cerebx.loop.link import DelayChannel
+from cerebx.report.studies import preset_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -123,3 +124,17 @@ def test_cloud_percentiles_are_the_thesis_figures(load):
     assert pick(cloud.r2c_percentiles) == pick(cloud.c2r_percentiles) == [9.0, 10.0, 12.0]
     assert pick(wifi.r2c_percentiles) == [12.0, 14.0, 20.0]
     assert pick(wifi.c2r_percentiles) == [29.0, 32.0, 36.0]
+
+
+def test_fig3_6_moves_the_pathway_delay_with_the_kernel(load):
+    """As the original's bio-delay launches: kernel peak 2D + 50 ms, onset 2D + 20 ms, pathway delay D."""
+    jobs = preset_sweep(["+experiment=fig3_6_kernels"])
+    assert len(jobs) == 9
+    peaks = []
+    for job in jobs:
+        cfg = load(["+experiment=fig3_6_kernels", *job])
+        rule = cfg.controller.network.projections["pf_pc"].plasticity
+        d = cfg.controller.pathway_delay_ms
+        assert rule.kernel_peak_ms == 2 * d + 50 and rule.kernel_onset_ms == 2 * d + 20
+        peaks.append(rule.kernel_peak_ms)
+    assert peaks == [90, 110, 130, 150, 170, 190, 210, 230, 250]

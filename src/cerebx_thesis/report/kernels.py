@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from cerebx.report.convergence import Convergence, combined  # noqa: E402
-from cerebx.report.plot import mean_std  # noqa: E402
+from cerebx.report.plot import fmt, mean_std  # noqa: E402
 from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
 from cerebx.report.runs import Run, RunSet  # noqa: E402
 from cerebx.snn.schema import KernelSTDP  # noqa: E402
@@ -112,14 +112,16 @@ def fig3_6(runs: RunSet, stem: Path) -> Figure:
     table.append(["PD reference, no delay (rad)", "0.076", "–" if pd is None else mean_std(pd.mae)])
     origins: dict[str, list[str]] = {}
     for p, r in by_peak.items():
-        origins.setdefault(origin(r), []).append(f"{p:g} ({r.trials})")
+        d = r.get("controller.pathway_delay_ms")
+        origins.setdefault(origin(r), []).append(f"{p:g} (D = {fmt(d, 0)} ms, {r.trials})")
     origin_text = "; ".join(f"{o}: {', '.join(v)}" for o, v in origins.items())
     caption = ("Fig. 3.6 — SNN on the horizontal circle without delay for each PF-PC LTD kernel. (A) the kernels "
                "as the network builds them (ltd_kernel_table of each run's config); (B) MAE, mean ± std over the last "
                "min(100, trials) trials, with the PD reference (no delay); (C) linear fit of the per-kernel mean MAE "
-               "vs kernel peak beside the thesis's regression. Kernel peak in ms (trials per run) by how the run "
-               f"started — {origin_text}. The thesis learned each kernel from scratch with 100 trials per kernel in "
-               "the regression.")
+               "vs kernel peak beside the thesis's regression. Kernel peak in ms (pathway delay D each way, trials "
+               f"per run) by how the run started — {origin_text}. The original ran each kernel with its own pathway "
+               "delay D = (peak − 50 ms) / 2 and its own learnt weights (bio-delay launches), 100 trials per kernel "
+               "in the regression.")
     return Figure([png], caption, table, notes, *_fig3_6_shape(runs, by_peak, last, fit))
 
 def _common_grid(ks: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
