@@ -285,3 +285,19 @@ def test_agonist_antagonist_io_declares_the_two_muscle_signals():
     assert [(s.name, s.size, s.low, s.high) for s in io.writes] == [("muscle.ag", 6, 0.0, 1.0),
                                                                     ("muscle.at", 6, 0.0, 1.0)]
     assert [s.name for s in SNNController(network=full_network()).io(6).writes] == ["joint.torque"]
+
+
+def test_error_reference_lag_pairs_the_measurement_with_an_earlier_desired_sample():
+    """The original's full-state node fed the CF error q_d(s - D) - q(s); the MF state keeps q_d(s)."""
+    lagged = make_ctrl(pathway_delay_ms=10.0, error_reference_lag_ms=50.0)
+    plain = make_ctrl(pathway_delay_ms=10.0)
+    for c in (lagged, plain):
+        c.reset(np.random.default_rng(0))
+        drive(c, 100)  # desired q_d(t) = 0.3 sin(pi t); the measurement is 0.02 rad below it
+    t = 99 * 0.002
+    q = np.sin(np.pi * t) * 0.3 - 0.02
+    kpos, kvel = np.asarray(plain.cfg.error.kpos), np.asarray(plain.cfg.error.kvel)
+    qd_meas = np.cos(np.pi * t) * 0.3
+    for c, t_ref in ((plain, t), (lagged, t - 0.050)):
+        want = kpos * (0.3 * np.sin(np.pi * t_ref) - q) + kvel * (0.3 * np.cos(np.pi * t_ref) - qd_meas)
+        np.testing.assert_allclose(c.last_error, want, rtol=1e-9, atol=1e-12)

@@ -251,6 +251,8 @@ class SNNControllerImpl(Controller):
         else:
             q_des, qd_des = self._desired_at(s.stamp_s, inp)
             mf = (self.mf.active(q_des, s.q, qd_des, s.qd) + self.sl_mf.start).astype(np.int32)
+            if self.cfg.error_reference_lag_ms:
+                q_des, qd_des = self._desired_at(s.stamp_s - self.cfg.error_reference_lag_ms / 1000.0, inp)
             e = self.cf.error(q_des, s.q, qd_des, s.qd)
             self.last_error = e
             cf = (self.cf.active(e) + self.sl_cf.start).astype(np.int32)

@@ -100,6 +100,11 @@ class SNNController(ControllerConfig):
     cf_pathway_delay_ms: NonNegFloat | None = Field(
         None, description="afferent delay of the CF (error) spikes; null = pathway_delay_ms (the original's "
         "first setup: 40 ms with 50 ms for the MF)")
+    error_reference_lag_ms: NonNegFloat = Field(
+        0.0, description="the CF error compares the measurement of stamp s with the desired sample of s - lag "
+        "(the MF state coding keeps the desired sample of s): lag = pathway_delay_ms teaches the network to "
+        "follow the path that much late, as the original's full-state node did (it paired them at now - "
+        "sensorial delay - transmission delay). 0 = the path itself")
     efferent: Literal["auto", "hold", "stamp"] = Field(
         "hold",
         description="'hold': a torque is emitted D after the network computed it; 'stamp': it is sent at "
