@@ -256,7 +256,7 @@ def fig12(runs: RunSet, stem: Path) -> Figure:
              label="paper (400 trials)")
     ax_b.set_xticks(xs, [f"{g[0]:g} kg" for g in gains])
     ax_b.set_ylabel("error reduction at the last trial (%)")
-    ax_b.set_ylim(0, 118)  # room above the bars (reductions are percentages) for the legend
+    ax_b.set_ylim(top=118)  # room above the bars (reductions are percentages) for the legend
     ax_b.legend(fontsize=8, loc="upper center", ncols=2)
     for ax in (ax_a, ax_b):
         ax.grid(alpha=0.3)
