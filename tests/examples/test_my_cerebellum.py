@@ -6,12 +6,12 @@ subprocess, so nothing of it leaks into the other tests."""
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from installed_plugin import plugin_env
 
 pytestmark = pytest.mark.integration
 
@@ -21,12 +21,7 @@ EXAMPLE = ROOT / "examples" / "my_cerebellum"
 
 @pytest.fixture(scope="module")
 def env(tmp_path_factory) -> dict[str, str]:
-    site = tmp_path_factory.mktemp("site")
-    info = site / "my_cerebellum-0.1.0.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: my-cerebellum\nVersion: 0.1.0\n")
-    (info / "entry_points.txt").write_text("[cerebx.plugins]\nmy_cerebellum = my_cerebellum:register\n")
-    return {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(EXAMPLE)])}
+    return plugin_env(tmp_path_factory.mktemp("site"), "my_cerebellum")
 
 
 def _cerebx(env: dict[str, str], cwd: Path, *args: str) -> subprocess.CompletedProcess:

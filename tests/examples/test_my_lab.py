@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import csv
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from installed_plugin import plugin_env
 
 from cerebx.recording.reader import read_messages
 
@@ -25,12 +25,7 @@ EXAMPLE = ROOT / "examples" / "my_lab"
 
 @pytest.fixture(scope="module")
 def env(tmp_path_factory) -> dict[str, str]:
-    site = tmp_path_factory.mktemp("site")
-    info = site / "my_lab-0.1.0.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: my-lab\nVersion: 0.1.0\n")
-    (info / "entry_points.txt").write_text("[cerebx.plugins]\nmy_lab = my_lab:register\n")
-    return {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(EXAMPLE)])}
+    return plugin_env(tmp_path_factory.mktemp("site"), "my_lab")
 
 
 def _run(env: dict[str, str], cwd: Path, *args: str) -> subprocess.CompletedProcess:
