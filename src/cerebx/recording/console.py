@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from cerebx.metrics import window_stats
+from cerebx.metrics import final_mae, window_stats
 
 
 def format_summary(s: dict[str, Any], run_dir: Path | None = None) -> str:
@@ -21,7 +21,10 @@ def format_summary(s: dict[str, Any], run_dir: Path | None = None) -> str:
     mae = s.get("mae_per_trial") or []
     lines.append(f"trials    {s.get('trials_completed', len(mae))}/{s['trials']}")
     if mae:
-        lines.append(f"MAE       first {mae[0]:.4f} rad   final {s['final_mae']:.4f} rad (mean of last 10 %)")
+        # a summary edited by hand may lack final_mae: it is the mean of the last 10 % of the trials listed
+        final = s.get("final_mae")
+        final = final_mae(mae) if final is None else final
+        lines.append(f"MAE       first {mae[0]:.4f} rad   final {final:.4f} rad (mean of last 10 %)")
         n = len(mae)
         cuts = sorted({0, n // 5, n // 2, n})
         parts = []

@@ -155,6 +155,17 @@ def test_inspect_prints_summary_and_channels(load, tmp_path, capsys):
     assert "status    completed" in out and "/joint_states/actual" in out and "1,000" in out
 
 
+def test_inspect_summary_without_final_mae_computes_it(tmp_path, capsys):
+    # found by the fuzzing test: a damaged key left the per-trial MAE list but no final_mae
+    s = {"status": "completed", "task": "joint_sine", "controller": "pd", "plant": "planar2", "delay": "none",
+         "seed": 0, "trials": 10, "trials_completed": 10, "mae_per_trial": [0.5] * 9 + [0.125]}
+    (tmp_path / "summary.json").write_text(json.dumps(s))
+    assert main(["inspect", str(tmp_path)]) in (0, 2)
+    out, err = capsys.readouterr()
+    assert "Traceback" not in out + err
+    assert "first 0.5000 rad   final 0.1250 rad" in out
+
+
 def test_inspect_file_that_is_not_mcap_one_line(tmp_path, capsys, load):
     run_experiment(load([*DEMO, "trials=1"]), tmp_path / "r")
     data = (tmp_path / "r" / "run.mcap").read_bytes()
