@@ -26,9 +26,9 @@ from __future__ import annotations
 import copy
 import hashlib
 import json
-import threading
 import time
 from collections import deque
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -69,7 +69,8 @@ class SNNControllerImpl(Controller):
         slack = self.k_in + (self.k_delay if self.hold else 0)
         self.chunk = max(1, slack // 2)
         self.pipeline = cfg.pipeline and slack >= 2
-        self._worker: tuple[threading.Thread, dict] | None = None
+        self._worker: Future | None = None  # the chunk in flight
+        self._pool: ThreadPoolExecutor | None = None
         self.net = Network(self.net_cfg, parallel=cfg.parallel and not self.pipeline)
         self.net.learn = cfg.plasticity
         io = self.net_cfg.io
@@ -165,36 +166,41 @@ class SNNControllerImpl(Controller):
         self._net_step += len(results)
 
     def _launch(self) -> None:
-        """Start simulating the next chunk of pending inputs on the worker thread."""
+        """Hand the next chunk of pending inputs to the network thread."""
         chunk = [self._pending.popleft() for _ in range(self.chunk)]
         first = self._net_step  # no chunk is in flight when a new one starts
-        box: dict[str, Any] = {}
-
         clock = phase_clock.active()
 
-        def work() -> None:
+        def work() -> list[tuple]:
             t0, c0 = (time.perf_counter(), time.thread_time()) if clock is not None else (0.0, 0.0)
             try:
-                box["out"] = self._simulate(chunk, first)
-            except BaseException as exc:  # re-raised in the loop's thread by _join
-                box["err"] = exc
-            if clock is not None:
-                clock.add_background("network", time.perf_counter() - t0, time.thread_time() - c0)
+                return self._simulate(chunk, first)
+            finally:
+                if clock is not None:
+                    clock.add_background("network", time.perf_counter() - t0, time.thread_time() - c0)
 
-        self._worker = (threading.Thread(target=work, name="cerebx-snn", daemon=True), box)
-        self._worker[0].start()
+        if self._pool is None:
+            # one long-lived thread: starting a thread per chunk cost the loop ~1 ms each time (Thread.start
+            # waits until the new thread has the GIL), a third of a learning run's controller time
+            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="cerebx-snn")
+        self._worker = self._pool.submit(work)
 
     def _join(self) -> None:
         worker = self._worker
         if worker is None:
             return
-        thread, box = worker
-        with phase_clock.charge("wait"):
-            thread.join()
         self._worker = None
-        if "err" in box:
-            raise box["err"]
-        self._absorb(box["out"])
+        with phase_clock.charge("wait"):
+            results = worker.result()  # an exception of the network thread is raised here
+        self._absorb(results)
+
+    def __getstate__(self) -> dict:
+        """For checkpoints (pickled between trials, when no chunk is in flight): the network thread is not
+        part of the state; a restored controller starts its own when it first needs one."""
+        self._join()
+        state = self.__dict__.copy()
+        state["_pool"] = None
+        return state
 
     def _advance(self) -> None:
         """Make sure this tick's torque is ready; in pipeline mode keep one chunk in flight."""
