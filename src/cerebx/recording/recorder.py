@@ -33,8 +33,8 @@ leaves a valid file.
 from __future__ import annotations
 
 import json
-from pathlib import Path
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import foxglove
