@@ -5,6 +5,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 DOCS_STAMP := $(VENV)/.docs-stamp
+SLURM_STAMP := $(VENV)/.slurm-stamp
 export NUMBA_CACHE_DIR ?= $(CURDIR)/.cache/numba
 export CEREBX_CACHE ?= $(CURDIR)/.cache/cerebx
 
@@ -33,6 +34,12 @@ $(DOCS_STAMP): $(STAMP) pyproject.toml
 	$(BIN)/pip install --quiet -e ".[test,docs]"
 	touch $(DOCS_STAMP)
 
+# the slow tests include a sweep through a local SLURM (scripts/slurm_local.sh brings one up as root with apt;
+# without either, that test skips and says why)
+$(SLURM_STAMP): $(STAMP) pyproject.toml
+	$(BIN)/pip install --quiet -e ".[test,slurm]"
+	touch $(SLURM_STAMP)
+
 install: $(STAMP) ## create .venv and install cerebx with its test tools
 
 run: $(STAMP) ## run the default experiment (RUN_ARGS=... to choose another)
@@ -44,10 +51,10 @@ test: $(STAMP) ## unit and integration tests, not the slow ones (under 5 minutes
 test-unit: $(STAMP) ## only the unit tests (seconds)
 	$(BIN)/pytest -m unit
 
-test-slow: $(STAMP) ## only the slow tests (what test-full adds to test)
+test-slow: $(SLURM_STAMP) ## only the slow tests (what test-full adds to test)
 	$(BIN)/pytest -m slow
 
-test-full: $(STAMP) ## every test, including the slow ones
+test-full: $(SLURM_STAMP) ## every test, including the slow ones
 	$(BIN)/pytest
 
 bench: $(STAMP) ## speed of plant, network and closed loop, as JSON

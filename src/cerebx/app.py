@@ -30,6 +30,7 @@ log = logging.getLogger("cerebx")
 
 @hydra.main(config_path="conf", config_name="config", version_base="1.3")
 def run_app(cfg: DictConfig) -> float | None:
+    jobenv.configure_job()
     log.info("job: %s", jobenv.describe())
     hc = HydraConfig.get()
     run_dir = Path(hc.runtime.output_dir)

@@ -9,6 +9,10 @@ set wins; otherwise:
   shared by the jobs of a sweep on one machine (or one shared home on a cluster), never ``src/…/__pycache__``;
 - ``NUMBA_NUM_THREADS`` = the CPUs given to this job: ``SLURM_CPUS_PER_TASK`` inside a SLURM job, else
   the CPUs this process may run on.
+
+A value set by cerebx itself in another process (``CEREBX_JOBENV_CHOSEN`` names them: a sweep's submitting
+process on a 2-CPU login node, whose environment SLURM hands to each job) does not count as set: the job
+chooses again for its own allocation.
 """
 
 from __future__ import annotations
@@ -16,6 +20,10 @@ from __future__ import annotations
 import os
 import sys
 from pathlib import Path
+
+
+CHOSEN_BY_CEREBX = "CEREBX_JOBENV_CHOSEN"
+"""Names of the variables :func:`configure` set itself (not the user), comma-separated."""
 
 
 def job_cpus(environ: dict[str, str] | None = None) -> int:
@@ -46,11 +54,27 @@ def configure(environ: dict[str, str] | None = None) -> dict[str, str]:
     what was set. Does nothing to numba itself once it is imported (its config is read at import)."""
     env = os.environ if environ is None else environ
     chosen = {"NUMBA_CACHE_DIR": str(numba_cache_dir(env)), "NUMBA_NUM_THREADS": str(job_cpus(env))}
-    set_now = {k: v for k, v in chosen.items() if not env.get(k)}
+    # values an earlier cerebx process chose for itself (a sweep's submitting process, whose environment a
+    # SLURM job inherits) are chosen again here; only what the user set wins
+    ours = set(filter(None, env.get(CHOSEN_BY_CEREBX, "").split(",")))
+    set_now = {k: v for k, v in chosen.items() if not env.get(k) or (k in ours and env[k] != v)}
     env.update(set_now)
+    env[CHOSEN_BY_CEREBX] = ",".join(sorted(ours | {k for k in chosen if env.get(k) == chosen[k] and
+                                                    (k in set_now or k in ours)}))
     if environ is None and "numba" in sys.modules and set_now:
         return {}  # too late for this process; nothing changed in effect
     return set_now
+
+
+def configure_job() -> None:
+    """:func:`configure` at the start of a launcher's job, which may not have imported :mod:`cerebx.app` (Hydra
+    hands launchers the undecorated task function, which cloudpickle then sends by value); if numba is loaded
+    already, its thread count is set at run time instead (numba reads ``NUMBA_NUM_THREADS`` only at import)."""
+    configure()
+    numba = sys.modules.get("numba")
+    if numba is not None:
+        wanted = int(os.environ["NUMBA_NUM_THREADS"])
+        numba.set_num_threads(max(1, min(wanted, numba.config.NUMBA_NUM_THREADS)))
 
 
 def describe(environ: dict[str, str] | None = None) -> str:

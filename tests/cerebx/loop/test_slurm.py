@@ -36,6 +36,17 @@ def test_configure_sets_only_what_is_unset(tmp_path):
     assert "SLURM_JOB_ID=7 " in jobenv.describe({**env, "SLURM_JOB_ID": "7"})
 
 
+def test_a_job_chooses_again_what_the_submitting_process_chose():
+    # the sweep's own process (2 CPUs here, say) sets the thread count; its SLURM job inherits that
+    # environment, and must use its own allocation instead, unless the user had set the value
+    submitter = {"CEREBX_CACHE": "/c"}
+    jobenv.configure(submitter)
+    job = {**submitter, "SLURM_CPUS_PER_TASK": "1", "NUMBA_NUM_THREADS": "2"}
+    assert jobenv.configure(job) == {"NUMBA_NUM_THREADS": "1"} and job["NUMBA_NUM_THREADS"] == "1"
+    user = {"CEREBX_CACHE": "/c", "SLURM_CPUS_PER_TASK": "1", "NUMBA_NUM_THREADS": "2"}
+    assert "NUMBA_NUM_THREADS" not in jobenv.configure(user) and user["NUMBA_NUM_THREADS"] == "2"
+
+
 def _slurm_up() -> str | None:
     """Bring the local SLURM up; the reason it cannot be, else None."""
     try:
