@@ -21,7 +21,6 @@ import os
 import sys
 from pathlib import Path
 
-
 CHOSEN_BY_CEREBX = "CEREBX_JOBENV_CHOSEN"
 """Names of the variables :func:`configure` set itself (not the user), comma-separated."""
 
