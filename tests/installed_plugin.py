@@ -4,6 +4,8 @@ path), for tests that run cerebx in a subprocess with it."""
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -18,3 +20,8 @@ def plugin_env(site: Path, package: str, version: str = "0.1.0") -> dict[str, st
     (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {dist}\nVersion: {version}\n")
     (info / "entry_points.txt").write_text(f"[cerebx.plugins]\n{package} = {package}:register\n")
     return {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(ROOT / "examples" / package)])}
+
+
+def run_python(env: dict[str, str], cwd: Path, *args: str) -> subprocess.CompletedProcess:
+    """``python ARGS`` in ``cwd`` with ``env`` (e.g. ``"-m", "cerebx", "run", ...``), output captured."""
+    return subprocess.run([sys.executable, *args], env=env, cwd=cwd, capture_output=True, text=True, timeout=600)

@@ -58,8 +58,7 @@ def configure(environ: dict[str, str] | None = None) -> dict[str, str]:
     ours = set(filter(None, env.get(CHOSEN_BY_CEREBX, "").split(",")))
     set_now = {k: v for k, v in chosen.items() if not env.get(k) or (k in ours and env[k] != v)}
     env.update(set_now)
-    env[CHOSEN_BY_CEREBX] = ",".join(sorted(ours | {k for k in chosen if env.get(k) == chosen[k] and
-                                                    (k in set_now or k in ours)}))
+    env[CHOSEN_BY_CEREBX] = ",".join(sorted(ours | set_now.keys()))
     if environ is None and "numba" in sys.modules and set_now:
         return {}  # too late for this process; nothing changed in effect
     return set_now

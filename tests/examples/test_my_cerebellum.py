@@ -6,12 +6,10 @@ subprocess, so nothing of it leaks into the other tests."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
-from installed_plugin import plugin_env
+from installed_plugin import plugin_env, run_python
 
 pytestmark = pytest.mark.integration
 
@@ -24,22 +22,16 @@ def env(tmp_path_factory) -> dict[str, str]:
     return plugin_env(tmp_path_factory.mktemp("site"), "my_cerebellum")
 
 
-def _cerebx(env: dict[str, str], cwd: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "cerebx", *args], env=env, cwd=cwd, capture_output=True, text=True,
-                          timeout=600)
-
-
 def test_the_model_learns_and_starts_again_from_its_state(env, tmp_path):
-    first = _cerebx(env, tmp_path, "run", "+experiment=adaptive_filter_demo", "trials=12", "hydra.run.dir=first")
+    run = ("-m", "cerebx", "run", "+experiment=adaptive_filter_demo")
+    first = run_python(env, tmp_path, *run, "trials=12", "hydra.run.dir=first")
     assert first.returncode == 0, first.stderr
     mae = json.loads((tmp_path / "first" / "summary.json").read_text())["mae_per_trial"]
     assert mae[-1] < 0.4 * mae[0]  # the filter takes over from the weak PD
-    again = _cerebx(env, tmp_path, "run", "+experiment=adaptive_filter_demo", "trials=2", "init_from=first",
-                    "hydra.run.dir=again")
+    again = run_python(env, tmp_path, *run, "trials=2", "init_from=first", "hydra.run.dir=again")
     assert again.returncode == 0, again.stderr
     assert json.loads((tmp_path / "again" / "summary.json").read_text())["mae_per_trial"][0] < 0.5 * mae[0]
-    other = _cerebx(env, tmp_path, "run", "+experiment=adaptive_filter_demo", "init_from=first",
-                    "controller.parts.1.filters=4", "hydra.run.dir=other")
+    other = run_python(env, tmp_path, *run, "init_from=first", "controller.parts.1.filters=4", "hydra.run.dir=other")
     assert other.returncode == 2
     assert other.stderr.strip().startswith("init_from: ") and "8 filters" in other.stderr
     assert not (tmp_path / "other").exists()
@@ -50,6 +42,5 @@ def test_the_model_keeps_the_stage_contract(env, tmp_path):
             "from cerebx.stages.check import check_experiment\n"
             "cfg, _ = load(['+experiment=adaptive_filter_demo'])\n"
             "check_experiment(lambda: build_components(cfg))\nprint('ok')")
-    done = subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, capture_output=True, text=True,
-                          timeout=300)
+    done = run_python(env, tmp_path, "-c", code)
     assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr

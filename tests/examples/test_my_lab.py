@@ -8,12 +8,10 @@ from __future__ import annotations
 
 import csv
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
-from installed_plugin import plugin_env
+from installed_plugin import plugin_env, run_python
 
 from cerebx.recording.reader import read_messages
 
@@ -28,13 +26,9 @@ def env(tmp_path_factory) -> dict[str, str]:
     return plugin_env(tmp_path_factory.mktemp("site"), "my_lab")
 
 
-def _run(env: dict[str, str], cwd: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, *args], env=env, cwd=cwd, capture_output=True, text=True, timeout=600)
-
-
 def test_the_pendulum_swings_through_the_rate_limiter(env, tmp_path):
     payload = "events=[{at_trial: 2, action: {kind: attach_payload, mass_kg: 0.5}}]"
-    done = _run(env, tmp_path, "-m", "cerebx", "run", "+experiment=pendulum_demo", "trials=4", payload,
+    done = run_python(env, tmp_path, "-m", "cerebx", "run", "+experiment=pendulum_demo", "trials=4", payload,
                 "hydra.run.dir=demo")
     assert done.returncode == 0, done.stderr
     summary = json.loads((tmp_path / "demo" / "summary.json").read_text())
@@ -48,25 +42,25 @@ def test_the_pendulum_swings_through_the_rate_limiter(env, tmp_path):
 
 
 def test_a_task_that_does_not_fit_is_refused_in_one_line(env, tmp_path):
-    done = _run(env, tmp_path, "-m", "cerebx", "validate", "+experiment=pendulum_demo", "task.move_s=1.2")
+    done = run_python(env, tmp_path, "-m", "cerebx", "validate", "+experiment=pendulum_demo", "task.move_s=1.2")
     assert done.returncode == 2
     assert done.stderr.strip() == "task.move_s: two movements of 1.2 s do not fit in period_s 2.0 s"
 
 
 def test_the_plant_and_the_stages_keep_their_contracts(env, tmp_path):
-    done = _run(env, tmp_path, str(EXAMPLE / "check_contracts.py"))
+    done = run_python(env, tmp_path, str(EXAMPLE / "check_contracts.py"))
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "pendulum, pd and ['hold', 'rate_limit'] keep their contracts"
 
 
 def test_the_report_draws_the_figure_from_its_study(env, tmp_path):
-    listed = _run(env, tmp_path, "-m", "cerebx", "report", "--list")
+    listed = run_python(env, tmp_path, "-m", "cerebx", "report", "--list")
     assert "my_lab_rate_limit" in listed.stdout and "studies: my_lab_rate_limits" in listed.stdout
-    done = _run(env, tmp_path, "-m", "cerebx", "report", "--profile", "quick", "--figures", "my_lab_rate_limit")
+    done = run_python(env, tmp_path, "-m", "cerebx", "report", "--profile", "quick", "--figures", "my_lab_rate_limit")
     assert done.returncode == 0, done.stdout + done.stderr
     assert (tmp_path / "reports" / "figures" / "my_lab_rate_limit.png").stat().st_size > 10_000
     assert len(list((tmp_path / "runs" / "report" / "quick" / "my_lab_rate_limits").glob("*/summary.json"))) == 4
     rows = list(csv.reader((tmp_path / "reports" / "paper_vs_cerebx.csv").open()))
     assert ["my_lab_rate_limit", "the error falls as the limit loosens", "yes", "yes"] in [r[:4] for r in rows]
-    again = _run(env, tmp_path, "-m", "cerebx", "report", "--profile", "quick", "--figures", "my_lab_rate_limit")
+    again = run_python(env, tmp_path, "-m", "cerebx", "report", "--profile", "quick", "--figures", "my_lab_rate_limit")
     assert "1 reused, 0 to run" in again.stdout  # finished runs are reused

@@ -121,7 +121,6 @@ class Recorder:
         opts = MCAPWriteOptions(compression=_COMPRESSION[compression], chunk_size=chunk_size_kb * 1024,
                                 compression_threads=0, profile="")
         self._w = foxglove.open_mcap(self.path, allow_overwrite=True, context=self._ctx, writer_options=opts)
-        self._channels: dict[str, foxglove.Channel] = {}
         self._logs: dict[str, Callable[[bytes, int], None]] = {}
         self._joint_msgs: dict[str, dict[str, Any]] = {}
         self.joint_names = tuple(joint_names)
@@ -137,7 +136,6 @@ class Recorder:
             # the SDK's own channel object under the Python wrapper: the bytes go straight to the writer (the
             # wrapper's checks of the message's type cost about a microsecond a message, four messages a step)
             log = _Both(ch, twin).log if twin is not None else ch.base.log
-            self._channels[topic] = ch
             self._logs[topic] = log
         return log
 
