@@ -7,6 +7,7 @@ or capped at 1 (saturate)."""
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 
 class DCNDecoder:
@@ -35,3 +36,43 @@ class DCNDecoder:
         """Torque (N m) from the local DCN indices that spiked in this bin (repeats count)."""
         net = np.bincount(local_idx // self.per_joint, weights=self.sign[local_idx], minlength=self.n_joints)
         return self.alpha * net[: self.n_joints]
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def chunk_torques(idx, off, lo, hi, per_joint, sign, alpha):
+    """A chunk's torques without the interpreter lock: ``idx[off[s]:off[s + 1]]`` are the global indices that
+    spiked in step s; the DCN are ``lo:hi``. Returns (torque per step and joint, DCN spikes per step), the sums
+    made in the order of the spikes, as ``np.bincount`` with weights makes them (the same doubles as
+    :meth:`DCNDecoder.torque` per step)."""
+    n, nj = off.size - 1, alpha.size
+    net = np.zeros((n, nj))
+    counts = np.zeros(n, np.int64)
+    for s in range(n):
+        for k in range(off[s], off[s + 1]):
+            i = idx[k]
+            if lo <= i < hi:
+                d = i - lo
+                net[s, d // per_joint] += sign[d]
+                counts[s] += 1
+    for s in range(n):
+        for j in range(nj):
+            net[s, j] = alpha[j] * net[s, j]
+    return net, counts
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def chunk_select(idx, off, lo, hi):
+    """The spikes of the population ``lo:hi`` in a chunk, as local indices, and where each step's part ends
+    (step s is ``local[ends[s - 1]:ends[s]]``, the first from 0)."""
+    n = off.size - 1
+    local = np.empty(off[n] - off[0], np.int32)
+    ends = np.empty(n, np.int64)
+    m = 0
+    for s in range(n):
+        for k in range(off[s], off[s + 1]):
+            i = idx[k]
+            if lo <= i < hi:
+                local[m] = i - lo
+                m += 1
+        ends[s] = m
+    return local[:m], ends

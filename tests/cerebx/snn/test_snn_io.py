@@ -13,7 +13,7 @@ from cerebx.controllers.snn.controller import SNNControllerImpl
 from cerebx.controllers.snn.schema import BoxEncoder, CFEncoder, SNNController
 from cerebx.errors import StateMismatchError
 from cerebx.schema.controller import GivenRanges
-from cerebx.snn.decoder import DCNDecoder
+from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
 from cerebx.snn.encoders import ClimbingEncoder, MossyEncoder
 from cerebx.snn.presets import network as full_network
 from cerebx.snn.topology import build_topology
@@ -71,6 +71,24 @@ def test_dcn_decoder_counts_agonist_minus_antagonist():
     idx = np.array([0, 1, 2, 49, 50, 99, 150, 151, 160])  # joint 0: 4 ag, 2 antag; joint 1: 0 ag, 3 antag
     np.testing.assert_allclose(dec.torque(idx), [0.75 * 2, -1.1 * 3])
     np.testing.assert_allclose(dec.torque(np.array([], np.int64)), [0, 0])
+
+
+def test_a_chunk_decodes_and_splits_as_each_step_alone():
+    """The compiled chunk decoder gives each step exactly what DCNDecoder.torque gives it alone, and the
+    recorded population's spikes step by step (empty steps, spikes outside the DCN, repeats)."""
+    dec = DCNDecoder((0.75, 1.1), 2, 100)
+    lo, rng = 1000, np.random.default_rng(4)
+    steps = [rng.integers(0, 1400, rng.integers(0, 60)).astype(np.int32) for _ in range(30)] + [np.zeros(0, np.int32)]
+    idx = np.concatenate(steps)
+    off = np.concatenate([[0], np.cumsum([len(s) for s in steps])]).astype(np.int64)
+    taus, counts = chunk_torques(idx, off, lo, lo + 200, dec.per_joint, dec.sign, dec.alpha)
+    local, ends = chunk_select(idx, off, 1100, 1300)
+    for k, s in enumerate(steps):
+        dcn = s[(s >= lo) & (s < lo + 200)] - lo
+        assert taus[k].tolist() == dec.torque(dcn).tolist() and counts[k] == len(dcn)
+        want = s[(s >= 1100) & (s < 1300)] - 1100
+        assert local[(ends[k - 1] if k else 0):ends[k]].tolist() == want.tolist()
+    assert ends[-1] == len(local)
 
 
 class _Task:

@@ -26,9 +26,11 @@ from __future__ import annotations
 import copy
 import hashlib
 import json
+import queue
+import threading
 import time
+import weakref
 from collections import deque
-from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -40,7 +42,7 @@ from cerebx.controllers.ranges import mf_ranges
 from cerebx.controllers.snn.schema import SNNController
 from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
-from cerebx.snn.decoder import DCNDecoder
+from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
 from cerebx.snn.network import Network
 from cerebx.snn.weight_stats import weight_stats
 
@@ -51,6 +53,37 @@ STATE_VERSION = 1
 def encoder_ranges(cfg: SNNController, n_joints: int, task: Any = None) -> tuple[np.ndarray, np.ndarray]:
     """(lo, hi) of shape (n_joints, 4) for the MF signals q_d, q, qd_d, qd."""
     return mf_ranges(cfg.mf.ranges, n_joints, task)
+
+
+class NetworkThread:
+    """The long-lived thread that simulates the network's chunks, one at a time, in the order given. The chunks
+    and their results pass through C queues: a thread started per chunk cost the loop ~1 ms each (``start``
+    waits until the new thread holds the interpreter lock), and an executor's futures run interpreted
+    locking code on both threads per chunk. The thread ends when its owner is garbage-collected."""
+
+    def __init__(self) -> None:
+        self._jobs: queue.SimpleQueue = queue.SimpleQueue()
+        self._done: queue.SimpleQueue = queue.SimpleQueue()
+        threading.Thread(target=_serve, args=(self._jobs, self._done), name="cerebx-snn", daemon=True).start()
+        weakref.finalize(self, self._jobs.put, None)
+
+    def submit(self, job: Any) -> None:
+        self._jobs.put(job)
+
+    def result(self) -> Any:
+        """The result of the oldest chunk not yet collected (waits for it); raises what the chunk raised."""
+        ok, value = self._done.get()
+        if not ok:
+            raise value
+        return value
+
+
+def _serve(jobs: queue.SimpleQueue, done: queue.SimpleQueue) -> None:
+    while (job := jobs.get()) is not None:
+        try:
+            done.put((True, job()))
+        except BaseException as exc:  # handed to the loop's thread, raised by result()
+            done.put((False, exc))
 
 
 class SNNControllerImpl(Controller):
@@ -69,8 +102,8 @@ class SNNControllerImpl(Controller):
         slack = self.k_in + (self.k_delay if self.hold else 0)
         self.chunk = max(1, slack // 2)
         self.pipeline = cfg.pipeline and slack >= 2
-        self._worker: Future | None = None  # the chunk in flight
-        self._pool: ThreadPoolExecutor | None = None
+        self._in_flight = False  # a chunk is being simulated
+        self._thread: NetworkThread | None = None
         self.net = Network(self.net_cfg, parallel=cfg.parallel and not self.pipeline)
         self.net.learn = cfg.plasticity
         io = self.net_cfg.io
@@ -93,6 +126,7 @@ class SNNControllerImpl(Controller):
         self._rng_seed = ctx.rng("controller.snn.cf")
         self.cf = registry.encoders.build(cfg.cf, nj, n_cf // nj, cfg.error.kpos, cfg.error.kvel, self._rng_seed)
         self.decoder = DCNDecoder(cfg.decoder.alpha_Nm_per_spike, nj, n_dcn // nj)
+        self._alpha = np.ascontiguousarray(np.broadcast_to(self.decoder.alpha, (nj,)), dtype=np.float64)
         self.muscles = cfg.output == "agonist_antagonist"
         self.width = 2 * nj if self.muscles else nj  # values per step in the output FIFO ([ag, at] or tau)
         self.full_scale = np.asarray(cfg.decoder.full_scale(nj), float)  # M = 1 (agonist_antagonist output)
@@ -130,31 +164,33 @@ class SNNControllerImpl(Controller):
         """Run the network over ``inputs`` (one GIL-free call); per step: (time, output, DCN spike
         count, recorded spikes), the output a torque or [M_ag, M_at]. Decoding is done for the whole
         chunk at once. With spike propagation shed the network is not run and the DCN stay silent."""
-        n, nj = len(inputs), self.n_ctrl
+        n = len(inputs)
         if self._shed >= 2:
             self.net.t_sub += self.net.n_sub * n
             return [((first_step + i) * STEP_S, np.zeros(self.width), 0, None) for i in range(n)]
         idx, off = self.net.step_many(inputs)
-        step_of = np.repeat(np.arange(n), np.diff(off))
-        lo, hi = self.sl_dcn.start, self.sl_dcn.stop
-        sel = (idx >= lo) & (idx < hi)
-        dcn, st = idx[sel] - lo, step_of[sel]
-        dec = self.decoder
+        # decoding and the split of recorded spikes run in compiled code without the interpreter lock: on the
+        # network thread, interpreted work holds up the loop's thread whenever it needs the lock back
         if self.muscles:
-            taus = dec.sides(dcn, st, n, self.full_scale, self.cfg.decoder.saturate)
+            step_of = np.repeat(np.arange(n), np.diff(off))
+            lo, hi = self.sl_dcn.start, self.sl_dcn.stop
+            sel = (idx >= lo) & (idx < hi)
+            taus = self.decoder.sides(idx[sel] - lo, step_of[sel], n, self.full_scale, self.cfg.decoder.saturate)
+            counts = np.bincount(step_of[sel], minlength=n)
         else:
-            net = np.bincount(st * nj + dcn // dec.per_joint, weights=dec.sign[dcn], minlength=n * nj)
-            taus = dec.alpha * net.reshape(n, nj)
-        counts = np.bincount(st, minlength=n)
-        out = []
-        for i in range(n):
-            rec = None
-            if self.recorder is not None and self._shed < 3:
-                step_idx = idx[off[i]:off[i + 1]]
-                rec = {name: step_idx[(step_idx >= sl.start) & (step_idx < sl.stop)] - sl.start
-                       for name, sl in self.record.items()}
-            out.append(((first_step + i) * STEP_S, taus[i], int(counts[i]), rec))
-        return out
+            taus, counts = chunk_torques(idx, off, self.sl_dcn.start, self.sl_dcn.stop, self.decoder.per_joint,
+                                         self.decoder.sign, self._alpha)
+        per_step: list[dict[str, np.ndarray] | None] = [None] * n
+        if self.recorder is not None and self._shed < 3 and self.record:
+            per_step = [{} for _ in range(n)]
+            for name, sl in self.record.items():
+                local, ends = chunk_select(idx, off, sl.start, sl.stop)
+                start = 0
+                for i, end in enumerate(ends.tolist()):
+                    per_step[i][name] = local[start:end]
+                    start = end
+        counts = counts.tolist()
+        return [((first_step + i) * STEP_S, taus[i], counts[i], per_step[i]) for i in range(n)]
 
     def _absorb(self, results: list[tuple]) -> None:
         for t, tau, n_dcn, rec in results:
@@ -179,19 +215,17 @@ class SNNControllerImpl(Controller):
                 if clock is not None:
                     clock.add_background("network", time.perf_counter() - t0, time.thread_time() - c0)
 
-        if self._pool is None:
-            # one long-lived thread: starting a thread per chunk cost the loop ~1 ms each time (Thread.start
-            # waits until the new thread has the GIL), a third of a learning run's controller time
-            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="cerebx-snn")
-        self._worker = self._pool.submit(work)
+        if self._thread is None:
+            self._thread = NetworkThread()
+        self._thread.submit(work)
+        self._in_flight = True
 
     def _join(self) -> None:
-        worker = self._worker
-        if worker is None:
+        if not self._in_flight:
             return
-        self._worker = None
+        self._in_flight = False
         with phase_clock.charge("wait"):
-            results = worker.result()  # an exception of the network thread is raised here
+            results = self._thread.result()  # an exception of the network thread is raised here
         self._absorb(results)
 
     def __getstate__(self) -> dict:
@@ -199,7 +233,7 @@ class SNNControllerImpl(Controller):
         part of the state; a restored controller starts its own when it first needs one."""
         self._join()
         state = self.__dict__.copy()
-        state["_pool"] = None
+        state["_thread"] = None
         return state
 
     def _advance(self) -> None:
@@ -208,11 +242,11 @@ class SNNControllerImpl(Controller):
             self._absorb(self._simulate([self._pending.popleft()], self._net_step))
             return
         while not self._ready:
-            if self._worker is not None:
+            if self._in_flight:
                 self._join()
             else:
                 self._absorb(self._simulate([self._pending.popleft()], self._net_step))
-        if self._worker is None and len(self._pending) >= self.chunk:
+        if not self._in_flight and len(self._pending) >= self.chunk:
             self._launch()
 
     def prepare_real_time(self) -> None:
