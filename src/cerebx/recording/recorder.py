@@ -78,6 +78,9 @@ SCHEMAS: dict[str, dict] = {
 }
 
 _COMPRESSION = {"zstd": MCAPCompression.Zstd, "lz4": MCAPCompression.Lz4, "none": None}
+ZSTD_LEVEL = 1
+"""zstd's fastest level: a logged message (~0.8 kB of JSON) costs the loop's thread ~2.2 us instead of ~3.4 us at
+the default level 3, and the files are no larger (joint states and control compress to ~30 % either way)."""
 
 
 _NUMPY = orjson.OPT_SERIALIZE_NUMPY
@@ -119,7 +122,8 @@ class Recorder:
         self.path = Path(path)
         self._ctx = foxglove.Context()  # one context per recording: nothing leaks between runs
         opts = MCAPWriteOptions(compression=_COMPRESSION[compression], chunk_size=chunk_size_kb * 1024,
-                                compression_threads=0, profile="")
+                                compression_threads=0, profile="",
+                                compression_level=ZSTD_LEVEL if compression == "zstd" else 0)
         self._w = foxglove.open_mcap(self.path, allow_overwrite=True, context=self._ctx, writer_options=opts)
         self._logs: dict[str, Callable[[bytes, int], None]] = {}
         self._joint_msgs: dict[str, dict[str, Any]] = {}
