@@ -16,6 +16,7 @@ import pytest
 
 from cerebx.cli import main
 from cerebx.controllers.pd import PD
+from cerebx.loop import runner
 from cerebx.loop.runner import run_experiment
 from cerebx.recording.reader import channel_counts, read_messages, read_summary
 
@@ -128,7 +129,10 @@ def test_a_running_summary_whose_process_is_gone_reads_as_killed(load, tmp_path)
     assert read_summary(tmp_path)["status"] == "running"
 
 
-def test_summary_says_running_while_the_run_goes(load, tmp_path, monkeypatch):
+@pytest.mark.parametrize("every_s, progress", [(0.0, [0, 1, 2]), (3600.0, [0, 1, 1])])
+def test_summary_says_running_while_the_run_goes(load, tmp_path, monkeypatch, every_s, progress):
+    """summary.json says running, with the trials done so far, at most every SUMMARY_EVERY_S (the first trial
+    is always there); the last summary has them all."""
     seen = []
     original = PD.end_trial
 
@@ -137,10 +141,12 @@ def test_summary_says_running_while_the_run_goes(load, tmp_path, monkeypatch):
         return original(self, trial)
 
     monkeypatch.setattr(PD, "end_trial", peek)
+    monkeypatch.setattr(runner, "SUMMARY_EVERY_S", every_s)
     run_experiment(load([*DEMO, "trials=3"]), tmp_path)
     assert [x["status"] for x in seen] == ["running"] * 3
-    assert [x["trials_completed"] for x in seen] == [0, 1, 2]
-    assert read_summary(tmp_path)["status"] == "completed"
+    assert [x["trials_completed"] for x in seen] == progress
+    final = read_summary(tmp_path)
+    assert final["status"] == "completed" and final["trials_completed"] == 3 and len(final["mae_per_trial"]) == 3
 
 
 def test_an_unsealed_log_is_read_by_scanning_everywhere(load, tmp_path, capsys):
