@@ -1,17 +1,17 @@
 """Disk and time a run will take, printed before it starts, and the limit that refuses absurd sizes.
 
-The rates are measured, not derived (``cerebx run`` of 2-4 trials on the 2-core development machine,
-zstd chunks of 256 kB, every step recorded):
+The rates are measured, not derived (``cerebx run`` of 4 trials on the 2-core development machine, zstd
+level 1 chunks of 256 kB, joint states in CDR, every step recorded; 2026-11-24):
 
 ===========================================  ======================  ==========================
 run                                          run.mcap per sim. s     wall
 ===========================================  ======================  ==========================
-planar2 + PD (``+experiment=demo``)          113 kB                  docs/guide/speed.md
-Baxter + PD                                  288 kB                  docs/guide/speed.md
-Baxter + SNN ``small`` / ``full``      285 kB / 320 kB         docs/guide/speed.md
+planar2 + PD (``+experiment=demo``)          109 kB                  docs/guide/speed.md
+Baxter + PD                                  258 kB                  docs/guide/speed.md
+Baxter + SNN ``full``                        294 kB                  docs/guide/speed.md
 ===========================================  ======================  ==========================
 
-hence about 25 kB/s plus 44 kB/s per joint for the joint and control channels, and 32 kB/s for the
+hence about 25 kB/s plus 39 kB/s per joint for the joint and control channels, and 32 kB/s for the
 default spike channels of an SNN; without joint states (``recording.joint_states=false``) a third of the
 per-joint rate is kept for ``/control`` (*constructed*: one of three per-step channels). The learned SNN
 state holds 4 bytes per plastic synapse and ~44 bytes per neuron before compression (``full``:
@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 BYTES_PER_S_BASE = 25e3
-BYTES_PER_S_PER_JOINT = 44e3
+BYTES_PER_S_PER_JOINT = 39e3
 BYTES_PER_S_SPIKES = 32e3
 STATE_BYTES_PER_PLASTIC = 4.0
 STATE_BYTES_PER_NEURON = 44.0

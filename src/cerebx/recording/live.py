@@ -23,7 +23,7 @@ import foxglove
 import orjson
 from foxglove.websocket import Capability
 
-from cerebx.recording.recorder import channel_schema
+from cerebx.recording.recorder import channel_schema, message_encoding
 from cerebx.recording.scene import PREFIX
 
 log = logging.getLogger("cerebx")
@@ -66,7 +66,8 @@ class LiveView:
     def channel(self, topic: str, schema: str) -> foxglove.Channel:
         ch = self._channels.get(topic)
         if ch is None:
-            ch = foxglove.Channel(topic, message_encoding="json", context=self.ctx, schema=channel_schema(schema))
+            ch = foxglove.Channel(topic, message_encoding=message_encoding(schema), context=self.ctx,
+                                  schema=channel_schema(schema))
             self._channels[topic] = ch
         return ch
 

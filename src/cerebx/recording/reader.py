@@ -3,17 +3,19 @@
 from __future__ import annotations
 
 import json
+import struct
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 from mcap.decoder import DecoderFactory
 from mcap.reader import make_reader
-from mcap.records import Channel, Message, Metadata
+from mcap.records import Channel, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 
 from cerebx import runfiles
 from cerebx.errors import CerebxError
+from cerebx.recording.cdr import JOINT_STATE, decode_joint_state
 from cerebx.recording.pair import merge, robot_log
 from cerebx.recording.segments import segments
 from cerebx.recording.summary import read_summary
@@ -26,11 +28,20 @@ def _short(err: Exception) -> str:
     return f"{type(err).__name__}: {text[:100]}" + ("…" if len(text) > 100 else "")
 
 
-class JsonDecoderFactory(DecoderFactory):
-    """mcap ships no JSON decoder: JSON channels decode with json.loads."""
+class Decoders(DecoderFactory):
+    """JSON channels decode with json.loads (mcap ships no JSON decoder), the joint states' CDR with
+    ``recording/cdr.py`` into the shape their JSON messages had."""
 
     def decoder_for(self, message_encoding: str, schema: Any):
-        return json.loads if message_encoding == "json" else None
+        return _decoder(message_encoding, schema.name if schema is not None else None)
+
+
+def _decoder(message_encoding: str, schema_name: str | None) -> Any:
+    if message_encoding == "json":
+        return json.loads
+    if message_encoding == "cdr" and schema_name == JOINT_STATE:
+        return decode_joint_state()
+    return None
 
 
 def mcap_path(path: Path | str) -> Path:
@@ -40,7 +51,7 @@ def mcap_path(path: Path | str) -> Path:
 
 def _reader(fh):
     try:
-        return make_reader(fh, decoder_factories=[JsonDecoderFactory()])
+        return make_reader(fh, decoder_factories=[Decoders()])
     except Exception as err:  # mcap raises several types for bad files
         raise CerebxError(f"{fh.name}: not a readable MCAP file ({_short(err)})") from None
 
@@ -75,16 +86,21 @@ def _scan(fh) -> Iterator[Any]:
 
 
 def _stream_messages(fh, topics: list[str] | None) -> Iterator[tuple[str, int, Any]]:
-    channels: dict[int, Channel] = {}
+    schemas: dict[int, str] = {}
+    channels: dict[int, tuple[str, Any]] = {}  # id -> topic, decoder
     for rec in _scan(fh):
-        if isinstance(rec, Channel):
-            channels[rec.id] = rec
+        if isinstance(rec, Schema):
+            schemas[rec.id] = rec.name
+        elif isinstance(rec, Channel):
+            decode = _decoder(rec.message_encoding, schemas.get(rec.schema_id))
+            if decode is not None and (topics is None or rec.topic in topics):
+                channels[rec.id] = (rec.topic, decode)
         elif isinstance(rec, Message):
             ch = channels.get(rec.channel_id)
-            if ch is not None and (topics is None or ch.topic in topics) and ch.message_encoding == "json":
+            if ch is not None:
                 try:
-                    yield ch.topic, rec.log_time, json.loads(rec.data)
-                except ValueError:  # a message that is not JSON: skipped like the incomplete tail
+                    yield ch[0], rec.log_time, ch[1](rec.data)
+                except (ValueError, struct.error):  # a damaged message: skipped like the incomplete tail
                     continue
 
 

@@ -1,14 +1,15 @@
 """Writes a run's MCAP file through foxglove-sdk (a Rust MCAP writer, fast enough for every 2 ms
-step). Every channel is JSON (encoded with orjson) with a JSON Schema; the joint channels use the
-well-known ``foxglove.JointStates`` schema so Foxglove shows them natively.
+step). The joint channels are ROS 2 ``sensor_msgs/msg/JointState`` messages in CDR (``recording/cdr.py``),
+which Foxglove reads natively; every other channel is JSON (encoded with orjson) with a JSON Schema. Older
+runs have JSON joint states (a ``foxglove.JointStates``-shaped schema); the readers give both the same shape.
 
 Channels (units SI; time stamps are simulated time):
 
 =========================  =====================  ===============================================
 topic                      schema                 content
 =========================  =====================  ===============================================
-/joint_states/desired      foxglove.JointStates   desired position (rad) and velocity (rad/s)
-/joint_states/actual       foxglove.JointStates   actual position, velocity, applied torque (N·m)
+/joint_states/desired      sensor_msgs/JointState desired position (rad) and velocity (rad/s)
+/joint_states/actual       sensor_msgs/JointState actual position, velocity, applied torque (N·m)
 /control                   cerebx.Control         what the brain side sent (joint.torque as
                                                   tau_controller, other signals by name), what robot
                                                   stages report (tau_supervisor), error, end-effector
@@ -42,21 +43,11 @@ import numpy as np
 import orjson
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
-_TIME = {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}}
+from cerebx.recording.cdr import JOINT_STATE, JOINT_STATE_DEFINITION, JointStateEncoder
+
 _NUMS = {"type": "array", "items": {"type": "number"}}
 
 SCHEMAS: dict[str, dict] = {
-    "foxglove.JointStates": {
-        "title": "foxglove.JointStates",
-        "description": "Joint positions (rad), velocities (rad/s) and efforts (N·m)",
-        "type": "object",
-        "properties": {
-            "timestamp": _TIME,
-            "joints": {"type": "array", "items": {"type": "object", "properties": {
-                "name": {"type": "string"}, "position": {"type": "number"},
-                "velocity": {"type": "number"}, "effort": {"type": "number"}}}},
-        },
-    },
     "cerebx.Control": {
         "type": "object",
         "properties": {"t": {"type": "number"}, "trial": {"type": "integer"}, "tau_controller": _NUMS,
@@ -97,8 +88,19 @@ def register_schema(name: str, schema: dict) -> None:
         raise ValueError(f"schema {name!r} is already registered with another definition")
 
 
+CDR_SCHEMAS: dict[str, str] = {JOINT_STATE: JOINT_STATE_DEFINITION}
+"""Schemas of the channels written in CDR (ROS 2 message definitions)."""
+
+
 def channel_schema(name: str) -> foxglove.Schema:
+    if name in CDR_SCHEMAS:
+        return foxglove.Schema(name=name, encoding="ros2msg", data=CDR_SCHEMAS[name].encode())
     return foxglove.Schema(name=name, encoding="jsonschema", data=json.dumps(SCHEMAS[name]).encode())
+
+
+def message_encoding(schema: str) -> str:
+    """How the messages of a channel with ``schema`` are encoded: ``cdr`` or ``json``."""
+    return "cdr" if schema in CDR_SCHEMAS else "json"
 
 
 class _Both:
@@ -126,7 +128,7 @@ class Recorder:
                                 compression_level=ZSTD_LEVEL if compression == "zstd" else 0)
         self._w = foxglove.open_mcap(self.path, allow_overwrite=True, context=self._ctx, writer_options=opts)
         self._logs: dict[str, Callable[[bytes, int], None]] = {}
-        self._joint_msgs: dict[str, dict[str, Any]] = {}
+        self._joint_encoders: dict[str, JointStateEncoder] = {}
         self.joint_names = tuple(joint_names)
         self.live = live  # a LiveView (recording/live.py) whose server also gets every channel, or None
         self.closed = False
@@ -135,7 +137,8 @@ class Recorder:
         """The function that logs ``(data, log_time_ns)`` on ``topic``, creating the channel on first use."""
         log = self._logs.get(topic)
         if log is None:
-            ch = foxglove.Channel(topic, message_encoding="json", context=self._ctx, schema=channel_schema(schema))
+            ch = foxglove.Channel(topic, message_encoding=message_encoding(schema), context=self._ctx,
+                                  schema=channel_schema(schema))
             twin = self.live.twin(topic, schema) if self.live is not None else None
             # the SDK's own channel object under the Python wrapper: the bytes go straight to the writer (the
             # wrapper's checks of the message's type cost about a microsecond a message, four messages a step)
@@ -149,23 +152,14 @@ class Recorder:
 
     def joint_states(self, topic: str, t_s: float, q: np.ndarray, qd: np.ndarray,
                      effort: np.ndarray | None = None) -> None:
+        """A ``sensor_msgs/msg/JointState`` message: the joints named, or the first n of them when fewer
+        values are given (as zip would pair them); effort 0 when none is given."""
+        n = min(len(self.joint_names), len(q), len(qd), len(q) if effort is None else len(effort))
+        enc = self._joint_encoders.get(topic)
+        if enc is None or enc.n != n:
+            enc = self._joint_encoders[topic] = JointStateEncoder(self.joint_names[:n])
         ns = _ns(t_s)
-        msg = self._joint_msgs.get(topic)
-        if msg is None:  # one message per topic, its values replaced each step (cheaper than building it)
-            msg = {"timestamp": {"sec": 0, "nsec": 0},
-                   "joints": [{"name": n, "position": 0.0, "velocity": 0.0, "effort": 0.0} for n in self.joint_names]}
-            self._joint_msgs[topic] = msg
-        msg["timestamp"]["sec"], msg["timestamp"]["nsec"] = divmod(ns, 1_000_000_000)
-        qs, qds = q.tolist(), qd.tolist()
-        es = effort.tolist() if effort is not None else [0.0] * len(qs)
-        joints = msg["joints"]
-        n = min(len(joints), len(qs), len(qds), len(es))
-        if n < len(joints):  # fewer values than names: the first n joints, as zip gives them
-            joints = joints[:n]
-            msg = {"timestamp": msg["timestamp"], "joints": joints}
-        for j, a, b, c in zip(joints, qs, qds, es):
-            j["position"], j["velocity"], j["effort"] = a, b, c
-        self._channel(topic, "foxglove.JointStates")(orjson.dumps(msg), ns)
+        self._channel(topic, JOINT_STATE)(enc.encode(ns, q, qd, effort), ns)
 
     def spikes(self, topic: str, t_s: float, indices: np.ndarray) -> None:
         self.write(topic, "cerebx.Spikes", t_s, {"t": t_s, "indices": np.asarray(indices)})
