@@ -6,6 +6,20 @@ double in one pass without a temporary: numpy sums that contiguous float64 array
 partial sums up to 128 values, halves split at multiples of 8 above), and the pass below performs the
 same additions in the same order on ``(float64(w[i]) - mean)**2`` computed on the fly
 (``tests/cerebx/snn/test_weight_stats.py`` checks the equality over sizes around every branch).
+
+:func:`weight_stats` reads the weights twice where numpy's mean, std, min and max read them four times:
+:func:`_sum_min_max` gives the mean's sum, the min and the max in one pass, :func:`std_f64` the rest.
+``w.mean(dtype=float64)`` of float32 data is a buffered cast reduction: numpy casts ``np.getbufsize()``
+(8192) elements at a time into a float64 buffer, sums each buffer pairwise as above and adds the buffer
+sums in order to a result that starts at the identity 0.0 (not at the first element). A C-contiguous
+array, 2-D included, is iterated as one flat run, so the buffers are consecutive runs of the flat array,
+and :func:`_sum_min_max` sums the same runs the same way. Checked against numpy 2.4: runs of another
+length, or shifted by one element, change the last bits, so the tests use data whose sums round. Other
+layouts and dtypes keep numpy's reductions.
+
+The kernels index 0-based slices (``c = w[lo:hi]``, ``c[i]``): with an index numba cannot prove
+non-negative, every access carries the negative-index wraparound, which costs the pairwise sums 7-17 % and
+turns the vector loads of the min/max scan into gathers.
 """
 
 from __future__ import annotations
@@ -16,71 +30,153 @@ from numba import njit
 _BLOCK = 128  # numpy's PW_BLOCKSIZE
 
 
-@njit(cache=True, boundscheck=False)
-def _sq_dev_sum(w, lo, n, mean):
-    """numpy's pairwise sum of ``(float64(w[i]) - mean)**2`` over ``w[lo:lo + n]``."""
+@njit(cache=True, nogil=True, boundscheck=False)
+def _sum(c):
+    """numpy's pairwise sum of ``float64(c[i])`` (the additions of :func:`_sq_dev_sum`)."""
+    n = c.size
     if n < 8:
         res = -0.0
-        for i in range(lo, lo + n):
-            d = np.float64(w[i]) - mean
-            res += d * d
+        for i in range(n):
+            res += np.float64(c[i])
         return res
     if n <= _BLOCK:
-        d = np.float64(w[lo]) - mean
-        r0 = d * d
-        d = np.float64(w[lo + 1]) - mean
-        r1 = d * d
-        d = np.float64(w[lo + 2]) - mean
-        r2 = d * d
-        d = np.float64(w[lo + 3]) - mean
-        r3 = d * d
-        d = np.float64(w[lo + 4]) - mean
-        r4 = d * d
-        d = np.float64(w[lo + 5]) - mean
-        r5 = d * d
-        d = np.float64(w[lo + 6]) - mean
-        r6 = d * d
-        d = np.float64(w[lo + 7]) - mean
-        r7 = d * d
-        end = lo + n - n % 8
-        i = lo + 8
-        while i < end:
-            d = np.float64(w[i]) - mean
-            r0 += d * d
-            d = np.float64(w[i + 1]) - mean
-            r1 += d * d
-            d = np.float64(w[i + 2]) - mean
-            r2 += d * d
-            d = np.float64(w[i + 3]) - mean
-            r3 += d * d
-            d = np.float64(w[i + 4]) - mean
-            r4 += d * d
-            d = np.float64(w[i + 5]) - mean
-            r5 += d * d
-            d = np.float64(w[i + 6]) - mean
-            r6 += d * d
-            d = np.float64(w[i + 7]) - mean
-            r7 += d * d
-            i += 8
+        r0 = np.float64(c[0])
+        r1 = np.float64(c[1])
+        r2 = np.float64(c[2])
+        r3 = np.float64(c[3])
+        r4 = np.float64(c[4])
+        r5 = np.float64(c[5])
+        r6 = np.float64(c[6])
+        r7 = np.float64(c[7])
+        m = n - n % 8
+        for i in range(8, m, 8):
+            r0 += np.float64(c[i])
+            r1 += np.float64(c[i + 1])
+            r2 += np.float64(c[i + 2])
+            r3 += np.float64(c[i + 3])
+            r4 += np.float64(c[i + 4])
+            r5 += np.float64(c[i + 5])
+            r6 += np.float64(c[i + 6])
+            r7 += np.float64(c[i + 7])
         res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-        while i < lo + n:
-            d = np.float64(w[i]) - mean
-            res += d * d
-            i += 1
+        for i in range(m, n):
+            res += np.float64(c[i])
         return res
     n2 = n // 2
     n2 -= n2 % 8
-    return _sq_dev_sum(w, lo, n2, mean) + _sq_dev_sum(w, lo + n2, n - n2, mean)
+    return _sum(c[:n2]) + _sum(c[n2:])
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _sq_dev_sum(c, mean):
+    """numpy's pairwise sum of ``(float64(c[i]) - mean)**2``."""
+    n = c.size
+    if n < 8:
+        res = -0.0
+        for i in range(n):
+            d = np.float64(c[i]) - mean
+            res += d * d
+        return res
+    if n <= _BLOCK:
+        d = np.float64(c[0]) - mean
+        r0 = d * d
+        d = np.float64(c[1]) - mean
+        r1 = d * d
+        d = np.float64(c[2]) - mean
+        r2 = d * d
+        d = np.float64(c[3]) - mean
+        r3 = d * d
+        d = np.float64(c[4]) - mean
+        r4 = d * d
+        d = np.float64(c[5]) - mean
+        r5 = d * d
+        d = np.float64(c[6]) - mean
+        r6 = d * d
+        d = np.float64(c[7]) - mean
+        r7 = d * d
+        m = n - n % 8
+        for i in range(8, m, 8):
+            d = np.float64(c[i]) - mean
+            r0 += d * d
+            d = np.float64(c[i + 1]) - mean
+            r1 += d * d
+            d = np.float64(c[i + 2]) - mean
+            r2 += d * d
+            d = np.float64(c[i + 3]) - mean
+            r3 += d * d
+            d = np.float64(c[i + 4]) - mean
+            r4 += d * d
+            d = np.float64(c[i + 5]) - mean
+            r5 += d * d
+            d = np.float64(c[i + 6]) - mean
+            r6 += d * d
+            d = np.float64(c[i + 7]) - mean
+            r7 += d * d
+        res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+        for i in range(m, n):
+            d = np.float64(c[i]) - mean
+            res += d * d
+        return res
+    n2 = n // 2
+    n2 -= n2 % 8
+    return _sq_dev_sum(c[:n2], mean) + _sq_dev_sum(c[n2:], mean)
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _key(x):
+    """The bits ``x`` of a float32 as an integer that orders as the float does (NaN aside); its own inverse."""
+    return x ^ ((x >> 31) & 0x7FFFFFFF)
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _sum_min_max(w, bufsize):
+    """(sum as ``w.mean(dtype=float64)`` adds it, min, max) of the flat float32 ``w`` (size >= 1), one pass.
+
+    Each run of ``bufsize`` values is summed, then scanned for min and max while it is still in the cache.
+    The scan compares integer keys of the bits (:func:`_key`): a float min that must mind NaN stays scalar,
+    an integer one is vectorised, three to four times faster. A NaN in ``w`` makes the sum NaN, and only
+    then is ``w`` searched for one, which is then the min and the max, as numpy's min and max propagate it.
+    """
+    bits = w.view(np.int32)
+    total = 0.0
+    lo_k = hi_k = _key(bits[0])
+    for lo in range(0, w.size, bufsize):
+        total += _sum(w[lo : lo + bufsize])
+        b = bits[lo : lo + bufsize]
+        for i in range(b.size):
+            k = _key(b[i])
+            lo_k = min(lo_k, k)
+            hi_k = max(hi_k, k)
+    if np.isnan(total):
+        for i in range(w.size):
+            if np.isnan(w[i]):
+                return total, w[i], w[i]
+    out = np.empty(2, np.int32)
+    out[0] = _key(lo_k)
+    out[1] = _key(hi_k)
+    mm = out.view(np.float32)
+    return total, mm[0], mm[1]
 
 
 def std_f64(w: np.ndarray, mean: float) -> float:
     """``np.std(w, dtype=np.float64)`` (``mean``: ``w.mean(dtype=np.float64)``), without the temporary."""
     flat = np.ascontiguousarray(w).reshape(-1)
-    return float(np.sqrt(_sq_dev_sum(flat, 0, flat.size, np.float64(mean)) / flat.size))
+    return float(np.sqrt(_sq_dev_sum(flat, np.float64(mean)) / flat.size))
 
 
 def weight_stats(w: np.ndarray) -> tuple[float, float, float, float]:
     """(mean, std, min, max) of ``w`` as ``w.mean(dtype=float64)``, ``w.std(dtype=float64)``, ``w.min()``,
-    ``w.max()`` give them."""
-    mean = w.mean(dtype=np.float64)
-    return float(mean), std_f64(w, mean), float(w.min()), float(w.max())
+    ``w.max()`` give them.
+
+    A C-contiguous float32 ``w`` is read twice (:func:`_sum_min_max`, :func:`std_f64`). One difference
+    ``==`` does not see: where 0.0 and -0.0 both hold the min (or max), numpy reports either, by its
+    vector lane order, this -0.0 for the min and 0.0 for the max. The weights hold no -0.0: the plasticity
+    kernels clip at the lower bound by writing the bound.
+    """
+    if w.dtype != np.float32 or not w.flags.c_contiguous or w.size == 0:
+        mean = w.mean(dtype=np.float64)
+        return float(mean), std_f64(w, mean), float(w.min()), float(w.max())
+    flat = w.reshape(-1)
+    total, mn, mx = _sum_min_max(flat, np.getbufsize())
+    mean = total / flat.size
+    return float(mean), std_f64(flat, mean), float(mn), float(mx)

@@ -1,15 +1,34 @@
-"""Weight statistics for /weights: the one-pass standard deviation equals numpy's bit for bit."""
+"""Weight statistics for /weights: the one-pass standard deviation and the fused mean, min and max equal
+numpy's bit for bit."""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 import pytest
 
 from cerebx.snn.weight_stats import std_f64, weight_stats
 
-# around every branch of numpy's pairwise sum: < 8, the 8-way blocks up to 128, odd splits above
-SIZES = [1, 2, 7, 8, 9, 15, 16, 17, 127, 128, 129, 130, 255, 256, 257, 1000, 8191, 8192, 8193, 65_537,
-         1_000_003]
+# around every branch of numpy's pairwise sum: < 8, the 8-way blocks up to 128, odd splits above, and
+# around the 8192-value buffers of the mean's cast (one, two, three buffers and a bit)
+SIZES = [1, 2, 7, 8, 9, 15, 16, 17, 127, 128, 129, 130, 255, 256, 257, 1000, 8191, 8192, 8193, 16383,
+         16384, 16385, 8191 * 3, 65_537, 1_000_003, 2_000_001]
+SHAPES = [(10_000, 600), (37, 8193), (8193, 37)]
+
+
+def numpy_stats(w):
+    return tuple(float(x) for x in (w.mean(dtype=np.float64), w.std(dtype=np.float64), w.min(), w.max()))
+
+
+def patterns(n, seed):
+    """Random weights, mostly one value (as after learning), and signed values over many magnitudes. Drawn
+    in float64 and rounded to float32, so small values carry low bits and the float64 sums round: a sum
+    in another order differs in the last bits (with ``random(dtype=float32)`` they are exact)."""
+    rng = np.random.default_rng(seed)
+    yield (rng.random(n) * 5).astype(np.float32)
+    yield np.where(rng.random(n) < 0.9, 2.0, rng.random(n) * 5).astype(np.float32)
+    yield (rng.standard_normal(n) * np.exp(rng.normal(0.0, 4.0, n))).astype(np.float32)
 
 
 @pytest.mark.parametrize("n", SIZES)
@@ -20,9 +39,60 @@ def test_std_equals_numpy_bit_for_bit(n):
         assert std_f64(w, w.mean(dtype=np.float64)) == w.std(dtype=np.float64)
 
 
+@pytest.mark.parametrize("shape", SIZES + SHAPES)
+def test_weight_stats_equal_numpy_bit_for_bit(shape):
+    for w in patterns(int(np.prod(shape)), seed=int(np.prod(shape))):
+        w = w.reshape(shape)
+        assert weight_stats(w) == numpy_stats(w)
+
+
+def run_sums(w, run, start=0.0):
+    """``start`` plus numpy's pairwise float64 sums of consecutive runs of ``w``, added in order."""
+    for i in range(0, w.size, run):
+        start += np.add.reduce(w[i : i + run].astype(np.float64))
+    return start
+
+
+def test_the_mean_is_numpy_s_run_sums_and_the_data_shows_any_other_grouping():
+    w = list(patterns(2_000_001, seed=0))[2]
+    want = w.mean(dtype=np.float64)
+    assert weight_stats(w)[0] == run_sums(w, 8192) / w.size == want
+    # one sum over all, other run lengths, and runs after a first element taken as the start
+    for other in (run_sums(w, w.size), run_sums(w, 4096), run_sums(w, 8200), run_sums(w[1:], 8192, float(w[0]))):
+        assert other / w.size != want
+
+
+def test_another_buffer_size_is_followed():
+    w = next(patterns(100_003, seed=1))
+    old = np.setbufsize(4096)
+    try:
+        assert weight_stats(w) == numpy_stats(w)
+    finally:
+        np.setbufsize(old)
+
+
+def test_other_layouts_and_dtypes_are_numpy_s():
+    w = next(patterns(600 * 1000, seed=2)).reshape(1000, 600)
+    for v in (w[:, :300], w[::2], w.T, w.reshape(-1)[1::3], w.astype(np.float64)):
+        assert weight_stats(v) == numpy_stats(v)
+
+
+def test_nan_is_the_min_and_max_as_in_numpy_and_inf_is_kept():
+    for n, at in ((1, 0), (9, 8), (8193, 0), (8193, 4000), (100_000, 99_999)):
+        w = np.full(n, 2.0, np.float32)
+        w[at] = np.nan
+        got = weight_stats(w)
+        assert all(math.isnan(x) for x in got) and all(math.isnan(x) for x in numpy_stats(w))
+    w = next(patterns(20_000, seed=3))
+    w[[10, 15_000]] = np.inf, -np.inf  # mean and std NaN, min and max the infinities
+    with np.errstate(invalid="ignore"):
+        got, want = weight_stats(w), numpy_stats(w)
+    assert math.isnan(got[0]) and math.isnan(want[0]) and math.isnan(got[1]) and math.isnan(want[1])
+    assert got[2:] == want[2:] == (-math.inf, math.inf)
+
+
 def test_a_pf_pc_block_and_its_summary_are_numpy_s():
     rng = np.random.default_rng(0)
     w = np.full((10_000, 600), 2.0, np.float32)
     w.reshape(-1)[rng.integers(0, w.size, 100_000)] = rng.random(100_000, dtype=np.float32) * 5
-    want = (w.mean(dtype=np.float64), w.std(dtype=np.float64), w.min(), w.max())
-    assert weight_stats(w) == tuple(float(x) for x in want)
+    assert weight_stats(w) == numpy_stats(w)
