@@ -7,15 +7,40 @@ A checkpoint is
   Written to a temporary file, flushed to the disk, then renamed over the old one: that rename commits it.
 - ``checkpoint.<n>.arrays``: the arrays an object of the state tracks (a ``changed_ranges()`` method, e.g. the
   spiking network's weights, 145 MB for the full network), stored beside the pickle, which refers to them by
-  key. The first checkpoint a process writes puts them whole into a new file (``<n>``: its trial count);
-  each later one writes only the ranges changed since (a few % of the PF-PC rows per 10 trials), first into
-  ``checkpoint.journal`` (flushed to the disk), then commits the pickle, then writes the ranges into the
-  arrays file in place.
+  key. The first checkpoint a process writes puts them whole into a new file (``<n>``: its trial count),
+  unless the file was written ahead (below); each later one writes only the ranges changed since (a few % of
+  the PF-PC rows per 10 trials), first into ``checkpoint.journal`` (flushed to the disk), then commits the
+  pickle, then writes the ranges into the arrays file in place (then flushes it to the disk).
 
 A crash at any moment leaves the previous checkpoint or the new one, whole: before the commit the old
 pickle names the old arrays file, which a full write never touches (a new file) and a journal of a newer
 checkpoint leaves alone; after it, the journal of the committed checkpoint is complete on the disk and
 :func:`load` applies it again (it holds values, not increments), whatever part of it reached the arrays file.
+
+Written ahead (:func:`prime`, before the first trial of a process): the first checkpoint would copy the
+arrays whole on the loop's thread (0.4 s for the full network) to write them into a new file. Instead, at a
+moment the state does not change (between trials), :func:`prime` takes the tracked objects' changed ranges
+(which starts a new interval) and has the writer thread write the *live* arrays whole into the new file
+``checkpoint.<n>.arrays`` (``<n>``: the trial count of the first checkpoint due) while the run goes on; the
+first checkpoint is then written like a later one, a journal of the ranges changed since on top of that file.
+Why the file and its journal hold the state of the checkpoint:
+
+- a range not reported changed at the checkpoint was not written since the reset (a tracked object reports
+  every write since its last ``changed_ranges()``, which only the checkpoints call): the writer read it after
+  the reset and before the checkpoint (a checkpoint uses the file only once the writer has finished it), so
+  the file holds its value at the checkpoint;
+- a range written meanwhile (before, while or after the writer read it; its bytes in the file may be old, new
+  or torn) is reported changed at the checkpoint, so it is in the journal, with its value at the checkpoint,
+  which is applied after the commit and again by :func:`load` after a crash, overwriting those bytes;
+- the file is flushed to the disk and its name too before the first checkpoint is written, and no committed
+  pickle names it before that checkpoint commits (a name no committed pickle uses: a resumed run's checkpoint
+  is older than the checkpoint due); a crash while it is written leaves the previous checkpoint as it was;
+- the journal of the first checkpoint replaces that of the committed checkpoint (a resumed run's) before its
+  commit, so the writer first applies the committed journal to its own arrays file and flushes it (what the
+  process that wrote it would have done after its commit; the journal stays valid), and only then writes ahead.
+
+If writing ahead fails, the first checkpoint writes the arrays whole, as without it; a run that stops before
+its first checkpoint deletes the file (:func:`drop_ahead`).
 
 The loop's thread only pickles (into memory) and copies the changed ranges; a :class:`Writer` thread does
 the writing and flushing, one checkpoint at a time.
@@ -25,11 +50,13 @@ from __future__ import annotations
 
 import io
 import json
+import logging
 import os
 import pickle
 import threading
 import time
 import zlib
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -38,10 +65,16 @@ import numpy as np
 
 from cerebx import phase_clock, runfiles
 
+log = logging.getLogger("cerebx")
+
 CHECKPOINT = runfiles.CHECKPOINT
 JOURNAL = "checkpoint.journal"
 _JOURNAL_MAGIC = b"CXJ1"
 _ALIGN = 64
+_ndarray = np.ndarray
+
+# (key, starts, length, values): the ranges flat[s:s + length] of one array, their values one after the other
+Changes = list[tuple[str, np.ndarray, int, np.ndarray]]
 
 
 def arrays_name(seq: int) -> str:
@@ -57,6 +90,7 @@ class ArrayStore:
         self.layout: dict[str, dict[str, Any]] = {}  # key -> offset, dtype, shape in self.file
         self.key_of: dict[int, str] = {}  # id(array) -> key; the arrays are kept alive in self.arrays
         self.arrays: dict[str, np.ndarray] = {}
+        self.ahead: ArraysFile | None = None  # the arrays file being written ahead (prime)
         # per checkpoint
         self.ranges: dict[int, list[tuple[np.ndarray, int]]] = {}  # id(array) -> (starts, length) ranges
         self.asked: set[int] = set()
@@ -94,27 +128,49 @@ class ArrayStore:
                 self.layout.pop(self.key_of[i], None)
         return self.file is None or any(k not in self.layout for k in self.used)
 
+    def take_ahead(self) -> None:
+        """Use the arrays file written ahead if the writer finished it (else the next checkpoint is whole)."""
+        ahead, self.ahead = self.ahead, None
+        if ahead is not None and ahead.done and self.file is None:
+            self.file, self.layout = ahead.name, dict(ahead.layout)
+
 
 class _Pickler(cloudpickle.Pickler):
     def __init__(self, fh: Any, store: ArrayStore, persistent: dict[type, str]):
+        # the dispatch table as a plain dict instead of the base class's ChainMap (the same entries, looked up
+        # the same way): the pickler looks the class of every object it reduces up in it, and a ChainMap lookup
+        # runs Python code (two KeyErrors for most classes). The pickler reads it when it is created: set first.
+        self.dispatch_table = dict(cloudpickle.Pickler.dispatch_table)
         super().__init__(fh, protocol=pickle.HIGHEST_PROTOCOL)
         self.store = store
         self.persistent = persistent
-        self.how: dict[type, tuple[str, Any]] = {}  # per class, decided once: the state has ~50 k objects
+        # per class, decided once (the state has ~57 k objects, each passed to persistent_id)
+        self.plain: set[type] = set()  # neither persistent nor tracked: most of them (str, tuple, int, ...)
+        self.how: dict[type, tuple[str, Any]] = {}  # the others: ("id", pid) or ("tracked", changed_ranges)
 
     def persistent_id(self, obj: Any) -> Any:
         cls = type(obj)
-        if cls is np.ndarray:
+        if cls in self.plain:
+            return None
+        if cls is _ndarray:
             key = self.store.ref(obj)
             return None if key is None else ("array", key)
         how = self.how.get(cls)
         if how is None:
-            how = self.how[cls] = self._classify(cls)
+            how = self._classify(cls)
+            if how[0] == "plain":
+                self.plain.add(cls)
+                return None
+            self.how[cls] = how
         if how[0] == "id":
             return how[1]
-        if how[0] == "tracked":
-            self.store.ask(obj, how[1])
+        self.store.ask(obj, how[1])
         return None
+
+    def reducer_override(self, obj: Any) -> Any:
+        if type(obj) is _ndarray:  # neither a class nor a function: what the base class returns for it
+            return NotImplemented
+        return super().reducer_override(obj)
 
     def _classify(self, cls: type) -> tuple[str, Any]:
         for kind, pid in self.persistent.items():
@@ -147,7 +203,7 @@ def _fsync_dir(path: Path) -> None:
         os.close(fd)
 
 
-def _write_file(path: Path, parts: list[Any]) -> None:
+def _write_file(path: Path, parts: Iterable[Any]) -> None:
     """Write ``parts`` (bytes-like) into ``path`` through a temporary file, flushed, then renamed."""
     tmp = path.with_name(path.name + ".tmp")
     with open(tmp, "wb") as fh:
@@ -162,26 +218,30 @@ def _raw(a: np.ndarray) -> memoryview:
     return memoryview(np.ascontiguousarray(a)).cast("B")
 
 
+def _whole_parts(arrays: Iterable[np.ndarray]) -> list[Any]:
+    """The arrays one after the other, each at an offset aligned as :func:`_layout` says."""
+    parts: list[Any] = []
+    size = 0
+    for a in arrays:
+        pad = -size % _ALIGN
+        parts.append(b"\0" * pad)
+        size += pad + a.nbytes
+        parts.append(_raw(a))
+    return parts
+
+
 class Checkpoint:
     """One checkpoint, ready to be written: the pickle and the arrays (whole or the changed ranges)."""
 
     def __init__(self, run_dir: Path, head: dict[str, Any], stream: memoryview, whole: dict[str, np.ndarray] | None,
-                 changes: list[tuple[str, np.ndarray, int, np.ndarray]], layout: dict[str, dict[str, Any]],
-                 file: str | None):
+                 changes: Changes, layout: dict[str, dict[str, Any]], file: str | None):
         self.run_dir, self.head, self.stream = run_dir, head, stream
         self.whole, self.changes, self.layout, self.file = whole, changes, layout, file
 
     def write(self) -> None:
         run_dir, seq = self.run_dir, self.head["trials_done"]
         if self.whole is not None:
-            parts: list[Any] = []
-            size = 0
-            for a in self.whole.values():
-                pad = -size % _ALIGN
-                parts.append(b"\0" * pad)
-                size += pad + a.nbytes
-                parts.append(_raw(a))
-            _write_file(run_dir / self.file, parts)
+            _write_file(run_dir / self.file, _whole_parts(self.whole.values()))
         elif self.changes:
             _write_file(run_dir / JOURNAL, self._journal(seq))
         _write_file(run_dir / CHECKPOINT, [json.dumps(self.head).encode() + b"\n", self.stream])
@@ -209,32 +269,54 @@ class Checkpoint:
         return [_JOURNAL_MAGIC, json.dumps(header).encode() + b"\n", *data]
 
     def _apply(self) -> None:
-        fd = os.open(self.run_dir / self.file, os.O_WRONLY)
-        try:
-            for key, starts, length, values in self.changes:
-                _pwrite_ranges(fd, self.layout[key]["offset"], starts, length, values)
-            os.fsync(fd)
-        finally:
-            os.close(fd)
+        _apply_file(self.run_dir / self.file, self.layout, self.changes)
+
+
+def _apply_file(path: Path, layout: dict[str, dict[str, Any]], changes: Changes) -> None:
+    """Write the changed ranges into the arrays file in place, then flush it to the disk."""
+    fd = os.open(path, os.O_WRONLY)
+    try:
+        for key, starts, length, values in changes:
+            _pwrite_ranges(fd, layout[key]["offset"], starts, length, values)
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def _pwrite_ranges(fd: int, offset: int, starts: np.ndarray, length: int, values: np.ndarray) -> None:
+    """One write per run of ranges that follow each other in the file (they follow each other in
+    ``values`` too): a third of the writes of one per range for the PF-PC rows learning changed."""
+    if not len(starts):
+        return
     item = values.dtype.itemsize
-    rows = values.reshape(len(starts), length)
-    for start, row in zip(starts.tolist(), rows):
-        os.pwrite(fd, _raw(row), offset + start * item)
+    raw = _raw(values)
+    step = length * item
+    cut = (np.flatnonzero(np.diff(starts) != length) + 1).tolist()
+    firsts = [0, *cut]
+    ends = [*cut, len(starts)]
+    for i, j, start in zip(firsts, ends, starts[firsts].tolist()):
+        _pwrite_all(fd, raw[i * step:j * step], offset + start * item)
+
+
+def _pwrite_all(fd: int, data: memoryview, offset: int) -> None:
+    while data:
+        n = os.pwrite(fd, data, offset)
+        if n <= 0:
+            raise OSError(f"wrote {n} of {len(data)} bytes")
+        data, offset = data[n:], offset + n
 
 
 def prepare(run_dir: Path, head: dict[str, Any], state: Any, store: ArrayStore,
             persistent: dict[type, str]) -> Checkpoint:
     """Pickle ``state`` and copy what changed (the loop's thread; the state must not change meanwhile)."""
+    store.take_ahead()
     store.begin()
     stream = _dumps(state, store, persistent)
     seq = head["trials_done"]
     whole = None
-    changes: list[tuple[str, np.ndarray, int, np.ndarray]] = []
+    changes: Changes = []
     if store.full():
-        whole = {k: store.arrays[k].copy() for k in sorted(store.used, key=lambda k: int(k[1:]))}
+        whole = {k: store.arrays[k].copy() for k in _ordered(store.used)}
         store.file, store.layout = arrays_name(seq), _layout(whole)
     else:
         for key in sorted(store.used):
@@ -247,26 +329,130 @@ def prepare(run_dir: Path, head: dict[str, Any], state: Any, store: ArrayStore,
     return Checkpoint(run_dir, head, stream, whole, changes, dict(store.layout), store.file)
 
 
+def _ordered(keys: Iterable[str]) -> list[str]:
+    return sorted(keys, key=lambda k: int(k[1:]))
+
+
+class ArraysFile:
+    """The tracked arrays written whole from the live arrays, ahead of the first checkpoint (:func:`prime`):
+    ``done`` once the file and its name are on the disk."""
+
+    def __init__(self, run_dir: Path, name: str, arrays: dict[str, np.ndarray], settle: bool):
+        self.run_dir, self.name, self.arrays, self.settle = run_dir, name, arrays, settle
+        self.layout = _layout(arrays)
+        self.done = False
+
+    def write(self) -> None:
+        try:
+            if self.settle:
+                _settle(self.run_dir)
+            _write_file(self.run_dir / self.name, _whole_parts(self.arrays.values()))
+            _fsync_dir(self.run_dir)
+        except Exception as err:  # the first checkpoint writes the arrays whole instead
+            log.warning("could not write %s ahead of the first checkpoint: %s", self.name, err)
+            return
+        finally:
+            self.arrays = {}
+        self.done = True
+
+
+def prime(run_dir: Path, seq: int, state: Any, store: ArrayStore, persistent: dict[type, str]) -> ArraysFile | None:
+    """Before the first checkpoint of this process (the loop's thread, between trials): take the tracked
+    objects' changed ranges and return the job that writes their live arrays into ``checkpoint.<seq>.arrays``
+    (``seq``: the trial count of the first checkpoint due), for the :class:`Writer`; None when there is
+    nothing to write ahead, or ``run_dir``'s committed checkpoint uses that name."""
+    if store.file is not None or store.ahead is not None:
+        return None
+    run_dir = Path(run_dir)
+    name = arrays_name(seq)
+    try:
+        committed = read_head(run_dir)
+    except FileNotFoundError:
+        committed = None
+    except (OSError, ValueError):
+        return None
+    if committed is not None and (committed.get("arrays") or {}).get("file") == name:
+        return None
+    store.begin()
+    _dumps(state, store, persistent)  # finds the tracked arrays (and takes their changed ranges)
+    if not store.used:
+        return None
+    store.ahead = ArraysFile(run_dir, name, {k: store.arrays[k] for k in _ordered(store.used)},
+                             settle=committed is not None)
+    return store.ahead
+
+
+def drop_ahead(store: ArrayStore) -> None:
+    """Delete the arrays file written ahead of a checkpoint that never came (the run stopped before it); the
+    writer must be done with it. No committed pickle names it."""
+    ahead, store.ahead = store.ahead, None
+    if ahead is not None:
+        for name in (ahead.name, ahead.name + ".tmp"):
+            (ahead.run_dir / name).unlink(missing_ok=True)
+
+
+def _settle(run_dir: Path) -> None:
+    """Apply the journal of ``run_dir``'s committed checkpoint to its arrays file and flush that to the disk,
+    so that the journal can be replaced before the next commit."""
+    try:
+        head = read_head(run_dir)
+    except FileNotFoundError:
+        return
+    changes = _read_journal(run_dir, head)
+    if changes:
+        _apply_file(run_dir / head["arrays"]["file"], head["arrays"]["layout"], changes)
+
+
 def _dumps(state: Any, store: ArrayStore, persistent: dict[type, str]) -> memoryview:
     buf = io.BytesIO()
     _Pickler(buf, store, persistent).dump(state)
     return buf.getbuffer()
 
 
+def _check_ranges(flat: np.ndarray, starts: np.ndarray, length: int) -> np.ndarray:
+    starts = np.ascontiguousarray(starts, dtype=np.int64)
+    if flat.ndim != 1 or length < 0:
+        raise ValueError("ranges of a flat array, of a length >= 0")
+    if len(starts) and (int(starts.min()) < 0 or int(starts.max()) > flat.size - length):
+        raise ValueError(f"ranges of length {length} outside an array of {flat.size}")
+    return starts
+
+
+def _rows(flat: np.ndarray, starts: np.ndarray, length: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """``flat`` as a [rows, length] view and the row of each start, when the starts are increasing whole
+    numbers of ranges apart (the rows of a weight matrix); else None."""
+    if not len(starts) or length <= 0:
+        return None
+    base = int(starts[0]) % length
+    rows, off = np.divmod(starts - base, length)
+    if off.any() or (len(rows) > 1 and not (np.diff(rows) > 0).all()):
+        return None
+    n = (flat.size - base) // length
+    return flat[base:base + n * length].reshape(n, length), rows
+
+
 def _gather(flat: np.ndarray, starts: np.ndarray, length: int) -> np.ndarray:
     """The ranges ``flat[s:s + length]`` for s in ``starts``, one after the other (a copy)."""
-    if len(starts) <= 16:  # few long ranges (a whole array): slices, no index array
-        return np.concatenate([flat[s:s + length] for s in starts.tolist()])
-    return flat[(starts[:, None] + np.arange(length, dtype=np.int64)).reshape(-1)]
+    starts = _check_ranges(flat, starts, length)
+    view = _rows(flat, starts, length)
+    if view is not None:  # one copy per row, no index per element
+        return np.take(view[0], view[1], axis=0).reshape(-1)
+    if not len(starts):
+        return flat[:0].copy()
+    return np.concatenate([flat[s:s + length] for s in starts.tolist()])
 
 
 def _scatter(flat: np.ndarray, starts: np.ndarray, length: int, values: np.ndarray) -> None:
-    rows = values.reshape(len(starts), length)
-    if len(starts) <= 16:
-        for s, row in zip(starts.tolist(), rows):
-            flat[s:s + length] = row
-    else:
-        flat[(starts[:, None] + np.arange(length, dtype=np.int64)).reshape(-1)] = values
+    """``flat[s:s + length]`` = the next ``length`` values, for s in ``starts`` (the inverse of :func:`_gather`)."""
+    starts = _check_ranges(flat, starts, length)
+    if values.shape != (len(starts) * length,) or values.dtype != flat.dtype:
+        raise ValueError(f"{values.shape} {values.dtype} values for {len(starts)} ranges of {length} {flat.dtype}")
+    view = _rows(flat, starts, length)
+    if view is not None:
+        view[0][view[1]] = values.reshape(-1, length)
+        return
+    for i, s in enumerate(starts.tolist()):
+        flat[s:s + length] = values[i * length:(i + 1) * length]
 
 
 def _layout(arrays: dict[str, np.ndarray]) -> dict[str, dict[str, Any]]:
@@ -285,7 +471,7 @@ class Writer:
         self._thread: threading.Thread | None = None
         self._error: BaseException | None = None
 
-    def submit(self, ckpt: Checkpoint) -> None:
+    def submit(self, ckpt: Checkpoint | ArraysFile) -> None:
         self.wait()
         clock = phase_clock.active()
 
@@ -343,33 +529,37 @@ def _read_arrays(run_dir: Path, head: dict[str, Any]) -> dict[str, np.ndarray]:
             if a.size != count:
                 raise ValueError(f"{spec['file']}: {key} is cut short")
             arrays[key] = a.reshape(item["shape"])
-    _apply_journal(run_dir, head, arrays)
+    for key, starts, length, values in _read_journal(run_dir, head) or []:
+        _scatter(arrays[key].reshape(-1), starts, length, values)
     return arrays
 
 
-def _apply_journal(run_dir: Path, head: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
-    """Apply ``checkpoint.journal`` when it belongs to the committed checkpoint (same trial count and file)."""
+def _read_journal(run_dir: Path, head: dict[str, Any]) -> Changes | None:
+    """The changed ranges in ``checkpoint.journal`` when it belongs to the committed checkpoint ``head`` (same
+    trial count and arrays file), else None."""
     try:
         raw = (run_dir / JOURNAL).read_bytes()
     except FileNotFoundError:
-        return
-    if not raw.startswith(_JOURNAL_MAGIC):
-        return
+        return None
+    if not raw.startswith(_JOURNAL_MAGIC) or not head.get("arrays"):
+        return None
     line_end = raw.index(b"\n")
     header = json.loads(raw[len(_JOURNAL_MAGIC):line_end])
     if header["seq"] != head["trials_done"] or header["file"] != head["arrays"]["file"]:
-        return  # a journal of a checkpoint that was never committed
+        return None  # a journal of a checkpoint that was never committed
     data = memoryview(raw)[line_end + 1:]
     if zlib.crc32(data) != header["crc32"]:
         raise ValueError(f"{JOURNAL} of the committed checkpoint is damaged")
     pos = 0
+    changes: Changes = []
     for e in header["entries"]:
         n, length, dtype = e["count"], e["length"], np.dtype(e["dtype"])
         starts = np.frombuffer(data, np.int64, n, pos)
         pos += starts.nbytes
         values = np.frombuffer(data, dtype, n * length, pos)
         pos += values.nbytes
-        _scatter(arrays[e["key"]].reshape(-1), starts, length, values)
+        changes.append((e["key"], starts, length, values))
+    return changes
 
 
 def remove(run_dir: Path) -> None:

@@ -78,15 +78,35 @@ class Checkpointer:
         self.store = checkpoint.ArrayStore()
         self.writer = checkpoint.Writer()
 
+    def prime(self, loop: ClosedLoop) -> None:
+        """Before the trials of this process: have the writer write the learned arrays ahead of the first
+        checkpoint due, from the live arrays while the trials run (``checkpoint.prime``), so that the first
+        checkpoint does not copy them whole on the loop's thread. Nothing when no checkpoint is due."""
+        every = loop.cfg.recording.checkpoint_every
+        if every <= 0:
+            return
+        first = (loop.trials_done // every + 1) * every  # the first trial count :func:`due` says yes to
+        if first >= loop.cfg.trials:
+            return
+        job = checkpoint.prime(self.run_dir, first, _state(loop), self.store, {Recorder: _RECORDER})
+        if job is not None:
+            self.writer.submit(job)
+
     def save(self, loop: ClosedLoop, wall_seconds: float) -> None:
         self.writer.wait()  # the previous checkpoint first (and its error, if it failed)
         head = {"version": __version__, "config": same_config(loop.cfg), "trials_done": loop.trials_done,
                 "tick": loop.tick, "start_ns": int(round(loop.tick * loop.dt_s * 1e9)), "wall_seconds": wall_seconds}
-        state = {"ctx": loop.ctx, "loop": {f: getattr(loop, f) for f in _LOOP_FIELDS}}
-        self.writer.submit(checkpoint.prepare(self.run_dir, head, state, self.store, {Recorder: _RECORDER}))
+        self.writer.submit(checkpoint.prepare(self.run_dir, head, _state(loop), self.store, {Recorder: _RECORDER}))
 
     def close(self) -> None:
-        self.writer.wait()
+        try:
+            self.writer.wait()
+        finally:
+            checkpoint.drop_ahead(self.store)  # written ahead of a first checkpoint that never came
+
+
+def _state(loop: ClosedLoop) -> dict[str, Any]:
+    return {"ctx": loop.ctx, "loop": {f: getattr(loop, f) for f in _LOOP_FIELDS}}
 
 
 def save(loop: ClosedLoop, run_dir: Path, wall_seconds: float) -> None:

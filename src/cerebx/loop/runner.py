@@ -105,6 +105,8 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
                 clock.switch("loop")
             loop.scene = scene_writer(cfg, ctx.plant, rec, live)
             summary["controller_info"] = ctx.brain[0].describe()
+            with phase_clock.span("checkpoint"):
+                ckpt.prime(loop)  # the learned arrays written ahead of the first checkpoint, off this thread
             bar = _progress(cfg, cfg.trials)
             if bar is not None:
                 bar.update(loop.trials_done)

@@ -3,6 +3,11 @@ changed ranges in later ones, and a crash at any point leaving one whole checkpo
 
 from __future__ import annotations
 
+import io
+import pickle
+from types import SimpleNamespace
+
+import cloudpickle
 import numpy as np
 import pytest
 
@@ -111,3 +116,262 @@ def test_writer_raises_what_writing_raised(tmp_path):
     with pytest.raises(FileNotFoundError):
         writer.wait()
     writer.wait()  # raised once
+
+
+# ---------------------------------------------------------------- changed ranges: copied, scattered, written
+
+
+def _ranges_by_index(flat, starts, length):
+    return np.concatenate([flat[s:s + length] for s in starts]) if len(starts) else flat[:0]
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64, np.int64])
+def test_gather_and_scatter_ranges(dtype):
+    rng = np.random.default_rng(3)
+    rows, cols = 97, 13
+    flat = rng.normal(size=rows * cols).astype(dtype)
+    picks = {
+        "random": np.sort(rng.choice(rows, 30, replace=False)),
+        "first and last": np.array([0, rows - 1]),
+        "adjacent": np.array([4, 5, 6, 40, 41, 96]),
+        "none": np.zeros(0, np.int64),
+        "unsorted": np.array([50, 2, 51]),
+    }
+    for what, picked in picks.items():
+        starts = picked.astype(np.int64) * cols
+        got = checkpoint._gather(flat, starts, cols)
+        assert got.dtype == flat.dtype and got.shape == (len(starts) * cols,), what
+        np.testing.assert_array_equal(got, _ranges_by_index(flat, starts, cols), err_msg=what)
+        target = np.zeros_like(flat)
+        checkpoint._scatter(target, starts, cols, got)
+        expect = np.zeros_like(flat)
+        for s in starts:
+            expect[s:s + cols] = flat[s:s + cols]
+        np.testing.assert_array_equal(target, expect, err_msg=what)
+    whole = checkpoint._gather(flat, np.zeros(1, np.int64), flat.size)  # one range: all of it
+    np.testing.assert_array_equal(whole, flat)
+    # ranges that need not be rows: any offsets, overlapping ones scattered in order
+    np.testing.assert_array_equal(checkpoint._gather(flat, np.array([1, 3]), 4), flat[[1, 2, 3, 4, 3, 4, 5, 6]])
+    target = np.zeros(8, dtype)
+    checkpoint._scatter(target, np.array([0, 2]), 3, np.arange(1, 7).astype(dtype))
+    np.testing.assert_array_equal(target, np.array([1, 2, 4, 5, 6, 0, 0, 0], dtype))
+    # read-only values (a journal read from the disk)
+    values = np.frombuffer(np.arange(6, dtype=dtype).tobytes(), dtype)
+    checkpoint._scatter(target, np.array([5, 0]), 3, values)
+    np.testing.assert_array_equal(target, np.array([3, 4, 5, 5, 6, 0, 1, 2], dtype))
+
+
+def test_ranges_outside_the_array_are_refused():
+    flat = np.zeros(20, np.float32)
+    for starts, length in [(np.array([18]), 3), (np.array([-1]), 2), (np.array([0, 17]), 4)]:
+        with pytest.raises(ValueError, match="outside"):
+            checkpoint._gather(flat, starts, length)
+        with pytest.raises(ValueError, match="outside"):
+            checkpoint._scatter(flat, starts, length, np.zeros(len(starts) * length, np.float32))
+    with pytest.raises(ValueError):
+        checkpoint._scatter(flat, np.array([0]), 4, np.zeros(5, np.float32))
+    checkpoint._gather(flat, np.array([0, 17]), 3)  # up to the last element
+
+
+def test_apply_writes_each_run_of_adjacent_ranges_at_once(tmp_path, monkeypatch):
+    rows, cols = 40, 6
+    old = np.arange(rows * cols, dtype=np.float32)
+    before = np.zeros(8, np.int64)  # an array before it in the file
+    layout = checkpoint._layout({"a0": before, "a1": old})
+    path = tmp_path / "x.arrays"
+    checkpoint._write_file(path, checkpoint._whole_parts([before, old]))
+    starts = np.array([0, 1, 2, 9, 20, 21, 39], np.int64) * cols  # first row, adjacent rows, last row
+    values = -np.arange(len(starts) * cols, dtype=np.float32)
+    writes = []
+    pwrite = checkpoint.os.pwrite
+
+    def counted(fd, data, offset):
+        writes.append((offset, len(data)))
+        return pwrite(fd, data, offset)
+
+    monkeypatch.setattr(checkpoint.os, "pwrite", counted)
+    checkpoint._apply_file(path, layout, [("a1", starts, cols, values)])
+    off, item = layout["a1"]["offset"], 4
+    assert writes == [(off, 3 * cols * item), (off + 9 * cols * item, cols * item),
+                      (off + 20 * cols * item, 2 * cols * item), (off + 39 * cols * item, cols * item)]
+    expect = old.copy()
+    checkpoint._scatter(expect, starts, cols, values)
+    raw = path.read_bytes()
+    np.testing.assert_array_equal(np.frombuffer(raw, np.int64, 8, 0), before)
+    np.testing.assert_array_equal(np.frombuffer(raw, np.float32, rows * cols, off), expect)
+
+
+def test_the_pickler_fast_paths_change_no_byte():
+    class Persistent:
+        pass
+
+    class Sub(Persistent):
+        pass
+
+    plain = {"a": [1, 2.5, "s", b"b", (3, None, True)], "f": np.float64(1.5), "x": np.arange(5.0),
+             "d": np.dtype("f4"), "set": {1, 2}, "fn": _load}
+    store = checkpoint.ArrayStore()
+    stream = checkpoint._dumps(plain, store, {Persistent: "p"})
+    assert bytes(stream) == cloudpickle.dumps(plain, protocol=pickle.HIGHEST_PROTOCOL)
+    net = Tracked(3, 2)
+    net.learn([1])
+    state = {"p": Persistent(), "s": Sub(), "net": net, "again": [Sub(), net.w]}
+    stream = checkpoint._dumps(state, checkpoint.ArrayStore(), {Persistent: "p"})
+    out = checkpoint._Unpickler(io.BytesIO(stream), {"a0": "W"}, {"p": "P"}).load()
+    assert out["p"] == out["s"] == out["again"][0] == "P" and out["again"][1] == "W" and out["net"].w == "W"
+
+
+# ---------------------------------------------------------------- the arrays file written ahead (prime)
+
+
+def _torn_writes(monkeypatch, at_byte, during):
+    """The writer writes each array in two pieces, split at ``at_byte``, and ``during()`` runs between them
+    (the network learning while the arrays are written)."""
+    write_file = checkpoint._write_file
+
+    def pieces(parts):
+        for part in parts:
+            if len(part) > at_byte:
+                yield part[:at_byte]
+                during()
+                yield part[at_byte:]
+            else:
+                yield part
+
+    monkeypatch.setattr(checkpoint, "_write_file", lambda path, parts: write_file(path, pieces(parts)))
+
+
+def test_arrays_written_ahead_from_the_live_arrays_give_the_state_of_the_checkpoint(tmp_path, monkeypatch):
+    rows, cols = 30, 4
+    net, store = Tracked(rows, cols), checkpoint.ArrayStore()
+    net.learn(range(rows))
+    job = checkpoint.prime(tmp_path, 10, {"net": net}, store, {})
+    assert job is not None and job.name == "checkpoint.10.arrays"
+    # mid-write, rows 2 (written already), 11 (torn: its middle is where the write pauses) and 25 (not yet
+    # written) change; the write sees 2 old, 11 half old half new, 25 new
+    _torn_writes(monkeypatch, (11 * cols + 2) * 4, lambda: net.learn([2, 11, 25]))
+    job.write()
+    monkeypatch.undo()
+    assert job.done
+    on_disk = np.fromfile(tmp_path / job.name, np.float32)
+    assert on_disk[2 * cols] != net.w[2 * cols] and on_disk[11 * cols] != net.w[11 * cols]
+    assert on_disk[11 * cols + 3] == net.w[11 * cols + 3] and on_disk[25 * cols] == net.w[25 * cols]
+    net.learn([0, 29])  # after the write
+    at_10 = net.w.copy()
+    ckpt = checkpoint.prepare(tmp_path, {"trials_done": 10}, {"net": net}, store, {})
+    assert ckpt.whole is None and ckpt.file == job.name  # only a journal on top of the file written ahead
+    assert sorted((ckpt.changes[0][1] // cols).tolist()) == [0, 2, 11, 25, 29]
+    ckpt._apply = lambda: None  # died right after the commit
+    ckpt.write()
+    np.testing.assert_array_equal(_load(tmp_path)[1]["net"].w, at_10)
+    del ckpt._apply
+    ckpt.write()  # or not
+    np.testing.assert_array_equal(np.fromfile(tmp_path / job.name, np.float32), at_10)
+    np.testing.assert_array_equal(_load(tmp_path)[1]["net"].w, at_10)
+    net.learn([5])
+    later = _write(tmp_path, 20, {"net": net}, store)
+    assert later.whole is None
+    np.testing.assert_array_equal(_load(tmp_path)[1]["net"].w, net.w)
+
+
+def test_a_crash_while_writing_ahead_leaves_no_checkpoint_or_the_previous_one(tmp_path, monkeypatch):
+    net = Tracked(10, 4)
+    net.learn([1])
+    job = checkpoint.prime(tmp_path, 10, {"net": net}, checkpoint.ArrayStore(), {})
+
+    def crash():
+        raise KeyboardInterrupt
+
+    _torn_writes(monkeypatch, 8, crash)
+    with pytest.raises(KeyboardInterrupt):
+        job.write()
+    assert not job.done and not (tmp_path / checkpoint.CHECKPOINT).exists()
+    monkeypatch.undo()
+    with pytest.raises(FileNotFoundError):
+        _load(tmp_path)
+
+
+def test_a_resumed_run_settles_the_committed_journal_before_replacing_it(tmp_path):
+    net, store = Tracked(20, 4), checkpoint.ArrayStore()
+    net.learn([3])
+    _write(tmp_path, 5, {"net": net}, store)
+    net.learn([3, 9])
+    ckpt = checkpoint.prepare(tmp_path, {"trials_done": 10}, {"net": net}, store, {})
+    ckpt._apply = lambda: None  # killed after the commit: checkpoint.5.arrays lacks the rows of trial 10
+    ckpt.write()
+    at_10 = net.w.copy()
+    resumed = _load(tmp_path)[1]["net"]  # a new process
+    store = checkpoint.ArrayStore()
+    job = checkpoint.prime(tmp_path, 15, {"net": resumed}, store, {})
+    job.write()
+    assert job.done and sorted(p.name for p in tmp_path.glob("*.arrays")) == [
+        "checkpoint.15.arrays", "checkpoint.5.arrays"]
+    np.testing.assert_array_equal(np.fromfile(tmp_path / "checkpoint.5.arrays", np.float32), at_10)
+    resumed.learn([7])
+    first = checkpoint.prepare(tmp_path, {"trials_done": 15}, {"net": resumed}, store, {})
+    assert first.whole is None
+    checkpoint._write_file(tmp_path / checkpoint.JOURNAL, first._journal(15))  # died right after the journal
+    done, state = _load(tmp_path)
+    assert done == 10
+    np.testing.assert_array_equal(state["net"].w, at_10)
+    first.write()
+    done, state = _load(tmp_path)
+    assert done == 15 and sorted(p.name for p in tmp_path.glob("*.arrays")) == ["checkpoint.15.arrays"]
+    np.testing.assert_array_equal(state["net"].w, resumed.w)
+
+
+def test_nothing_is_written_ahead_over_the_committed_arrays_file(tmp_path):
+    net = Tracked(6, 2)
+    net.learn([1])
+    _write(tmp_path, 10, {"net": net}, checkpoint.ArrayStore())
+    assert checkpoint.prime(tmp_path, 10, {"net": net}, checkpoint.ArrayStore(), {}) is None
+    assert checkpoint.prime(tmp_path, 20, {"net": np.zeros(3)}, checkpoint.ArrayStore(), {}) is None  # untracked
+
+
+def test_when_writing_ahead_fails_the_first_checkpoint_is_whole(tmp_path, monkeypatch):
+    net, store = Tracked(6, 2), checkpoint.ArrayStore()
+    job = checkpoint.prime(tmp_path, 10, {"net": net}, store, {})
+
+    def fail(path, parts):
+        raise OSError("no space left")
+
+    monkeypatch.setattr(checkpoint, "_write_file", fail)
+    job.write()
+    monkeypatch.undo()
+    assert not job.done
+    net.learn([4])
+    ckpt = _write(tmp_path, 10, {"net": net}, store)
+    assert ckpt.whole is not None
+    np.testing.assert_array_equal(_load(tmp_path)[1]["net"].w, net.w)
+
+
+def test_the_checkpointer_writes_ahead_only_when_a_checkpoint_is_due(tmp_path):
+    from cerebx.loop import resume  # imports the closed loop
+
+    net = Tracked(6, 2)
+
+    def loop(done, trials, every):
+        cfg = SimpleNamespace(trials=trials, recording=SimpleNamespace(checkpoint_every=every),
+                              model_dump=lambda **_: {})
+        return SimpleNamespace(cfg=cfg, trials_done=done, ctx={"net": net}, tick=0, dt_s=0.01, metrics=[],
+                               _sensed=None, _task_rng=None, _events=[])
+
+    for done, trials, every, expect in [(0, 10, 10, None), (0, 11, 10, 10), (3, 30, 10, 10), (10, 30, 10, 20),
+                                        (0, 30, 0, None)]:
+        ck = resume.Checkpointer(tmp_path / f"{done}-{trials}-{every}")
+        ck.run_dir.mkdir()
+        ck.prime(loop(done, trials, every))
+        ck.writer.wait()
+        names = [p.name for p in ck.run_dir.iterdir()]
+        assert names == ([] if expect is None else [f"checkpoint.{expect}.arrays"]), (done, trials, every)
+        ck.close()  # the run stopped before its first checkpoint: nothing is left
+        assert not list(ck.run_dir.iterdir())
+    ck = resume.Checkpointer(tmp_path / "saved")  # once used by a checkpoint, the file stays
+    ck.run_dir.mkdir()
+    ck.prime(loop(0, 30, 10))
+    net.learn([2])
+    ck.save(loop(10, 30, 10), 1.0)
+    ck.close()
+    assert sorted(p.name for p in ck.run_dir.iterdir()) == [
+        "checkpoint.10.arrays", "checkpoint.journal", "checkpoint.pkl", "checkpoint.pkl.json"]
+    np.testing.assert_array_equal(_load(ck.run_dir)[1]["ctx"]["net"].w, net.w)

@@ -94,6 +94,30 @@ def test_sigkilled_run_resumes_to_the_same_trials(tmp_path):
     assert json.loads(read_metadata(killed)["summary"]["json"])["trials_completed"] == trials
 
 
+def test_sigkilled_learning_run_resumes_to_the_same_weights(tmp_path):
+    """The spiking network's weights: written ahead of the first checkpoint from the live array, then only
+    their changed rows; a resumed process writes its own file ahead (after settling the committed journal)."""
+    args = ["+task=circle", "+experiment=small_snn", "recording.progress=off", "trials=60",
+            "recording.checkpoint_every=10"]
+    whole, killed = tmp_path / "whole", tmp_path / "killed"
+    ref = _cerebx(*args, f"hydra.run.dir={whole}", cwd=tmp_path)
+    assert ref.wait() == 0, ref.stdout.read()
+    run = _cerebx(*args, f"hydra.run.dir={killed}", cwd=tmp_path)
+    _wait_for_checkpoint(killed, 20, run)
+    run.send_signal(signal.SIGKILL)
+    run.wait()
+    head = json.loads((killed / (resume.CHECKPOINT + ".json")).read_text())
+    assert head["arrays"]["file"] == "checkpoint.10.arrays"  # written ahead, then journals on top
+    assert head["trials_done"] < 60
+    cont = _cerebx(f"resume={killed}", cwd=tmp_path)
+    out, _ = cont.communicate(timeout=300)
+    assert cont.returncode == 0, out
+    a, b = _summary(whole), _summary(killed)
+    assert b["status"] == "completed" and b["mae_per_trial"] == a["mae_per_trial"]
+    with np.load(whole / "controller_state.npz") as sa, np.load(killed / "controller_state.npz") as sb:
+        assert sa.files == sb.files and all(np.array_equal(sa[k], sb[k]) for k in sa.files)
+
+
 def test_resume_refuses_another_config(tmp_path):
     run_dir = tmp_path / "run"
     p = _cerebx(*RUN, "trials=4", "recording.checkpoint_every=2", f"hydra.run.dir={run_dir}", cwd=tmp_path)

@@ -122,3 +122,26 @@ def test_checkpoints_rewrite_the_rows_learning_changed(tmp_path):
     _, state = checkpoint.load(tmp_path, {})
     np.testing.assert_array_equal(state["net"].dense_w, net.dense_w)
     np.testing.assert_array_equal(state["net"]._state.arrays.delivery.dense_w, net.dense_w)
+
+
+def test_weights_written_ahead_then_their_changed_rows_give_the_checkpoint(tmp_path):
+    net = plastic_net(n_pf=30, n_pc=4)
+    rng = np.random.default_rng(1)
+
+    def learn(n_steps):
+        run(net, {k: [("pf", int(i)) for i in rng.choice(30, 2, replace=False)]
+                  + ([("cf", int(rng.integers(4)))] if k % 7 == 0 else []) for k in range(0, n_steps, 5)}, n_steps)
+
+    learn(200)
+    store = checkpoint.ArrayStore()
+    job = checkpoint.prime(tmp_path, 1, {"net": net}, store, {})  # the whole weights, from the live array
+    learn(100)  # learning before the writer gets to them
+    job.write()
+    ahead = net.dense_w.copy()
+    learn(100)  # and after
+    ckpt = checkpoint.prepare(tmp_path, {"trials_done": 1}, {"net": net}, store, {})
+    assert ckpt.whole is None and ckpt.file == job.name
+    assert not np.array_equal(ahead, net.dense_w)
+    ckpt.write()
+    _, state = checkpoint.load(tmp_path, {})
+    np.testing.assert_array_equal(state["net"].dense_w, net.dense_w)
