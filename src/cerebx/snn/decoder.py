@@ -62,17 +62,30 @@ def chunk_torques(idx, off, lo, hi, per_joint, sign, alpha):
 
 @njit(cache=True, nogil=True, boundscheck=False)
 def chunk_select(idx, off, lo, hi):
-    """The spikes of the population ``lo:hi`` in a chunk, as local indices, and where each step's part ends
-    (step s is ``local[ends[s - 1]:ends[s]]``, the first from 0)."""
-    n = off.size - 1
-    local = np.empty(off[n] - off[0], np.int32)
-    ends = np.empty(n, np.int64)
+    """The spikes of each population ``lo[p]:hi[p]`` in a chunk, as local indices one population after the
+    other, and where each step's part ends (population p, step s: ``local[ends[p, s - 1]:ends[p, s]]``, the
+    first step from ``ends[p - 1, -1]``, 0 for the first population). One call for all the populations
+    recorded: each return from compiled code waits for the interpreter lock."""
+    n, n_pop = off.size - 1, lo.size
+    local = np.empty(n_pop * (off[n] - off[0]), np.int32)
+    ends = np.empty((n_pop, n), np.int64)
     m = 0
-    for s in range(n):
-        for k in range(off[s], off[s + 1]):
-            i = idx[k]
-            if lo <= i < hi:
-                local[m] = i - lo
-                m += 1
-        ends[s] = m
+    for p in range(n_pop):
+        a, b = lo[p], hi[p]
+        for s in range(n):
+            for k in range(off[s], off[s + 1]):
+                i = idx[k]
+                if a <= i < b:
+                    local[m] = i - a
+                    m += 1
+            ends[p, s] = m
     return local[:m], ends
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def chunk_outputs(idx, off, lo, hi, per_joint, sign, alpha, rec_lo, rec_hi):
+    """:func:`chunk_torques` and :func:`chunk_select` in one call (one wait for the interpreter lock when it
+    returns, where two calls would wait twice)."""
+    taus, counts = chunk_torques(idx, off, lo, hi, per_joint, sign, alpha)
+    local, ends = chunk_select(idx, off, rec_lo, rec_hi)
+    return taus, counts, local, ends

@@ -82,13 +82,17 @@ def test_a_chunk_decodes_and_splits_as_each_step_alone():
     idx = np.concatenate(steps)
     off = np.concatenate([[0], np.cumsum([len(s) for s in steps])]).astype(np.int64)
     taus, counts = chunk_torques(idx, off, lo, lo + 200, dec.per_joint, dec.sign, dec.alpha)
-    local, ends = chunk_select(idx, off, 1100, 1300)
+    pops = [(1100, 1300), (0, 5), (1390, 1400)]
+    local, ends = chunk_select(idx, off, np.array([a for a, _ in pops]), np.array([b for _, b in pops]))
+    flat_ends = ends.reshape(-1)
     for k, s in enumerate(steps):
         dcn = s[(s >= lo) & (s < lo + 200)] - lo
         assert taus[k].tolist() == dec.torque(dcn).tolist() and counts[k] == len(dcn)
-        want = s[(s >= 1100) & (s < 1300)] - 1100
-        assert local[(ends[k - 1] if k else 0):ends[k]].tolist() == want.tolist()
-    assert ends[-1] == len(local)
+        for p, (a, b) in enumerate(pops):
+            i = p * len(steps) + k
+            want = s[(s >= a) & (s < b)] - a
+            assert local[(flat_ends[i - 1] if i else 0):flat_ends[i]].tolist() == want.tolist()
+    assert flat_ends[-1] == len(local)
 
 
 class _Task:

@@ -42,12 +42,13 @@ from cerebx.controllers.ranges import mf_ranges
 from cerebx.controllers.snn.schema import SNNController
 from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
-from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
+from cerebx.snn.decoder import DCNDecoder, chunk_outputs, chunk_select
 from cerebx.snn.network import Network
 from cerebx.snn.weight_stats import weight_stats
 
 STEP_S = 0.002
 STATE_VERSION = 1
+_NONE = np.zeros(0, np.int64)  # no population recorded
 
 
 def encoder_ranges(cfg: SNNController, n_joints: int, task: Any = None) -> tuple[np.ndarray, np.ndarray]:
@@ -135,6 +136,8 @@ class SNNControllerImpl(Controller):
         self._shed = 0  # real-time load shedding level (link/shedding.py); 0: everything runs
         self._summaries = True  # periodic weight summaries (left out in wall-clock runs)
         self.record = {name: self.net.index(name) for name in cfg.record_spikes}
+        self._record_lo = np.array([sl.start for sl in self.record.values()], np.int64)
+        self._record_hi = np.array([sl.stop for sl in self.record.values()], np.int64)
         self.fingerprint = self.net.fingerprint
         self.config_hash = hashlib.sha256(
             json.dumps([self.net_cfg.model_dump(mode="json"), cfg.model_dump(mode="json")],
@@ -171,22 +174,25 @@ class SNNControllerImpl(Controller):
         idx, off = self.net.step_many(inputs)
         # decoding and the split of recorded spikes run in compiled code without the interpreter lock: on the
         # network thread, interpreted work holds up the loop's thread whenever it needs the lock back
+        recording = bool(self.recorder is not None and self._shed < 3 and self.record)
+        rec_lo, rec_hi = (self._record_lo, self._record_hi) if recording else (_NONE, _NONE)
         if self.muscles:
             step_of = np.repeat(np.arange(n), np.diff(off))
             lo, hi = self.sl_dcn.start, self.sl_dcn.stop
             sel = (idx >= lo) & (idx < hi)
             taus = self.decoder.sides(idx[sel] - lo, step_of[sel], n, self.full_scale, self.cfg.decoder.saturate)
             counts = np.bincount(step_of[sel], minlength=n)
+            local, ends = chunk_select(idx, off, rec_lo, rec_hi) if recording else (None, None)
         else:
-            taus, counts = chunk_torques(idx, off, self.sl_dcn.start, self.sl_dcn.stop, self.decoder.per_joint,
-                                         self.decoder.sign, self._alpha)
+            taus, counts, local, ends = chunk_outputs(idx, off, self.sl_dcn.start, self.sl_dcn.stop,
+                                                      self.decoder.per_joint, self.decoder.sign, self._alpha,
+                                                      rec_lo, rec_hi)
         per_step: list[dict[str, np.ndarray] | None] = [None] * n
-        if self.recorder is not None and self._shed < 3 and self.record:
+        if recording:
             per_step = [{} for _ in range(n)]
-            for name, sl in self.record.items():
-                local, ends = chunk_select(idx, off, sl.start, sl.stop)
-                start = 0
-                for i, end in enumerate(ends.tolist()):
+            start = 0
+            for name, pop_ends in zip(self.record, ends.tolist()):
+                for i, end in enumerate(pop_ends):
                     per_step[i][name] = local[start:end]
                     start = end
         counts = counts.tolist()
