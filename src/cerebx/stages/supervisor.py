@@ -29,6 +29,9 @@ class Supervisor(Stage):
     def correction(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         below, above = q < self.lo, q > self.hi
         outside = below | above
+        if not outside.any():  # every joint inside its bounds, as on most ticks: what the full rule gives
+            self.s = np.zeros(self.kp.shape)
+            return np.zeros(self.kp.shape)
         self.s = np.where(outside, np.minimum(self.s + self.ramp, 1.0), 0.0)
         bound = np.where(below, self.lo, self.hi)
         return np.where(outside, self.kp * (bound - q) - self.s * self.kd * qd, 0.0)

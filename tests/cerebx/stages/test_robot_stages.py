@@ -61,3 +61,19 @@ def test_supervisor_acts_only_outside_and_ramps():
     assert sup.record()["tau_supervisor"][0] == pytest.approx(20 * (1.0 - 1.1) - 0.04 * 5 * 2.0)
     assert run(0.0, 2.0) == 0.0
     assert sup.s[0] == 0.0
+
+
+def test_supervisor_correction_is_its_rule_on_every_tick():
+    """The shortcut for a tick with every joint inside its bounds gives what the full rule gives."""
+    cfg = SupervisorConfig(kp=(20.0, 10.0, 5.0), kd=(5.0, 2.0, 1.0), ramp_per_step=0.3)
+    sup = Supervisor(cfg, np.array([-1.0, -0.5, 0.0]), np.array([1.0, 0.5, 2.0]))
+    rng = np.random.default_rng(1)
+    s = np.zeros(3)
+    for _ in range(300):
+        q, qd = rng.normal(0.3, 0.9, 3), rng.normal(0.0, 1.0, 3)
+        below, above = q < sup.lo, q > sup.hi
+        outside = below | above
+        s = np.where(outside, np.minimum(s + sup.ramp, 1.0), 0.0)
+        want = np.where(outside, sup.kp * (np.where(below, sup.lo, sup.hi) - q) - s * sup.kd * qd, 0.0)
+        got = sup.correction(q, qd)
+        assert got.tobytes() == want.tobytes() and sup.s.tobytes() == s.tobytes()
