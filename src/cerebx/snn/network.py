@@ -32,6 +32,16 @@ class StepSpikes:
     sub: np.ndarray
 
 
+def pack(inputs: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The inputs of consecutive steps (global fibre indices per step) as one int32 array and the offsets of
+    each step's part, what :meth:`Network.step_packed` takes."""
+    n = len(inputs)
+    flat = np.concatenate(inputs).astype(np.int32) if n else np.zeros(0, np.int32)
+    in_off = np.zeros(n + 1, dtype=np.int64)
+    in_off[1:] = np.cumsum([len(x) for x in inputs])
+    return flat, in_off
+
+
 class Network:
     """Flat-array spiking network (see :mod:`cerebx.snn.kernels` for the numerics).
 
@@ -284,10 +294,11 @@ class Network:
     def step_many(self, inputs: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """Several consecutive steps in one GIL-free call. Returns (spike indices, offsets): the
         spikes of step s are ``idx[off[s]:off[s + 1]]`` (same spikes as calling :meth:`step`)."""
-        n = len(inputs)
-        flat = np.concatenate(inputs).astype(np.int32) if n else np.zeros(0, np.int32)
-        in_off = np.zeros(n + 1, dtype=np.int64)
-        in_off[1:] = np.cumsum([len(x) for x in inputs])
+        return self.step_packed(*pack(inputs))
+
+    def step_packed(self, flat: np.ndarray, in_off: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`step_many` of inputs already packed (:func:`pack`)."""
+        n = len(in_off) - 1
         cap = n * self.out_idx.shape[0]
         if getattr(self, "_chunk_idx", None) is None or self._chunk_idx.shape[0] < cap:
             self._chunk_idx = np.zeros(cap, dtype=np.int32)

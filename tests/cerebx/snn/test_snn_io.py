@@ -216,13 +216,13 @@ def test_cf_pathway_delay_shorter_than_mf(pipeline):
     ctrl = make_ctrl(pathway_delay_ms=50.0, cf_pathway_delay_ms=40.0, pipeline=pipeline)
     ctrl.reset(np.random.default_rng(0))
     seen: list[np.ndarray] = []
-    step_many = ctrl.net.step_many
+    step_packed = ctrl.net.step_packed
 
-    def spy(inputs):
-        seen.extend(np.asarray(a) for a in inputs)
-        return step_many(inputs)
+    def spy(flat, in_off):
+        seen.extend(flat[a:b] for a, b in zip(in_off[:-1], in_off[1:]))
+        return step_packed(flat, in_off)
 
-    ctrl.net.step_many = spy
+    ctrl.net.step_packed = spy
     for k in range(60):  # samples only at ticks 0-9, with a large error (CF near 10 Hz)
         t = k * 0.002
         q, qd = np.full(6, 0.2), np.zeros(6)

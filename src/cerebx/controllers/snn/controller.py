@@ -32,7 +32,7 @@ import time
 import weakref
 from collections import deque
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -43,7 +43,7 @@ from cerebx.controllers.snn.schema import SNNController
 from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
 from cerebx.snn.decoder import DCNDecoder, chunk_outputs, chunk_select
-from cerebx.snn.network import Network
+from cerebx.snn.network import Network, pack
 from cerebx.snn.weight_stats import weight_stats
 
 STEP_S = 0.002
@@ -54,6 +54,17 @@ _NONE = np.zeros(0, np.int64)  # no population recorded
 def encoder_ranges(cfg: SNNController, n_joints: int, task: Any = None) -> tuple[np.ndarray, np.ndarray]:
     """(lo, hi) of shape (n_joints, 4) for the MF signals q_d, q, qd_d, qd."""
     return mf_ranges(cfg.mf.ranges, n_joints, task)
+
+
+class Chunk(NamedTuple):
+    """A simulated chunk: its first step; per step the output (a torque or [M_ag, M_at]) and the DCN spike
+    count; the recorded populations' spikes (:func:`~cerebx.snn.decoder.chunk_select`), None when none are."""
+
+    first: int
+    out: np.ndarray
+    counts: np.ndarray
+    local: np.ndarray | None
+    ends: np.ndarray | None
 
 
 class NetworkThread:
@@ -163,17 +174,21 @@ class SNNControllerImpl(Controller):
         self.last_error = np.zeros(self.n_ctrl)
 
     # ------------------------------------------------------------------ network execution
-    def _simulate(self, inputs: list[np.ndarray], first_step: int) -> list[tuple]:
-        """Run the network over ``inputs`` (one GIL-free call); per step: (time, output, DCN spike
-        count, recorded spikes), the output a torque or [M_ag, M_at]. Decoding is done for the whole
-        chunk at once. With spike propagation shed the network is not run and the DCN stay silent."""
-        n = len(inputs)
+    def _simulate(self, inputs: list[np.ndarray], first_step: int) -> Chunk:
+        """Run the network over ``inputs`` (one GIL-free call) and decode its output."""
+        return self._simulate_packed(*pack(inputs), first_step)
+
+    def _simulate_packed(self, flat: np.ndarray, in_off: np.ndarray, first_step: int) -> Chunk:
+        """Run the network over packed inputs (:func:`~cerebx.snn.network.pack`) and decode the whole chunk at
+        once. With spike propagation shed the network is not run and the DCN stay silent. This is what the
+        network thread runs: its work is compiled code without the interpreter lock (interpreted work there
+        holds up the loop's thread, which needs the lock back after every MuJoCo step); cutting the result
+        into steps is left to :meth:`_absorb`."""
+        n = len(in_off) - 1
         if self._shed >= 2:
             self.net.t_sub += self.net.n_sub * n
-            return [((first_step + i) * STEP_S, np.zeros(self.width), 0, None) for i in range(n)]
-        idx, off = self.net.step_many(inputs)
-        # decoding and the split of recorded spikes run in compiled code without the interpreter lock: on the
-        # network thread, interpreted work holds up the loop's thread whenever it needs the lock back
+            return Chunk(first_step, np.zeros((n, self.width)), np.zeros(n, np.int64), None, None)
+        idx, off = self.net.step_packed(flat, in_off)
         recording = bool(self.recorder is not None and self._shed < 3 and self.record)
         rec_lo, rec_hi = (self._record_lo, self._record_hi) if recording else (_NONE, _NONE)
         if self.muscles:
@@ -187,36 +202,38 @@ class SNNControllerImpl(Controller):
             taus, counts, local, ends = chunk_outputs(idx, off, self.sl_dcn.start, self.sl_dcn.stop,
                                                       self.decoder.per_joint, self.decoder.sign, self._alpha,
                                                       rec_lo, rec_hi)
-        per_step: list[dict[str, np.ndarray] | None] = [None] * n
-        if recording:
-            per_step = [{} for _ in range(n)]
-            start = 0
-            for name, pop_ends in zip(self.record, ends.tolist()):
-                for i, end in enumerate(pop_ends):
-                    per_step[i][name] = local[start:end]
-                    start = end
-        counts = counts.tolist()
-        return [((first_step + i) * STEP_S, taus[i], counts[i], per_step[i]) for i in range(n)]
+        return Chunk(first_step, taus, counts, local if recording else None, ends if recording else None)
 
-    def _absorb(self, results: list[tuple]) -> None:
-        for t, tau, n_dcn, rec in results:
-            self._ready.append(tau)
-            self._dcn_spikes += n_dcn
-            if rec is not None:
-                for name, sel in rec.items():
-                    self.recorder.spikes(f"/spikes/{name}", t, sel)
-        self._net_step += len(results)
+    def _absorb(self, chunk: Chunk) -> None:
+        """Queue a simulated chunk's outputs and log its recorded spikes (``_net_step`` is advanced by the
+        caller, which may launch the next chunk first)."""
+        self._ready.extend(chunk.out)
+        self._dcn_spikes += int(chunk.counts.sum())
+        if chunk.local is not None:
+            local, start = chunk.local, 0
+            for name, pop_ends in zip(self.record, chunk.ends.tolist()):
+                topic = f"/spikes/{name}"
+                for i, end in enumerate(pop_ends):
+                    self.recorder.spikes(topic, (chunk.first + i) * STEP_S, local[start:end])
+                    start = end
+
+    def _run_now(self) -> None:
+        """Simulate the next pending input on this thread."""
+        chunk = self._simulate([self._pending.popleft()], self._net_step)
+        self._net_step += 1
+        self._absorb(chunk)
 
     def _launch(self) -> None:
-        """Hand the next chunk of pending inputs to the network thread."""
-        chunk = [self._pending.popleft() for _ in range(self.chunk)]
-        first = self._net_step  # no chunk is in flight when a new one starts
+        """Hand the next chunk of pending inputs to the network thread (packed here, so that the thread's
+        work is compiled code from the start)."""
+        flat, in_off = pack([self._pending.popleft() for _ in range(self.chunk)])
+        first = self._net_step  # the chunks before it are all collected
         clock = phase_clock.active()
 
-        def work() -> list[tuple]:
+        def work() -> Chunk:
             t0, c0 = (time.perf_counter(), time.thread_time()) if clock is not None else (0.0, 0.0)
             try:
-                return self._simulate(chunk, first)
+                return self._simulate_packed(flat, in_off, first)
             finally:
                 if clock is not None:
                     clock.add_background("network", time.perf_counter() - t0, time.thread_time() - c0)
@@ -226,13 +243,18 @@ class SNNControllerImpl(Controller):
         self._thread.submit(work)
         self._in_flight = True
 
-    def _join(self) -> None:
+    def _join(self, launch_next: bool = False) -> None:
+        """Collect the chunk in flight; with ``launch_next`` hand the next one to the network thread before
+        logging this one's spikes, so that the thread does not wait for the logging."""
         if not self._in_flight:
             return
         self._in_flight = False
         with phase_clock.charge("wait"):
-            results = self._thread.result()  # an exception of the network thread is raised here
-        self._absorb(results)
+            chunk = self._thread.result()  # an exception of the network thread is raised here
+        self._net_step += len(chunk.counts)
+        if launch_next and len(self._pending) >= self.chunk:
+            self._launch()
+        self._absorb(chunk)
 
     def __getstate__(self) -> dict:
         """For checkpoints (pickled between trials, when no chunk is in flight): the network thread is not
@@ -245,13 +267,13 @@ class SNNControllerImpl(Controller):
     def _advance(self) -> None:
         """Make sure this tick's torque is ready; in pipeline mode keep one chunk in flight."""
         if not self.pipeline:
-            self._absorb(self._simulate([self._pending.popleft()], self._net_step))
+            self._run_now()
             return
         while not self._ready:
             if self._in_flight:
-                self._join()
+                self._join(launch_next=True)
             else:
-                self._absorb(self._simulate([self._pending.popleft()], self._net_step))
+                self._run_now()
         if not self._in_flight and len(self._pending) >= self.chunk:
             self._launch()
 
