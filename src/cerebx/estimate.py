@@ -18,8 +18,8 @@ state holds 4 bytes per plastic synapse and ~44 bytes per neuron before compress
 147.9 MB raw, 0.7 MB of weights once zlib-compressed after 2 trials, because most PF-PC weights stay at
 their initial value); it is written compressed. Wall
 time uses the real-time factors of runs with their default recording on a quiet machine (Baxter + PD
-30x; a ``full``-network learning run 16x, measured 2026-11-24 with ``cerebx bench``'s learning runs,
-i.e. 0.033 s + 0.81 ns per plastic synapse per simulated second); a shared machine is slower.
+30x; a ``full``-network learning run 22x, measured 2026-11-24 with ``cerebx bench``'s learning runs (21.2x
+and 22.5x), i.e. 0.033 s + 0.36 ns per plastic synapse per simulated second); a shared machine is slower.
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ BYTES_PER_S_SPIKES = 32e3
 STATE_BYTES_PER_PLASTIC = 4.0
 STATE_BYTES_PER_NEURON = 44.0
 WALL_PER_SIM_S = 0.033
-WALL_PER_SIM_S_PER_PLASTIC = 0.81e-9
+WALL_PER_SIM_S_PER_PLASTIC = 0.36e-9
 DISK_MARGIN = 1.2
 """A run is refused when its estimate times this margin exceeds the free space of its folder's disk."""
 

@@ -264,6 +264,16 @@ class SNNControllerImpl(Controller):
         state["_thread"] = None
         return state
 
+    def __setstate__(self, state: dict) -> None:
+        """A checkpoint of this code, or of the code before the network thread's queues (which kept an
+        executor and the chunk's future instead, both None between trials): the derived arrays are rebuilt."""
+        state = {k: v for k, v in state.items() if k not in ("_worker", "_pool")}
+        self.__dict__.update(state)
+        self._in_flight, self._thread = False, None
+        self._alpha = np.ascontiguousarray(np.broadcast_to(self.decoder.alpha, (self.n_ctrl,)), dtype=np.float64)
+        self._record_lo = np.array([sl.start for sl in self.record.values()], np.int64)
+        self._record_hi = np.array([sl.stop for sl in self.record.values()], np.int64)
+
     def _advance(self) -> None:
         """Make sure this tick's torque is ready; in pipeline mode keep one chunk in flight."""
         if not self.pipeline:
