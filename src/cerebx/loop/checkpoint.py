@@ -244,6 +244,8 @@ class Checkpoint:
             _write_file(run_dir / self.file, _whole_parts(self.whole.values()))
         elif self.changes:
             _write_file(run_dir / JOURNAL, self._journal(seq))
+        if self.whole is not None or self.changes:
+            _fsync_dir(run_dir)  # the arrays file's or the journal's name is on the disk before the pickle names it
         _write_file(run_dir / CHECKPOINT, [json.dumps(self.head).encode() + b"\n", self.stream])
         _fsync_dir(run_dir)  # the renames are on the disk too
         if self.whole is None and self.changes:
