@@ -110,7 +110,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             bar = _progress(cfg, cfg.trials)
             if bar is not None:
                 bar.update(loop.trials_done)
-            summary_written = -SUMMARY_EVERY_S
+            summary_written = float("-inf")  # the first trial is always written
             for trial in range(loop.trials_done, cfg.trials):
                 m = loop.run_trial(trial)
                 if resume.due(loop):

@@ -138,7 +138,6 @@ class SNNControllerImpl(Controller):
         self._rng_seed = ctx.rng("controller.snn.cf")
         self.cf = registry.encoders.build(cfg.cf, nj, n_cf // nj, cfg.error.kpos, cfg.error.kvel, self._rng_seed)
         self.decoder = DCNDecoder(cfg.decoder.alpha_Nm_per_spike, nj, n_dcn // nj)
-        self._alpha = np.ascontiguousarray(np.broadcast_to(self.decoder.alpha, (nj,)), dtype=np.float64)
         self.muscles = cfg.output == "agonist_antagonist"
         self.width = 2 * nj if self.muscles else nj  # values per step in the output FIFO ([ag, at] or tau)
         self.full_scale = np.asarray(cfg.decoder.full_scale(nj), float)  # M = 1 (agonist_antagonist output)
@@ -147,8 +146,7 @@ class SNNControllerImpl(Controller):
         self._shed = 0  # real-time load shedding level (link/shedding.py); 0: everything runs
         self._summaries = True  # periodic weight summaries (left out in wall-clock runs)
         self.record = {name: self.net.index(name) for name in cfg.record_spikes}
-        self._record_lo = np.array([sl.start for sl in self.record.values()], np.int64)
-        self._record_hi = np.array([sl.stop for sl in self.record.values()], np.int64)
+        self._derive_kernel_args()
         self.fingerprint = self.net.fingerprint
         self.config_hash = hashlib.sha256(
             json.dumps([self.net_cfg.model_dump(mode="json"), cfg.model_dump(mode="json")],
@@ -270,6 +268,10 @@ class SNNControllerImpl(Controller):
         state = {k: v for k, v in state.items() if k not in ("_worker", "_pool")}
         self.__dict__.update(state)
         self._in_flight, self._thread = False, None
+        self._derive_kernel_args()
+
+    def _derive_kernel_args(self) -> None:
+        """The decoder's gains and the recorded populations' bounds as the chunk kernels take them."""
         self._alpha = np.ascontiguousarray(np.broadcast_to(self.decoder.alpha, (self.n_ctrl,)), dtype=np.float64)
         self._record_lo = np.array([sl.start for sl in self.record.values()], np.int64)
         self._record_hi = np.array([sl.stop for sl in self.record.values()], np.int64)
