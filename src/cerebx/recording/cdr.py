@@ -1,10 +1,13 @@
-"""Joint states as ROS 2 ``sensor_msgs/msg/JointState`` in CDR, the binary encoding Foxglove reads natively
-(plots, and the 3-D panel's robot model).
+"""Joint states as ROS 2 ``sensor_msgs/msg/JointState`` and spikes as ``cerebx_msgs/msg/Spikes``, both in CDR, the
+binary encoding Foxglove reads natively (plots, the 3-D panel's robot model, the raw messages).
 
 The two joint-state channels are logged every control step. As JSON (``foxglove.JointStates``-shaped, the
 format of older runs) a message was ~830 bytes of text: formatting 21 floats and compressing
 the text cost the loop's thread ~3.9 us a message. In CDR it is 300 bytes written in place into a template,
-~1.8 us. Everything else stays JSON.
+~1.8 us. The spikes of a recorded population are logged every step too: ~150 DCN indices a step were ~740
+bytes of JSON, formatted and logged on the loop's thread (~8 us a step). In CDR they are encoded for a whole
+chunk of steps at once on the network's thread (``snn/decoder.py: chunk_spike_messages``), and the loop's
+thread only logs them. Everything else stays JSON.
 
 The layout (XCDR1, little endian, after the 4-byte encapsulation header; every value aligned to its size
 from the start of the body)::
@@ -14,6 +17,12 @@ from the start of the body)::
 
 :func:`decode_joint_state` reads it back into the dict the JSON messages held (``timestamp``, ``joints``: name,
 position, velocity, effort), so every reader of a log sees the same values whichever way it was written.
+A spikes message::
+
+    float64 t, uint32[] indices
+
+is 16 + 4 n bytes (the header, ``t``, the count, the indices); :func:`decode_spikes` gives the JSON messages'
+dict (``t``, ``indices``).
 """
 
 from __future__ import annotations
@@ -42,7 +51,17 @@ uint32 nanosec
 """
 """The message definition as ROS 2 tools write it into MCAP schemas (encoding ``ros2msg``)."""
 
+SPIKES = "cerebx_msgs/msg/Spikes"
+SPIKES_DEFINITION = """\
+# the local indices of a population's cells that fired in the 2 ms step at t (s)
+float64 t
+uint32[] indices
+"""
+
 _HEADER = b"\x00\x01\x00\x00"  # CDR, little endian
+HEADER_WORD = 256
+"""The encapsulation header as one little-endian uint32 (for encoders that write 32-bit words)."""
+_SPIKES_HEAD = struct.Struct("<dI")
 _STAMP = struct.Struct("<iI")
 _U32 = struct.Struct("<I")
 
@@ -139,3 +158,20 @@ def decode_joint_state() -> Callable[[bytes | memoryview], dict[str, Any]]:
                            for a, b, c, d in zip(names, p, v, e)]}
 
     return decode
+
+
+def encode_spikes(t_s: float, indices: np.ndarray) -> bytes:
+    """One spikes message: the cells (local indices, non-negative) that fired in the step at ``t_s``."""
+    idx = np.asarray(indices)
+    return _HEADER + _SPIKES_HEAD.pack(t_s, idx.size) + idx.astype("<u4").tobytes()
+
+
+def decode_spikes(data: bytes | memoryview) -> dict[str, Any]:
+    """A spikes message as the dict the JSON messages held: ``t`` (s) and ``indices`` (a list of ints)."""
+    data = bytes(data)
+    if data[:4] != _HEADER:
+        raise ValueError(f"{SPIKES}: not little-endian CDR")
+    t, n = _SPIKES_HEAD.unpack_from(data, 4)
+    if len(data) != 16 + 4 * n:
+        raise ValueError(f"{SPIKES}: {len(data)} bytes for {n} indices")
+    return {"t": t, "indices": np.frombuffer(data, "<u4", n, 16).tolist()}

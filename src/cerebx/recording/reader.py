@@ -15,7 +15,7 @@ from mcap.stream_reader import StreamReader
 
 from cerebx import runfiles
 from cerebx.errors import CerebxError
-from cerebx.recording.cdr import JOINT_STATE, decode_joint_state
+from cerebx.recording.cdr import JOINT_STATE, SPIKES, decode_joint_state, decode_spikes
 from cerebx.recording.pair import merge, robot_log
 from cerebx.recording.segments import segments
 from cerebx.recording.summary import read_summary
@@ -29,8 +29,8 @@ def _short(err: Exception) -> str:
 
 
 class Decoders(DecoderFactory):
-    """JSON channels decode with json.loads (mcap ships no JSON decoder), the joint states' CDR with
-    ``recording/cdr.py`` into the shape their JSON messages had."""
+    """JSON channels decode with json.loads (mcap ships no JSON decoder), the joint states' and spikes' CDR
+    with ``recording/cdr.py`` into the shape their JSON messages had."""
 
     def decoder_for(self, message_encoding: str, schema: Any):
         return _decoder(message_encoding, schema.name if schema is not None else None)
@@ -41,6 +41,8 @@ def _decoder(message_encoding: str, schema_name: str | None) -> Any:
         return json.loads
     if message_encoding == "cdr" and schema_name == JOINT_STATE:
         return decode_joint_state()
+    if message_encoding == "cdr" and schema_name == SPIKES:
+        return decode_spikes
     return None
 
 

@@ -1,7 +1,8 @@
 """Writes a run's MCAP file through foxglove-sdk (a Rust MCAP writer, fast enough for every 2 ms
-step). The joint channels are ROS 2 ``sensor_msgs/msg/JointState`` messages in CDR (``recording/cdr.py``),
-which Foxglove reads natively; every other channel is JSON (encoded with orjson) with a JSON Schema. Older
-runs have JSON joint states (a ``foxglove.JointStates``-shaped schema); the readers give both the same shape.
+step). The joint channels are ROS 2 ``sensor_msgs/msg/JointState`` messages and the spikes
+``cerebx_msgs/msg/Spikes``, both in CDR (``recording/cdr.py``), which Foxglove reads natively; every other
+channel is JSON (encoded with orjson) with a JSON Schema. Older runs have JSON joint states (a
+``foxglove.JointStates``-shaped schema) and JSON spikes (``cerebx.Spikes``); the readers give both the same shape.
 
 Channels (units SI; time stamps are simulated time):
 
@@ -17,7 +18,7 @@ topic                      schema                 content
                                                   this step's messages (r2c_ms, c2r_ms)
 /trial_metrics             cerebx.TrialMetrics    per-trial MAE per joint, velocity MAE, dtau, task variant
 /events                    cerebx.PlantEvent      plant events as they happen
-/spikes/<population>       cerebx.Spikes          neuron indices that fired in the step
+/spikes/<population>       cerebx_msgs/Spikes     time (s) and local indices of the cells that fired in the step
 /weights                   cerebx.WeightSummary   per-trial plastic-weight statistics
 /task/cartesian_path       cerebx.CartesianPath   desired Cartesian path of the first trial
 =========================  =====================  ===============================================
@@ -34,7 +35,7 @@ leaves a valid file.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -43,7 +44,7 @@ import numpy as np
 import orjson
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
-from cerebx.recording.cdr import JOINT_STATE, JOINT_STATE_DEFINITION, JointStateEncoder
+from cerebx.recording.cdr import JOINT_STATE, JOINT_STATE_DEFINITION, SPIKES, SPIKES_DEFINITION, JointStateEncoder
 
 _NUMS = {"type": "array", "items": {"type": "number"}}
 
@@ -62,8 +63,6 @@ SCHEMAS: dict[str, dict] = {
     },
     "cerebx.PlantEvent": {"type": "object", "properties": {"t": {"type": "number"}, "kind": {"type": "string"},
                                                            "params": {"type": "object"}}},
-    "cerebx.Spikes": {"type": "object", "properties": {"t": {"type": "number"}, "indices": {
-        "type": "array", "items": {"type": "integer"}}}},
     "cerebx.WeightSummary": {"type": "object", "properties": {"trial": {"type": "integer"}}},
     "cerebx.CartesianPath": {"type": "object", "properties": {"x": _NUMS, "y": _NUMS, "z": _NUMS}},
 }
@@ -88,7 +87,7 @@ def register_schema(name: str, schema: dict) -> None:
         raise ValueError(f"schema {name!r} is already registered with another definition")
 
 
-CDR_SCHEMAS: dict[str, str] = {JOINT_STATE: JOINT_STATE_DEFINITION}
+CDR_SCHEMAS: dict[str, str] = {JOINT_STATE: JOINT_STATE_DEFINITION, SPIKES: SPIKES_DEFINITION}
 """Schemas of the channels written in CDR (ROS 2 message definitions)."""
 
 
@@ -161,8 +160,18 @@ class Recorder:
         ns = _ns(t_s)
         self._channel(topic, JOINT_STATE)(enc.encode(ns, q, qd, effort), ns)
 
-    def spikes(self, topic: str, t_s: float, indices: np.ndarray) -> None:
-        self.write(topic, "cerebx.Spikes", t_s, {"t": t_s, "indices": np.asarray(indices)})
+    def spike_messages(self, topics: Sequence[str], times_s: Sequence[float], data: bytes,
+                       starts: Sequence[int]) -> None:
+        """Log a chunk's spikes messages, encoded already (:func:`~cerebx.recording.spike_chunks.chunk_spike_messages`):
+        message k = p * len(times_s) + s, ``data[starts[k]:starts[k + 1]]``, is population ``topics[p]``'s
+        step s, logged at ``times_s[s]``."""
+        stamps = [_ns(t) for t in times_s]
+        k = 0
+        for topic in topics:
+            log = self._channel(topic, SPIKES)
+            for ns in stamps:
+                log(data[starts[k]:starts[k + 1]], ns)
+                k += 1
 
     def metadata(self, name: str, data: dict[str, str]) -> None:
         self._w.write_metadata(name, {k: str(v) for k, v in data.items()})

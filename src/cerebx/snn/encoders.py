@@ -22,13 +22,15 @@ STEP_S = 0.002
 
 
 @numba.njit(cache=True)
-def _mf_active(x, lo, hi, step, half_width, F, out):  # pragma: no cover - numba
-    """Box coding of x (n_joints, 4) into ``out``; returns the number of active fibres."""
+def _mf_active(q_des, q, qd_des, qd, lo, hi, step, half_width, F, out):  # pragma: no cover - numba
+    """Box coding of the four signals of the first n_joints = ``lo.shape[0]`` joints into ``out``; returns the
+    number of active fibres."""
     n = 0
-    nj = x.shape[0]
+    nj = lo.shape[0]
     for j in range(nj):
         for s in range(4):
-            v = min(max(x[j, s], lo[j, s]), hi[j, s])
+            x = q_des[j] if s == 0 else q[j] if s == 1 else qd_des[j] if s == 2 else qd[j]
+            v = min(max(x, lo[j, s]), hi[j, s])
             b = int(np.rint((v - lo[j, s]) / step[j, s]))
             b = min(max(b, 0), F - 1)
             base = (j * 4 + s) * F
@@ -45,17 +47,30 @@ def _mf_active(x, lo, hi, step, half_width, F, out):  # pragma: no cover - numba
 
 
 @numba.njit(cache=True)
+def _cf_error(q_des, q, qd_des, qd, kpos, kvel):  # pragma: no cover - numba
+    """kpos (q_des - q) + kvel (qd_des - qd) over the first kpos.size joints, the array form's operations in
+    its order (the same doubles)."""
+    e = np.empty(kpos.size)
+    for j in range(kpos.size):
+        e[j] = kpos[j] * (q_des[j] - q[j]) + kvel[j] * (qd_des[j] - qd[j])
+    return e
+
+
+@numba.njit(cache=True)
 def _cf_step(e, u, centres, width, r_min, r_max, max_burst, half, burst_left, out):  # pragma: no cover
     """One 2 ms step of the CF encoder: new events (u < rate * dt) on the side the error's sign
     selects, bursts of floor(|e| / c_k) spikes; returns the number of fibres spiking now."""
     per_joint = 2 * half
+    # no rate the formula can give exceeds r_min + (r_max - r_min) (rounding is monotone and the tanh term is
+    # at most 1): a draw at or above that rate's probability makes no event, whatever the error
+    u_never = max(r_min, r_min + (r_max - r_min)) * 0.002
     n = 0
     for j in range(e.shape[0]):
         x = abs(e[j])
         side = 0 if e[j] > 0 else half
         for k in range(half):
             i = j * per_joint + side + k
-            if burst_left[i] == 0:
+            if burst_left[i] == 0 and u[i] < u_never:
                 rate = r_min + (r_max - r_min) * (np.tanh((x - centres[k]) / width) + 1.0) / 2.0
                 if u[i] < rate * 0.002:
                     b = int(np.floor(x / centres[k]))
@@ -67,6 +82,12 @@ def _cf_step(e, u, centres, width, r_min, r_max, max_burst, half, burst_left, ou
                 n += 1
                 burst_left[i] -= 1
     return n
+
+
+def _require(what: str, n_joints: int, *signals: np.ndarray) -> None:
+    """The compiled encoders read the first n_joints values of each signal: fewer is an error."""
+    if min(map(len, signals)) < n_joints:
+        raise ValueError(f"{what}: {n_joints} joints, got signals of {[len(x) for x in signals]} values")
 
 
 class MossyEncoder:
@@ -81,8 +102,7 @@ class MossyEncoder:
         self.half_width = self.step * cfg.width_factor
         self.n_joints = self.lo.shape[0]
         self.base = (np.arange(self.n_joints)[:, None] * 4 + np.arange(4)[None, :]) * self.F
-        self._x = np.zeros((self.n_joints, 4))
-        self._out = np.zeros(self.n_joints * 4 * 3, dtype=np.int64)
+        self._out = np.zeros(self.n_joints * 4 * 3, dtype=np.int32)
 
     @property
     def n_fibers(self) -> int:
@@ -90,10 +110,9 @@ class MossyEncoder:
 
     def active(self, q_des, q, qd_des, qd) -> np.ndarray:
         """Local indices of the fibres firing this step (one per signal; two only on an exact
-        box boundary, as in the original), in increasing order."""
-        nj, x = self.n_joints, self._x
-        x[:, 0], x[:, 1], x[:, 2], x[:, 3] = q_des[:nj], q[:nj], qd_des[:nj], qd[:nj]
-        n = _mf_active(x, self.lo, self.hi, self.step, self.half_width, self.F, self._out)
+        box boundary, as in the original), in increasing order (int32)."""
+        _require("mossy encoder", self.n_joints, q_des, q, qd_des, qd)
+        n = _mf_active(q_des, q, qd_des, qd, self.lo, self.hi, self.step, self.half_width, self.F, self._out)
         return self._out[:n].copy()
 
 
@@ -112,11 +131,13 @@ class ClimbingEncoder:
         self.width = (cfg.center_max - cfg.center_min) / max(n - 1, 1)
         self.rng = rng
         self.burst_left = np.zeros(n_joints * per_joint, dtype=np.int64)
-        self._out = np.zeros(n_joints * per_joint, dtype=np.int64)
+        self._out = np.zeros(n_joints * per_joint, dtype=np.int32)
+        self._u = np.zeros(n_joints * per_joint)
 
     def error(self, q_des, q, qd_des, qd) -> np.ndarray:
-        n = self.n_joints
-        return self.kpos * (q_des[:n] - q[:n]) + self.kvel * (qd_des[:n] - qd[:n])
+        """kpos (q_des - q) + kvel (qd_des - qd) of the first n_joints joints."""
+        _require("climbing encoder", self.n_joints, q_des, q, qd_des, qd)
+        return _cf_error(q_des, q, qd_des, qd, self.kpos, self.kvel)
 
     def rates(self, e: np.ndarray) -> np.ndarray:
         """Firing rate (Hz) of every fibre, shape (n_joints, per_joint); the silent side is 0."""
@@ -142,10 +163,16 @@ class ClimbingEncoder:
         per step keeps the random stream independent of the error.
         """
         c = self.cfg
-        u = self.rng.random(self.burst_left.shape[0])
+        u = self.rng.random(out=self._u)  # the same draws as rng.random(n), into one array kept
         n = _cf_step(np.ascontiguousarray(e, dtype=np.float64), u, self.centres, self.width, c.rate_min_hz,
                      c.rate_max_hz, c.max_burst, self.half, self.burst_left, self._out)
         return self._out[:n].copy()
 
     def reset(self) -> None:
         self.burst_left[:] = 0
+
+    def __setstate__(self, state: dict) -> None:
+        """A checkpoint of the code before the draws' array was kept has none."""
+        self.__dict__.update(state)
+        if "_u" not in state:
+            self._u = np.zeros(self.burst_left.shape[0])

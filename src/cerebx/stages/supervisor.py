@@ -5,11 +5,29 @@ from __future__ import annotations
 
 from typing import Any
 
+import numba
 import numpy as np
 
 from cerebx.schema.stages import SupervisorConfig
 from cerebx.signals import Frame
 from cerebx.stages.base import Stage
+
+
+@numba.njit(cache=True, boundscheck=False)
+def _correct(q, qd, lo, hi, kp, kd, ramp, s, tau):  # pragma: no cover - numba
+    """The rule joint by joint, ``s`` and ``tau`` written in place: the same operations in the same order as
+    the array form ``where(outside, kp (bound - q) - s kd qd, 0)``, so the same doubles."""
+    for j in range(kp.size):
+        if q[j] < lo[j]:
+            bound = lo[j]
+        elif q[j] > hi[j]:
+            bound = hi[j]
+        else:
+            s[j] = 0.0
+            tau[j] = 0.0
+            continue
+        s[j] = min(s[j] + ramp, 1.0)
+        tau[j] = kp[j] * (bound - q[j]) - s[j] * kd[j] * qd[j]
 
 
 class Supervisor(Stage):
@@ -18,7 +36,7 @@ class Supervisor(Stage):
     name = "supervisor"
 
     def __init__(self, cfg: SupervisorConfig, lo: np.ndarray, hi: np.ndarray):
-        self.kp, self.kd = np.asarray(cfg.kp), np.asarray(cfg.kd)
+        self.kp, self.kd = np.asarray(cfg.kp, float), np.asarray(cfg.kd, float)
         self.ramp = cfg.ramp_per_step
         self.lo, self.hi = lo - cfg.margin_rad, hi + cfg.margin_rad
         self.s = np.zeros_like(self.kp)
@@ -27,14 +45,13 @@ class Supervisor(Stage):
         self.tau = np.zeros_like(self.kp)
 
     def correction(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-        below, above = q < self.lo, q > self.hi
-        outside = below | above
-        if not outside.any():  # every joint inside its bounds, as on most ticks: what the full rule gives
-            self.s = np.zeros(self.kp.shape)
-            return np.zeros(self.kp.shape)
-        self.s = np.where(outside, np.minimum(self.s + self.ramp, 1.0), 0.0)
-        bound = np.where(below, self.lo, self.hi)
-        return np.where(outside, self.kp * (bound - q) - self.s * self.kd * qd, 0.0)
+        """The correction for this tick (a new array), the ramp advanced. One compiled call: as array
+        operations the rule cost the loop ~6 us a tick."""
+        if q.shape != self.kp.shape or qd.shape != self.kp.shape:
+            raise ValueError(f"supervisor: {len(self.kp)} joints, got q {q.shape} and qd {qd.shape}")
+        tau = np.empty(self.kp.shape)
+        _correct(q, qd, self.lo, self.hi, self.kp, self.kd, self.ramp, self.s, tau)
+        return tau
 
     def reset(self, rng: np.random.Generator) -> None:
         self.s = np.zeros_like(self.kp)

@@ -66,7 +66,7 @@ def test_snn_controller_is_a_shedding_target(load):
     t_sub = net.t_sub
     out = target._simulate([np.zeros(0, np.int32)] * 3, 0)
     assert net.t_sub == t_sub + 3 * net.n_sub and out.out.shape[0] == 3 and not out.out.any()
-    assert not out.counts.any() and out.local is None
+    assert not out.counts.any() and out.spikes is None
     target.shed(0)
     assert net.learn is True
     assert shed_targets(build_components(load(["+task=circle", "controller=pd", "trials=1"])).brain) == []

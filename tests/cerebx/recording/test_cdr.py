@@ -1,6 +1,7 @@
-"""Joint states in CDR: what the encoder writes is a valid ``sensor_msgs/msg/JointState`` for the ROS 2
-decoder the mcap project maintains (the one Foxglove's own stack mirrors), and cerebx's reader gives the
-values back in the shape the JSON joint states had."""
+"""Joint states and spikes in CDR: what the encoders write is a valid ``sensor_msgs/msg/JointState`` and
+``cerebx_msgs/msg/Spikes`` for the ROS 2 decoder the mcap project maintains (the one Foxglove's own stack
+mirrors), the spikes a network chunk encodes in compiled code are the same bytes message by message, and
+cerebx's reader gives the values back in the shape the JSON messages had."""
 
 from __future__ import annotations
 
@@ -8,9 +9,20 @@ import numpy as np
 import pytest
 from mcap.records import Schema
 
-from cerebx.recording.cdr import JOINT_STATE, JOINT_STATE_DEFINITION, JointStateEncoder, decode_joint_state
+from cerebx.recording.cdr import (
+    JOINT_STATE,
+    JOINT_STATE_DEFINITION,
+    SPIKES,
+    SPIKES_DEFINITION,
+    JointStateEncoder,
+    decode_joint_state,
+    decode_spikes,
+    encode_spikes,
+)
 from cerebx.recording.reader import read_messages
 from cerebx.recording.recorder import Recorder
+from cerebx.recording.spike_chunks import chunk_spike_messages
+from cerebx.snn.decoder import chunk_select
 
 mcap_ros2 = pytest.importorskip("mcap_ros2.decoder")
 
@@ -18,8 +30,8 @@ NAMES = [("left_s0", "left_s1", "left_e0", "left_e1", "left_w0", "left_w1", "lef
          ("shoulder", "ellbow\u00e9", "w"), ()]
 
 
-def reference(data: bytes):
-    schema = Schema(id=1, name=JOINT_STATE, encoding="ros2msg", data=JOINT_STATE_DEFINITION.encode())
+def reference(data: bytes, name: str = JOINT_STATE, definition: str = JOINT_STATE_DEFINITION):
+    schema = Schema(id=1, name=name, encoding="ros2msg", data=definition.encode())
     return mcap_ros2.DecoderFactory().decoder_for("cdr", schema)(data)
 
 
@@ -71,3 +83,61 @@ def test_a_run_log_reads_back_with_fewer_values_than_names(tmp_path):
 def test_a_damaged_message_is_refused():
     with pytest.raises(ValueError, match="CDR"):
         decode_joint_state()(b"\x01\x00\x00\x00" + bytes(40))
+
+
+@pytest.mark.parametrize("indices", [[], [0], [3, 17, 17, 4_000_000_000], list(range(300))])
+def test_the_ros2_decoder_reads_a_spikes_message(indices):
+    data = encode_spikes(123.456, np.array(indices, np.int64))
+    msg = reference(data, SPIKES, SPIKES_DEFINITION)
+    assert msg.t == 123.456 and list(msg.indices) == indices
+    assert decode_spikes(data) == {"t": 123.456, "indices": indices}
+    with pytest.raises(ValueError, match="bytes for"):
+        decode_spikes(data[:-1] if indices else data + b"\0")
+
+
+def chunk(seed: int, n_steps: int, n_cells: int = 5000):
+    """A chunk's spikes as the network thread has them: global indices per step, ``off`` where each step starts."""
+    rng = np.random.default_rng(seed)
+    counts = rng.integers(0, 300, n_steps)
+    counts[::4] = 0  # silent steps too
+    off = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+    return rng.integers(0, n_cells, off[-1]).astype(np.int32), off
+
+
+@pytest.mark.parametrize("seed,n_steps,pops", [(0, 25, [(100, 400), (4000, 4900)]), (1, 1, [(0, 5000)]),
+                                                (2, 12, [(0, 0)]), (3, 7, [])])
+def test_a_chunk_encoded_at_once_is_each_step_encoded_alone(seed, n_steps, pops):
+    idx, off = chunk(seed, n_steps)
+    lo, hi = np.array([a for a, _ in pops], np.int64), np.array([b for _, b in pops], np.int64)
+    local, ends = chunk_select(idx, off, lo, hi)
+    first, step_s = 1234 + seed, 0.002
+    words, starts = chunk_spike_messages(local, ends.reshape(len(pops), n_steps), first, step_s)
+    data = words.tobytes()
+    assert len(starts) == len(pops) * n_steps + 1 and starts[-1] == len(data)
+    k = 0
+    for a, b in pops:
+        for s in range(n_steps):
+            step = idx[off[s]:off[s + 1]]
+            fired = step[(step >= a) & (step < b)] - a
+            assert data[starts[k]:starts[k + 1]] == encode_spikes((first + s) * step_s, fired)
+            k += 1
+
+
+def test_a_chunk_of_spikes_reads_back_per_population_and_step(tmp_path):
+    idx, off = chunk(4, 6)
+    lo, hi = np.array([0, 2500], np.int64), np.array([2500, 5000], np.int64)
+    local, ends = chunk_select(idx, off, lo, hi)
+    words, starts = chunk_spike_messages(local, ends, 10, 0.002)
+    rec = Recorder(tmp_path / "r.mcap")
+    times = [(10 + s) * 0.002 for s in range(6)]
+    rec.spike_messages(("/spikes/a", "/spikes/b"), times, words.tobytes(), starts.tolist())
+    rec.close()
+    got: dict[str, list] = {"/spikes/a": [], "/spikes/b": []}
+    for topic, t_ns, msg in read_messages(tmp_path / "r.mcap"):
+        assert t_ns == round(msg["t"] * 1e9)
+        got[topic].append(msg)
+    for topic, base in (("/spikes/a", 0), ("/spikes/b", 2500)):
+        assert [m["t"] for m in got[topic]] == times
+        for s, m in enumerate(got[topic]):
+            step = idx[off[s]:off[s + 1]]
+            assert m["indices"] == (step[(step >= base) & (step < base + 2500)] - base).tolist()

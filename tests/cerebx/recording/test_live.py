@@ -55,7 +55,9 @@ def test_live_run_serves_what_the_mcap_records(load, tmp_path):
     for topic, t, data in client.messages:
         got.setdefault(topic, []).append((t, data))
     for topic in sorted(SIGNALS | SCENE):
-        assert len(got.get(topic, ())) > 50, f"{topic}: {len(got.get(topic, ()))} messages received"
+        # the scene goes out at most display_hz times a wall-clock second: fewer frames the faster the run
+        least = 10 if topic in SCENE else 50
+        assert len(got.get(topic, ())) > least, f"{topic}: {len(got.get(topic, ()))} messages received"
         for t, data in got[topic]:
             assert recorded.get((topic, t)) == data, f"{topic} at {t} ns differs from run.mcap"
     # the scene is sent at the display rate, far fewer frames than the 2,000 steps
@@ -112,13 +114,13 @@ def test_a_client_that_stops_reading_loses_messages_and_never_blocks():
     try:
         assert client.connected.wait(10)
         payload = {"blob": "x" * 10_000}
-        view.log("/big", "cerebx.Spikes", 0.0, payload)  # advertise; the client subscribes
+        view.log("/big", "cerebx.WeightSummary", 0.0, payload)  # advertise; the client subscribes
         time.sleep(0.5)
         rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
         t0 = time.perf_counter()
         n = 20_000  # 200 MB if it were all queued
         for i in range(n):
-            view.log("/big", "cerebx.Spikes", i * 0.002, payload)
+            view.log("/big", "cerebx.WeightSummary", i * 0.002, payload)
         per_log_us = (time.perf_counter() - t0) / n * 1e6
         grown_mb = (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - rss0) / 1024
     finally:

@@ -12,6 +12,7 @@ from cerebx.controllers.base import ControlInput, SensorMsg
 from cerebx.controllers.snn.controller import SNNControllerImpl
 from cerebx.controllers.snn.schema import BoxEncoder, CFEncoder, SNNController
 from cerebx.errors import StateMismatchError
+from cerebx.recording.cdr import decode_spikes
 from cerebx.schema.controller import GivenRanges
 from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
 from cerebx.snn.encoders import ClimbingEncoder, MossyEncoder
@@ -64,6 +65,31 @@ def test_cf_rates_stay_between_1_and_10_hz_and_split_by_sign():
     enc2 = ClimbingEncoder(CFEncoder(), 1, 100, [1.0], [0.0], np.random.default_rng(1))
     n = sum(int((enc2.active(np.array([0.5])) == 0).sum()) for _ in range(50000))  # 100 s
     assert 6 * 10 * 100 * 0.85 < n < 6 * 10 * 100 * 1.15
+
+
+@pytest.mark.parametrize("cfg", [CFEncoder(), CFEncoder(rate_min_hz=0.0, rate_max_hz=400.0, max_burst=2)])
+def test_cf_steps_follow_the_rates_and_bursts_rule(cfg):
+    """The compiled step (which skips the rate of a fibre whose draw no rate could beat) against the rule
+    written with :meth:`rates` and :meth:`bursts`, fed the same draws: events, bursts, errors, joints."""
+    n_joints, per_joint = 3, 20
+    enc = ClimbingEncoder(cfg, n_joints, per_joint, [1.0, 2.0, 0.5], [0.1, 0.0, 0.2], np.random.default_rng(7))
+    draws = np.random.default_rng(7)
+    rng = np.random.default_rng(8)
+    left = np.zeros(n_joints * per_joint, np.int64)
+    fired_any = 0
+    for _ in range(3000):
+        q_des, q, qd_des, qd = rng.normal(0.0, 0.01, (4, n_joints))
+        e = enc.error(q_des, q, qd_des, qd)
+        assert e.tobytes() == (enc.kpos * (q_des - q) + enc.kvel * (qd_des - qd)).tobytes()
+        u = draws.random(left.size)
+        event = (left == 0) & (u < enc.rates(e).ravel() * 0.002)
+        left[event] = enc.bursts(e).ravel()[event]
+        want = np.flatnonzero(left > 0)
+        left[want] -= 1
+        got = enc.active(e)
+        assert got.tolist() == want.tolist()
+        fired_any += len(got)
+    assert fired_any > 100
 
 
 def test_dcn_decoder_counts_agonist_minus_antagonist():
@@ -140,8 +166,14 @@ def test_controller_records_spikes_when_recorder_has_spikes():
         def __init__(self):
             self.calls = []
 
-        def spikes(self, topic, t_s, idx):
-            self.calls.append((topic, t_s, len(idx)))
+        def spike_messages(self, topics, times_s, data, starts):
+            k = 0
+            for topic in topics:
+                for t_s in times_s:
+                    msg = decode_spikes(data[starts[k]:starts[k + 1]])
+                    assert msg["t"] == t_s
+                    self.calls.append((topic, t_s, len(msg["indices"])))
+                    k += 1
 
     ctrl = make_ctrl()
     rec = Rec()

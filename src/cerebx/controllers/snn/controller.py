@@ -42,6 +42,7 @@ from cerebx.controllers.ranges import mf_ranges
 from cerebx.controllers.snn.schema import SNNController
 from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
+from cerebx.recording.spike_chunks import chunk_spike_messages
 from cerebx.snn.decoder import DCNDecoder, chunk_outputs, chunk_select
 from cerebx.snn.network import Network, pack
 from cerebx.snn.weight_stats import weight_stats
@@ -58,13 +59,14 @@ def encoder_ranges(cfg: SNNController, n_joints: int, task: Any = None) -> tuple
 
 class Chunk(NamedTuple):
     """A simulated chunk: its first step; per step the output (a torque or [M_ag, M_at]) and the DCN spike
-    count; the recorded populations' spikes (:func:`~cerebx.snn.decoder.chunk_select`), None when none are."""
+    count; the recorded populations' spikes as encoded messages and where each starts
+    (:func:`~cerebx.recording.spike_chunks.chunk_spike_messages`), None when none are recorded."""
 
     first: int
     out: np.ndarray
     counts: np.ndarray
-    local: np.ndarray | None
-    ends: np.ndarray | None
+    spikes: bytes | None
+    starts: list[int] | None
 
 
 class NetworkThread:
@@ -200,20 +202,19 @@ class SNNControllerImpl(Controller):
             taus, counts, local, ends = chunk_outputs(idx, off, self.sl_dcn.start, self.sl_dcn.stop,
                                                       self.decoder.per_joint, self.decoder.sign, self._alpha,
                                                       rec_lo, rec_hi)
-        return Chunk(first_step, taus, counts, local if recording else None, ends if recording else None)
+        if not recording:
+            return Chunk(first_step, taus, counts, None, None)
+        words, starts = chunk_spike_messages(local, ends, first_step, STEP_S)
+        return Chunk(first_step, taus, counts, words.tobytes(), starts.tolist())
 
     def _absorb(self, chunk: Chunk) -> None:
         """Queue a simulated chunk's outputs and log its recorded spikes (``_net_step`` is advanced by the
         caller, which may launch the next chunk first)."""
         self._ready.extend(chunk.out)
         self._dcn_spikes += int(chunk.counts.sum())
-        if chunk.local is not None:
-            local, start = chunk.local, 0
-            for name, pop_ends in zip(self.record, chunk.ends.tolist()):
-                topic = f"/spikes/{name}"
-                for i, end in enumerate(pop_ends):
-                    self.recorder.spikes(topic, (chunk.first + i) * STEP_S, local[start:end])
-                    start = end
+        if chunk.spikes is not None:
+            times = [(chunk.first + i) * STEP_S for i in range(len(chunk.counts))]
+            self.recorder.spike_messages(self._spike_topics, times, chunk.spikes, chunk.starts)
 
     def _run_now(self) -> None:
         """Simulate the next pending input on this thread."""
@@ -271,10 +272,12 @@ class SNNControllerImpl(Controller):
         self._derive_kernel_args()
 
     def _derive_kernel_args(self) -> None:
-        """The decoder's gains and the recorded populations' bounds as the chunk kernels take them."""
+        """The decoder's gains and the recorded populations' bounds as the chunk kernels take them, and their
+        topics."""
         self._alpha = np.ascontiguousarray(np.broadcast_to(self.decoder.alpha, (self.n_ctrl,)), dtype=np.float64)
         self._record_lo = np.array([sl.start for sl in self.record.values()], np.int64)
         self._record_hi = np.array([sl.stop for sl in self.record.values()], np.int64)
+        self._spike_topics = tuple(f"/spikes/{name}" for name in self.record)
 
     def _advance(self) -> None:
         """Make sure this tick's torque is ready; in pipeline mode keep one chunk in flight."""
@@ -330,12 +333,12 @@ class SNNControllerImpl(Controller):
             mf = cf = np.zeros(0, np.int32)
         else:
             q_des, qd_des = self._desired_at(s.stamp_s, inp)
-            mf = (self.mf.active(q_des, s.q, qd_des, s.qd) + self.sl_mf.start).astype(np.int32)
+            mf = (self.mf.active(q_des, s.q, qd_des, s.qd) + self.sl_mf.start).astype(np.int32, copy=False)
             if self.cfg.error_reference_lag_ms:
                 q_des, qd_des = self._desired_at(s.stamp_s - self.cfg.error_reference_lag_ms / 1000.0, inp)
             e = self.cf.error(q_des, s.q, qd_des, s.qd)
             self.last_error = e
-            cf = (self.cf.active(e) + self.sl_cf.start).astype(np.int32)
+            cf = (self.cf.active(e) + self.sl_cf.start).astype(np.int32, copy=False)
         self._mf_lag.append(mf)
         self._cf_lag.append(cf)
         self._pending.append(np.concatenate([self._mf_lag.popleft(), self._cf_lag.popleft()]))
@@ -370,7 +373,7 @@ class SNNControllerImpl(Controller):
         return out
 
     def attach_recorder(self, recorder: Any) -> None:
-        self.recorder = recorder if hasattr(recorder, "spikes") else None
+        self.recorder = recorder if hasattr(recorder, "spike_messages") else None
 
     def describe(self) -> dict[str, Any]:
         return {
