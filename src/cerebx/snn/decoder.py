@@ -80,12 +80,3 @@ def chunk_select(idx, off, lo, hi):
                     m += 1
             ends[p, s] = m
     return local[:m], ends
-
-
-@njit(cache=True, nogil=True, boundscheck=False)
-def chunk_outputs(idx, off, lo, hi, per_joint, sign, alpha, rec_lo, rec_hi):
-    """:func:`chunk_torques` and :func:`chunk_select` in one call (one wait for the interpreter lock when it
-    returns, where two calls would wait twice)."""
-    taus, counts = chunk_torques(idx, off, lo, hi, per_joint, sign, alpha)
-    local, ends = chunk_select(idx, off, rec_lo, rec_hi)
-    return taus, counts, local, ends

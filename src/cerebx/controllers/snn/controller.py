@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 import numpy as np
+from numba import njit
 
 from cerebx import phase_clock, registry
 from cerebx.controllers.base import CommandMsg, ControlInput, Controller, TorqueMsg
@@ -43,7 +44,7 @@ from cerebx.controllers.snn.schema import SNNController
 from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
 from cerebx.recording.spike_chunks import chunk_spike_messages
-from cerebx.snn.decoder import DCNDecoder, chunk_outputs, chunk_select
+from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
 from cerebx.snn.network import Network, pack
 from cerebx.snn.weight_stats import weight_stats
 
@@ -69,20 +70,40 @@ class Chunk(NamedTuple):
     starts: list[int] | None
 
 
+@njit(cache=True, nogil=True, boundscheck=False)
+def _chunk_outputs(idx, off, lo, hi, per_joint, sign, alpha, rec_lo, rec_hi, first, step_s):  # pragma: no cover
+    """A chunk's torques and DCN counts (:func:`~cerebx.snn.decoder.chunk_torques`) and its recorded spikes'
+    messages (:func:`~cerebx.snn.decoder.chunk_select`,
+    :func:`~cerebx.recording.spike_chunks.chunk_spike_messages`) in one call: each return from compiled code
+    waits for the interpreter lock, which the loop's thread holds but for its MuJoCo steps."""
+    taus, counts = chunk_torques(idx, off, lo, hi, per_joint, sign, alpha)
+    local, ends = chunk_select(idx, off, rec_lo, rec_hi)
+    words, starts = chunk_spike_messages(local, ends, first, step_s)
+    return taus, counts, words, starts
+
+
 class NetworkThread:
     """The long-lived thread that simulates the network's chunks, one at a time, in the order given. The chunks
     and their results pass through C queues: a thread started per chunk cost the loop ~1 ms each (``start``
     waits until the new thread holds the interpreter lock), and an executor's futures run interpreted
-    locking code on both threads per chunk. The thread ends when its owner is garbage-collected."""
+    locking code on both threads per chunk. The thread ends when its owner is garbage-collected.
+
+    :meth:`submit` returns once the thread has taken the chunk. Without that hand-over the thread, woken by the
+    queue, waited for the interpreter lock until the loop's thread next let go of it (its next MuJoCo step):
+    a median 0.1 ms and a mean 0.2 ms a chunk of the network's time, where the hand-over costs the loop's thread
+    the thread's wake-up (tens of microseconds)."""
 
     def __init__(self) -> None:
         self._jobs: queue.SimpleQueue = queue.SimpleQueue()
+        self._taken: queue.SimpleQueue = queue.SimpleQueue()
         self._done: queue.SimpleQueue = queue.SimpleQueue()
-        threading.Thread(target=_serve, args=(self._jobs, self._done), name="cerebx-snn", daemon=True).start()
+        threading.Thread(target=_serve, args=(self._jobs, self._taken, self._done), name="cerebx-snn",
+                         daemon=True).start()
         weakref.finalize(self, self._jobs.put, None)
 
     def submit(self, job: Any) -> None:
         self._jobs.put(job)
+        self._taken.get()  # lets go of the interpreter lock until the thread holds it and has the job
 
     def result(self) -> Any:
         """The result of the oldest chunk not yet collected (waits for it); raises what the chunk raised."""
@@ -92,8 +113,9 @@ class NetworkThread:
         return value
 
 
-def _serve(jobs: queue.SimpleQueue, done: queue.SimpleQueue) -> None:
+def _serve(jobs: queue.SimpleQueue, taken: queue.SimpleQueue, done: queue.SimpleQueue) -> None:
     while (job := jobs.get()) is not None:
+        taken.put(None)
         try:
             done.put((True, job()))
         except BaseException as exc:  # handed to the loop's thread, raised by result()
@@ -197,14 +219,13 @@ class SNNControllerImpl(Controller):
             sel = (idx >= lo) & (idx < hi)
             taus = self.decoder.sides(idx[sel] - lo, step_of[sel], n, self.full_scale, self.cfg.decoder.saturate)
             counts = np.bincount(step_of[sel], minlength=n)
-            local, ends = chunk_select(idx, off, rec_lo, rec_hi) if recording else (None, None)
+            words, starts = chunk_spike_messages(*chunk_select(idx, off, rec_lo, rec_hi), first_step, STEP_S)
         else:
-            taus, counts, local, ends = chunk_outputs(idx, off, self.sl_dcn.start, self.sl_dcn.stop,
-                                                      self.decoder.per_joint, self.decoder.sign, self._alpha,
-                                                      rec_lo, rec_hi)
+            taus, counts, words, starts = _chunk_outputs(idx, off, self.sl_dcn.start, self.sl_dcn.stop,
+                                                         self.decoder.per_joint, self.decoder.sign, self._alpha,
+                                                         rec_lo, rec_hi, first_step, STEP_S)
         if not recording:
             return Chunk(first_step, taus, counts, None, None)
-        words, starts = chunk_spike_messages(local, ends, first_step, STEP_S)
         return Chunk(first_step, taus, counts, words.tobytes(), starts.tolist())
 
     def _absorb(self, chunk: Chunk) -> None:
