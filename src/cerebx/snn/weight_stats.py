@@ -8,7 +8,9 @@ same additions in the same order on ``(float64(w[i]) - mean)**2`` computed on th
 (``tests/cerebx/snn/test_weight_stats.py`` checks the equality over sizes around every branch).
 
 :func:`weight_stats` reads the weights twice where numpy's mean, std, min and max read them four times:
-:func:`_sum_min_max` gives the mean's sum, the min and the max in one pass, :func:`std_f64` the rest.
+:func:`_sum_min_max` gives the mean's sum, the min and the max in one pass, :func:`std_f64` the rest. Both
+passes can be split between two threads (the runs' sums are kept and added in order afterwards; the pairwise
+sum's first split is numpy's too).
 ``w.mean(dtype=float64)`` of float32 data is a buffered cast reduction: numpy casts ``np.getbufsize()``
 (8192) elements at a time into a float64 buffer, sums each buffer pairwise as above and adds the buffer
 sums in order to a result that starts at the identity 0.0 (not at the first element). A C-contiguous
@@ -23,6 +25,9 @@ turns the vector loads of the min/max scan into gathers.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -129,24 +134,34 @@ def _key(x):
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def _sum_min_max(w, bufsize):
-    """(sum as ``w.mean(dtype=float64)`` adds it, min, max) of the flat float32 ``w`` (size >= 1), one pass.
+def _runs_min_max(w, bufsize, first, last, sums):
+    """Runs ``first:last`` of ``bufsize`` values of the flat float32 ``w``: each run's pairwise sum into
+    ``sums[run]``, and the min and max keys (:func:`_key`) over those runs.
 
-    Each run of ``bufsize`` values is summed, then scanned for min and max while it is still in the cache.
-    The scan compares integer keys of the bits (:func:`_key`): a float min that must mind NaN stays scalar,
-    an integer one is vectorised, three to four times faster. A NaN in ``w`` makes the sum NaN, and only
-    then is ``w`` searched for one, which is then the min and the max, as numpy's min and max propagate it.
-    """
+    Each run is summed, then scanned for min and max while it is still in the cache. The scan compares integer
+    keys of the bits: a float min that must mind NaN stays scalar, an integer one is vectorised, three to four
+    times faster."""
     bits = w.view(np.int32)
-    total = 0.0
-    lo_k = hi_k = _key(bits[0])
-    for lo in range(0, w.size, bufsize):
-        total += _sum(w[lo : lo + bufsize])
+    lo_k = hi_k = _key(bits[first * bufsize])
+    for r in range(first, last):
+        lo = r * bufsize
+        sums[r] = _sum(w[lo : lo + bufsize])
         b = bits[lo : lo + bufsize]
         for i in range(b.size):
             k = _key(b[i])
             lo_k = min(lo_k, k)
             hi_k = max(hi_k, k)
+    return lo_k, hi_k
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _total_min_max(w, sums, lo_k, hi_k):
+    """(the mean's sum: the runs' sums added in order to 0.0, as numpy adds its buffers; min; max). A NaN in
+    ``w`` makes the sum NaN, and only then is ``w`` searched for one, which is then the min and the max, as
+    numpy's min and max propagate it."""
+    total = 0.0
+    for r in range(sums.size):
+        total += sums[r]
     if np.isnan(total):
         for i in range(w.size):
             if np.isnan(w[i]):
@@ -158,25 +173,60 @@ def _sum_min_max(w, bufsize):
     return total, mm[0], mm[1]
 
 
-def std_f64(w: np.ndarray, mean: float) -> float:
-    """``np.std(w, dtype=np.float64)`` (``mean``: ``w.mean(dtype=np.float64)``), without the temporary."""
+Beside = Callable[..., Callable[[], Any]]
+"""Runs ``fn(*args)`` on another thread and returns a function that waits for its result."""
+
+SPLIT_MIN = 1 << 20
+"""Arrays at least this large are read by two threads when a second one is offered."""
+
+
+def _sum_min_max(w: np.ndarray, bufsize: int, beside: Beside | None = None) -> tuple[float, Any, Any]:
+    """(sum as ``w.mean(dtype=float64)`` adds it, min, max) of the flat float32 ``w`` (size >= 1), one pass;
+    with ``beside`` the second half of the runs is read on the other thread."""
+    n_runs = -(-w.size // bufsize)
+    sums = np.empty(n_runs)
+    if beside is None or w.size < SPLIT_MIN:
+        lo_k, hi_k = _runs_min_max(w, bufsize, 0, n_runs, sums)
+    else:
+        half = n_runs // 2
+        other = beside(_runs_min_max, w, bufsize, half, n_runs, sums)
+        lo_k, hi_k = _runs_min_max(w, bufsize, 0, half, sums)
+        lo2, hi2 = other()
+        lo_k, hi_k = min(lo_k, lo2), max(hi_k, hi2)
+    return _total_min_max(w, sums, lo_k, hi_k)
+
+
+def std_f64(w: np.ndarray, mean: float, beside: Beside | None = None) -> float:
+    """``np.std(w, dtype=np.float64)`` (``mean``: ``w.mean(dtype=np.float64)``), without the temporary; with
+    ``beside`` the two halves of numpy's first pairwise split are summed on two threads and added as numpy
+    adds them."""
     flat = np.ascontiguousarray(w).reshape(-1)
-    return float(np.sqrt(_sq_dev_sum(flat, np.float64(mean)) / flat.size))
+    mean = np.float64(mean)
+    if beside is None or flat.size < SPLIT_MIN or flat.size <= _BLOCK:  # numpy splits only above a block
+        total = _sq_dev_sum(flat, mean)
+    else:
+        n2 = flat.size // 2
+        n2 -= n2 % 8
+        right = beside(_sq_dev_sum, flat[n2:], mean)
+        total = _sq_dev_sum(flat[:n2], mean) + right()
+    return float(np.sqrt(total / flat.size))
 
 
-def weight_stats(w: np.ndarray) -> tuple[float, float, float, float]:
+def weight_stats(w: np.ndarray, beside: Beside | None = None) -> tuple[float, float, float, float]:
     """(mean, std, min, max) of ``w`` as ``w.mean(dtype=float64)``, ``w.std(dtype=float64)``, ``w.min()``,
     ``w.max()`` give them.
 
-    A C-contiguous float32 ``w`` is read twice (:func:`_sum_min_max`, :func:`std_f64`). One difference
-    ``==`` does not see: where 0.0 and -0.0 both hold the min (or max), numpy reports either, by its
-    vector lane order, this -0.0 for the min and 0.0 for the max. The weights hold no -0.0: the plasticity
-    kernels clip at the lower bound by writing the bound.
+    A C-contiguous float32 ``w`` is read twice (:func:`_sum_min_max`, :func:`std_f64`), each pass split between
+    this thread and another when ``beside`` offers one (the spiking controller's network thread, idle between
+    trials): the same additions in the same order, about half the wall time. One difference ``==`` does not
+    see: where 0.0 and -0.0 both hold the min (or max), numpy reports either, by its vector lane order, this
+    -0.0 for the min and 0.0 for the max. The weights hold no -0.0: the plasticity kernels clip at the lower
+    bound by writing the bound.
     """
     if w.dtype != np.float32 or not w.flags.c_contiguous or w.size == 0:
         mean = w.mean(dtype=np.float64)
         return float(mean), std_f64(w, mean), float(w.min()), float(w.max())
     flat = w.reshape(-1)
-    total, mn, mx = _sum_min_max(flat, np.getbufsize())
+    total, mn, mx = _sum_min_max(flat, np.getbufsize(), beside)
     mean = total / flat.size
-    return float(mean), std_f64(flat, mean), float(mn), float(mx)
+    return float(mean), std_f64(flat, mean, beside), float(mn), float(mx)

@@ -4,10 +4,12 @@ numpy's bit for bit."""
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 import pytest
 
+from cerebx.snn import weight_stats as ws
 from cerebx.snn.weight_stats import std_f64, weight_stats
 
 # around every branch of numpy's pairwise sum: < 8, the 8-way blocks up to 128, odd splits above, and
@@ -96,3 +98,36 @@ def test_a_pf_pc_block_and_its_summary_are_numpy_s():
     w = np.full((10_000, 600), 2.0, np.float32)
     w.reshape(-1)[rng.integers(0, w.size, 100_000)] = rng.random(100_000, dtype=np.float32) * 5
     assert weight_stats(w) == numpy_stats(w)
+
+
+def on_a_thread(fn, *args):
+    """A ``beside``: ``fn(*args)`` on a thread of its own."""
+    box = {}
+    t = threading.Thread(target=lambda: box.setdefault("result", fn(*args)))
+    t.start()
+
+    def wait():
+        t.join()
+        return box["result"]
+
+    return wait
+
+
+@pytest.mark.parametrize("shape", SIZES + SHAPES)
+def test_two_threads_give_numpy_s_stats_bit_for_bit(shape, monkeypatch):
+    monkeypatch.setattr(ws, "SPLIT_MIN", 1)  # split every size, the smallest included
+    for w in patterns(int(np.prod(shape)), seed=int(np.prod(shape))):
+        w = w.reshape(shape)
+        assert weight_stats(w, on_a_thread) == numpy_stats(w)
+
+
+def test_two_threads_find_a_nan_or_an_extreme_in_either_half(monkeypatch):
+    monkeypatch.setattr(ws, "SPLIT_MIN", 1)
+    for n, at in ((8193, 0), (8193 * 4, 8193 * 3), (100_000, 99_999)):
+        w = np.full(n, 2.0, np.float32)
+        w[at] = np.nan
+        assert all(math.isnan(x) for x in weight_stats(w, on_a_thread))
+        w[at] = -7.0
+        assert weight_stats(w, on_a_thread) == numpy_stats(w)
+        w[at] = 9.0
+        assert weight_stats(w, on_a_thread) == numpy_stats(w)

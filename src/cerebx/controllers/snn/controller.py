@@ -310,6 +310,14 @@ class SNNControllerImpl(Controller):
         self._record_hi = np.array([sl.stop for sl in self.record.values()], np.int64)
         self._spike_topics = tuple(f"/spikes/{name}" for name in self.record)
 
+    def _on_network_thread(self, fn: Any, *args: Any) -> Any:
+        """Run ``fn(*args)`` on the network thread, idle while no chunk is in flight (between trials); returns
+        the function that waits for its result."""
+        if self._thread is None:
+            self._thread = NetworkThread()
+        self._thread.submit(lambda: fn(*args))
+        return self._thread.result
+
     def _advance(self) -> None:
         """Make sure this tick's torque is ready; in pipeline mode keep one chunk in flight."""
         if not self.pipeline:
@@ -395,8 +403,9 @@ class SNNControllerImpl(Controller):
         self._dcn_spikes = self._steps = 0
         every = self.cfg.weight_summary_every_trials
         if every and trial % every == 0 and self._summaries and self._shed < 3:
+            beside = self._on_network_thread if self.pipeline else None
             for name in self.net.plastic_projections:
-                stats = weight_stats(self.net.weights(name))
+                stats = weight_stats(self.net.weights(name), beside)
                 out.update(zip((f"w_{name}_mean", f"w_{name}_std", f"w_{name}_min", f"w_{name}_max"), stats))
         lost = int(self.net.pf_lost.sum())
         if lost:
