@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections import deque
 from typing import Any
 
+import numba
 import numpy as np
 
 from cerebx.schema import stages as schema
@@ -32,6 +33,14 @@ class Hold(Receiver):
         return self.values
 
 
+@numba.njit(cache=True, boundscheck=False)
+def _push(buf, total, i, x):  # pragma: no cover - numba
+    """``total += x - buf[i]; buf[i] = x``, element by element (the array form's doubles)."""
+    for j in range(total.size):
+        total[j] += x[j] - buf[i, j]
+        buf[i, j] = x[j]
+
+
 class _RunningMean:
     """Mean of the last ``taps`` samples of one signal, kept as a running sum (recomputed exactly
     every 1000 samples so rounding cannot drift)."""
@@ -44,9 +53,9 @@ class _RunningMean:
         self.value = np.zeros(n)
 
     def push(self, x: np.ndarray) -> None:
-        i = self.count % self.taps
-        self.sum += x - self.buf[i]
-        self.buf[i] = x
+        if x.shape != self.sum.shape:
+            raise ValueError(f"mean filter: a sample of shape {x.shape}, the filter's is {self.sum.shape}")
+        _push(self.buf, self.sum, self.count % self.taps, x)
         self.count += 1
         if self.count % 1000 == 0:
             self.sum = self.buf.sum(0)

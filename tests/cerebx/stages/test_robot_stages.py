@@ -77,3 +77,20 @@ def test_supervisor_correction_is_its_rule_on_every_tick():
         want = np.where(outside, sup.kp * (np.where(below, sup.lo, sup.hi) - q) - s * sup.kd * qd, 0.0)
         got = sup.correction(q, qd)
         assert got.tobytes() == want.tobytes() and sup.s.tobytes() == s.tobytes()
+
+
+def test_mean_filter_running_sum_is_the_array_rule_bit_for_bit():
+    """The compiled push against ``sum += x - buf[i]; buf[i] = x`` and the exact re-sum every 1000 samples."""
+    f = MeanFilter((Signal("joint.torque", 3),), 15)
+    rng = np.random.default_rng(2)
+    buf, total = np.zeros((15, 3)), np.zeros(3)
+    for k in range(2500):
+        x = rng.normal(0.0, 10.0 ** rng.integers(-3, 3), 3)
+        total += x - buf[k % 15]
+        buf[k % 15] = x
+        if (k + 1) % 1000 == 0:
+            total = buf.sum(0)
+        got = f.receive([Message(k * 0.002, {"joint.torque": x})], k * 0.002)["joint.torque"]
+        assert got.tobytes() == (total / min(k + 1, 15)).tobytes()
+    with pytest.raises(ValueError, match="shape"):
+        f.receive([Message(0.0, {"joint.torque": np.zeros(2)})], 0.0)
