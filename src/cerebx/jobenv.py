@@ -72,12 +72,20 @@ def configure_job() -> None:
     numba = sys.modules.get("numba")
     if numba is not None:
         wanted = int(os.environ["NUMBA_NUM_THREADS"])
-        numba.set_num_threads(max(1, min(wanted, numba.config.NUMBA_NUM_THREADS)))
+        pool = numba.config.NUMBA_NUM_THREADS  # sized at import
+        # numba reads its environment again when it compiles a kernel, and once its threads are started it
+        # refuses a NUMBA_NUM_THREADS other than the pool's: the variable says the pool's size
+        os.environ["NUMBA_NUM_THREADS"] = str(pool)
+        numba.set_num_threads(max(1, min(wanted, pool)))
 
 
 def describe(environ: dict[str, str] | None = None) -> str:
-    """One line for the job's log: where it runs and with which numba settings."""
-    env = os.environ if environ is None else environ
+    """One line for the job's log: where it runs and with which numba settings (in this process, once numba is
+    loaded, the threads it runs with, whatever the size of its pool)."""
+    env = dict(os.environ if environ is None else environ)
+    numba = sys.modules.get("numba")
+    if environ is None and numba is not None:
+        env["NUMBA_NUM_THREADS"] = str(numba.get_num_threads())
     keys = ("SLURM_JOB_ID", "SLURM_ARRAY_TASK_ID", "SLURM_RESTART_COUNT", "SLURM_CPUS_PER_TASK",
             "NUMBA_NUM_THREADS", "NUMBA_CACHE_DIR")
     return " ".join(f"{k}={env[k]}" for k in keys if env.get(k))
