@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import numba
 import numpy as np
 
 from cerebx.errors import Diverged
@@ -15,6 +16,15 @@ from cerebx.signals import Frame, Message
 
 # the plant is checked for divergence every this many ticks, and at the end of every trial
 DIVERGENCE_CHECK_TICKS = 50
+
+
+@numba.njit(cache=True)
+def all_finite(v):  # pragma: no cover - numba
+    """``np.isfinite(v).all()`` in one compiled call (a command is checked every tick)."""
+    for x in v.ravel():
+        if not np.isfinite(x):
+            return False
+    return True
 
 
 def brain_phase(stages: Sequence[Any], tick: int, t: float, q_des: np.ndarray, qd_des: np.ndarray,
@@ -44,7 +54,7 @@ def robot_phase(stages: Sequence[Any], tick: int, t: float, robot: dict[str, Any
         adjust(robot)
     command = {name: robot[name] for name in commands}
     for name, v in command.items():
-        if not np.isfinite(v).all():
+        if not all_finite(np.asarray(v)):
             raise Diverged(f"trial {trial}, t = {t:.3f} s: non-finite {name} command {v.tolist()}")
     return command
 

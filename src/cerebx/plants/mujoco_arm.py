@@ -18,10 +18,24 @@ from collections.abc import Sequence
 from typing import Any
 
 import mujoco
+import numba
 import numpy as np
 
 from cerebx.plants.base import Plant
 from cerebx.plants.interaction import Interaction
+
+
+@numba.njit(cache=True)
+def _saturate(tau, limit, out):  # pragma: no cover - numba
+    """``minimum(maximum(tau, -limit), limit)`` into ``out``, a NaN kept as numpy's keeps it."""
+    for j in range(out.size):
+        x = tau[j]
+        lo = -limit[j]
+        if x < lo:
+            x = lo
+        if x > limit[j]:
+            x = limit[j]
+        out[j] = x
 
 
 class MujocoArm(Plant):
@@ -85,7 +99,10 @@ class MujocoArm(Plant):
     def apply(self, tau: np.ndarray) -> np.ndarray:
         """Saturate ``tau``; without a torque lag it is the motors' control at once, with one
         :meth:`step` moves the control towards it."""
-        np.minimum(np.maximum(tau, -self._limit, out=self._cmd), self._limit, out=self._cmd)
+        if tau.shape == self._cmd.shape == self._limit.shape:  # every tick: one compiled call
+            _saturate(tau, self._limit, self._cmd)
+        else:
+            np.minimum(np.maximum(tau, -self._limit, out=self._cmd), self._limit, out=self._cmd)
         if self._lag_gain == 1.0:
             self.data.ctrl[:] = self._cmd
         return self._cmd.copy()

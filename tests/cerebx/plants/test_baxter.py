@@ -11,8 +11,10 @@ import pytest
 
 from cerebx.controllers.base import ControlInput, SensorMsg
 from cerebx.controllers.position import PositionServo
+from cerebx.loop.phases import all_finite
 from cerebx.plants.base import PlantEvent
 from cerebx.plants.baxter import JOINTS, BaxterArm, baxter_model, kinematic_model
+from cerebx.plants.mujoco_arm import _saturate
 from cerebx.schema.controller import PositionController
 from cerebx.schema.plant import BaxterConfig
 
@@ -301,3 +303,18 @@ def test_torque_lag_is_first_order():
     instant.apply(tau)
     instant.step()
     assert instant.data.ctrl[4] == 1.0
+
+
+def test_saturation_is_numpy_s_clip_nan_and_infinities_included():
+    rng = np.random.default_rng(4)
+    limit = np.array([50.0, 50.0, 50.0, 50.0, 15.0, 15.0])
+    for _ in range(200):
+        tau = rng.normal(0.0, 40.0, 6)
+        tau[rng.integers(0, 6)] = rng.choice([np.nan, np.inf, -np.inf, 50.0, -15.0, 0.0, -0.0])
+        want = np.minimum(np.maximum(tau, -limit), limit)
+        out = np.empty(6)
+        _saturate(tau, limit, out)
+        assert out.tobytes() == want.tobytes()
+    loop_finite = all_finite(np.array([1.0, 2.0])), all_finite(np.array([1.0, np.nan])), all_finite(np.zeros(0))
+    assert loop_finite == (True, False, True)
+    assert not all_finite(np.array([[1.0], [-np.inf]]))
