@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 
@@ -20,6 +21,16 @@ class TrialMetrics:
     ee_error_m: float | None
 
 
+@numba.njit(cache=True, boundscheck=False)
+def _put_row(q_des, q, qd_des, qd, tau, pos_err, vel_err, taus, i):  # pragma: no cover - numba
+    """Row ``i`` of the errors (``q_des - q``, ``qd_des - qd``) and the command, in one compiled call."""
+    for j in range(pos_err.shape[1]):
+        pos_err[i, j] = q_des[j] - q[j]
+        vel_err[i, j] = qd_des[j] - qd[j]
+    for j in range(taus.shape[1]):
+        taus[i, j] = tau[j]
+
+
 class TrialAccumulator:
     """Collects one trial's rows (preallocated) and reduces them once at the end of the trial."""
 
@@ -30,12 +41,22 @@ class TrialAccumulator:
         self.tau = np.zeros((steps, n_joints if n_command is None else n_command))  # the applied command
         self.ee_err = np.full(steps, np.nan)
         self.i = 0
+        self._row = (n_joints,)
 
     def add(self, q_des, q, qd_des, qd, tau, ee_des=None, ee=None) -> None:
         i = self.i
-        np.subtract(q_des, q, out=self.pos_err[i])
-        np.subtract(qd_des, qd, out=self.vel_err[i])
-        self.tau[i] = tau
+        row = self._row
+        try:
+            fits = (i < len(self.tau) and q_des.shape == q.shape == qd_des.shape == qd.shape == row
+                    and tau.shape == self.tau.shape[1:])
+        except AttributeError:  # not arrays
+            fits = False
+        if fits:
+            _put_row(q_des, q, qd_des, qd, tau, self.pos_err, self.vel_err, self.tau, i)
+        else:  # numpy's broadcasting and errors
+            np.subtract(q_des, q, out=self.pos_err[i])
+            np.subtract(qd_des, qd, out=self.vel_err[i])
+            self.tau[i] = tau
         if ee_des is not None and ee is not None:
             d = ee_des - ee
             self.ee_err[i] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) ** 0.5

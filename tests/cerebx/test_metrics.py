@@ -46,3 +46,21 @@ def test_torque_variability_of_the_trial_averaged_torque():
     assert per_trial == pytest.approx((2.1 + 1.9) / 2 / 2.0)
     with pytest.raises(ValueError):
         torque_variability_of_mean(ramp)
+
+
+def test_accumulated_rows_are_the_array_differences_bit_for_bit():
+    rng = np.random.default_rng(3)
+    acc = TrialAccumulator(3, steps=50, n_command=4)
+    rows = [rng.normal(size=(4, 3)) for _ in range(50)]
+    taus = rng.normal(size=(50, 4))
+    for (q_des, q, qd_des, qd), tau in zip(rows, taus):
+        acc.add(q_des, q, qd_des, qd, tau)
+    want_pos = np.array([r[0] - r[1] for r in rows])
+    want_vel = np.array([r[2] - r[3] for r in rows])
+    assert acc.pos_err.tobytes() == want_pos.tobytes() and acc.vel_err.tobytes() == want_vel.tobytes()
+    assert acc.tau.tobytes() == taus.tobytes()
+    with pytest.raises(IndexError):  # a trial's rows are full: numpy's error, no write past the end
+        acc.add(*rows[0], taus[0])
+    other = TrialAccumulator(3, steps=2)
+    other.add(np.ones(3), 0.5, np.ones(3), np.zeros(3), np.ones(3))  # a scalar broadcasts, as with numpy
+    assert other.pos_err[0].tolist() == [0.5, 0.5, 0.5]
