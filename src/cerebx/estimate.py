@@ -8,18 +8,19 @@ run                                          run.mcap per sim. s     wall
 ===========================================  ======================  ==========================
 planar2 + PD (``+experiment=demo``)          109 kB                  docs/guide/speed.md
 Baxter + PD                                  258 kB                  docs/guide/speed.md
-Baxter + SNN ``full``                        294 kB                  docs/guide/speed.md
+Baxter + SNN ``full``                        303 kB                  docs/guide/speed.md
 ===========================================  ======================  ==========================
 
-hence about 25 kB/s plus 39 kB/s per joint for the joint and control channels, and 32 kB/s for the
-default spike channels of an SNN; without joint states (``recording.joint_states=false``) a third of the
+hence about 25 kB/s plus 39 kB/s per joint for the joint and control channels, and 41 kB/s for the
+default spike channels of an SNN (in CDR since the evening of 2026-11-24; 32 kB/s as JSON); without joint
+states (``recording.joint_states=false``) a third of the
 per-joint rate is kept for ``/control`` (*constructed*: one of three per-step channels). The learned SNN
 state holds 4 bytes per plastic synapse and ~44 bytes per neuron before compression (``full``:
 147.9 MB raw, 0.7 MB of weights once zlib-compressed after 2 trials, because most PF-PC weights stay at
 their initial value); it is written compressed. Wall
 time uses the real-time factors of runs with their default recording on a quiet machine (Baxter + PD
-30x; a ``full``-network learning run 22x, measured 2026-11-24 with ``cerebx bench``'s learning runs (21.2x
-and 22.5x), i.e. 0.033 s + 0.36 ns per plastic synapse per simulated second); a shared machine is slower.
+30x; a ``full``-network learning run 23x, measured 2026-11-24 evening with ``cerebx bench``'s learning runs
+(23.1-24.1x), i.e. 0.033 s + 0.30 ns per plastic synapse per simulated second); a shared machine is slower.
 """
 
 from __future__ import annotations
@@ -31,11 +32,11 @@ from typing import Any
 
 BYTES_PER_S_BASE = 25e3
 BYTES_PER_S_PER_JOINT = 39e3
-BYTES_PER_S_SPIKES = 32e3
+BYTES_PER_S_SPIKES = 41e3
 STATE_BYTES_PER_PLASTIC = 4.0
 STATE_BYTES_PER_NEURON = 44.0
 WALL_PER_SIM_S = 0.033
-WALL_PER_SIM_S_PER_PLASTIC = 0.36e-9
+WALL_PER_SIM_S_PER_PLASTIC = 0.30e-9
 DISK_MARGIN = 1.2
 """A run is refused when its estimate times this margin exceeds the free space of its folder's disk."""
 
