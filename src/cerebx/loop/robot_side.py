@@ -45,15 +45,17 @@ from cerebx.link.clock import host_identity, host_steal_ms, now_ns, pace, realti
 from cerebx.link.pairing import START_LEAD_S, RemoteController, fingerprint, pong, wait_for_hello
 from cerebx.link.stats import describe
 from cerebx.link.wire import Kind, Packet
-from cerebx.loop.phases import DIVERGENCE_CHECK_TICKS, check_diverged, control_message, robot_phase
+from cerebx.loop.phases import DIVERGENCE_CHECK_TICKS, all_finite, check_diverged, control_message, robot_phase
 from cerebx.loop.realtime import LinkEvents, TickLog, side_summary
-from cerebx.metrics import TrialAccumulator, TrialMetrics
+from cerebx.metrics import TrialAccumulator, TrialMetrics, _put_row
+from cerebx.plants.mujoco_arm import _saturate
 from cerebx.recording.recorder import Recorder
 from cerebx.recording.sentinel import Sentinel
 from cerebx.recording.summary import finish_run, new_summary, trial_fields, write_summary
 from cerebx.schema.stages import SupervisorConfig
 from cerebx.signals import Message
-from cerebx.stages.supervisor import Supervisor
+from cerebx.stages.receivers import _push
+from cerebx.stages.supervisor import Supervisor, _correct
 from cerebx.wiring import wire
 
 log = logging.getLogger("cerebx")
@@ -348,6 +350,18 @@ def _start(end: LinkEnd, welcome: dict[str, Any], timeout_s: float) -> int:
     raise LinkLost(f"link lost: the brain side did not start within {timeout_s:g} s")
 
 
+def prepare_real_time() -> None:
+    """Before pairing: load (or on a new machine compile) the compiled helpers a robot-side tick calls (the
+    command check, the arm's saturation, the mean filter, the supervisor, the trial's rows), for the argument
+    types a tick gives them, so that the paced loop's first ticks do not wait for them."""
+    z, zz = np.zeros(1), np.zeros((1, 1))
+    all_finite(z)
+    _saturate(z, z, np.zeros(1))
+    _push(np.zeros((1, 1)), np.zeros(1), 0, z)
+    _correct(z, z, z, z, z, z, 0.0, np.zeros(1), np.zeros(1))
+    _put_row(z, z, z, z, z, zz.copy(), zz.copy(), zz.copy(), 0)
+
+
 def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, hello: Any, overrides: list[str]) -> dict[str, Any]:
     """Build the robot side, open its files, start with the brain side and run; returns the summary."""
     run_dir.mkdir(parents=True, exist_ok=True)
@@ -367,6 +381,7 @@ def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, hello: Any, overrides: list
     try:
         ctx = build_robot_parts(cfg, hello.info.get("controller") or {}, run_dir)
         rec.joint_names = tuple(ctx.plant.joint_names)
+        prepare_real_time()
         welcome = {"fingerprint": fingerprint(cfg), **host_identity()}
         end.send_control(Kind.WELCOME, welcome)
         t0 = _start(end, welcome, cfg.link.pair_timeout_s)

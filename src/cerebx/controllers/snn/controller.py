@@ -336,8 +336,12 @@ class SNNControllerImpl(Controller):
         state, and leave out the periodic weight summaries (a pass over every plastic weight takes longer than
         the pathway delay leaves between two ticks; the learned state is still saved at the end)."""
         self.net.step_many([])
+        _chunk_outputs(np.zeros(0, np.int32), np.zeros(1, np.int64), self.sl_dcn.start, self.sl_dcn.stop,
+                       self.decoder.per_joint, self.decoder.sign, self._alpha, self._record_lo, self._record_hi, 0,
+                       STEP_S)
         z = np.zeros(self.n_ctrl)
         self.mf.active(z, z, z, z)
+        self.cf.error(z, z, z, z)
         copy.deepcopy(self.cf).active(z)
         self._summaries = False
 
