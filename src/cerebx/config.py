@@ -84,7 +84,7 @@ def compose(overrides: list[str]) -> DictConfig:
 
 def compose_with_choices(overrides: list[str]) -> tuple[DictConfig, dict[str, str]]:
     """Compose, and return the option chosen in each config group (what ``cerebx run`` records as presets)."""
-    problems = check_args(overrides)
+    problems = check_args(overrides) + _group_lists(overrides)
     if problems:
         raise ConfigError(problems)
     try:
@@ -99,6 +99,23 @@ def compose_with_choices(overrides: list[str]) -> tuple[DictConfig, dict[str, st
     with open_dict(cfg):
         del cfg["hydra"]
     return cfg, choices
+
+
+def _group_lists(overrides: list[str]) -> list[str]:
+    """A config group given a list takes option names only (Hydra crashes on anything else in it)."""
+    problems = []
+    parser = OverridesParser.create()
+    for text in overrides:
+        try:
+            o = parser.parse_override(text)
+        except HydraException:
+            continue  # Hydra refuses it with its own message
+        value = None if o.is_sweep_override() else o.value()
+        if isinstance(value, list) and not _is_hydra(text) and _is_group(o.key_or_group.split("/")[-1]):
+            bad = next((v for v in value if not isinstance(v, str)), None)
+            if bad is not None:
+                problems.append(f"{o.key_or_group}: a config group takes option names, got {bad!r} in the list")
+    return problems
 
 
 def user_choices(choices: Any) -> dict[str, str]:

@@ -111,6 +111,10 @@ INVALID = [
      "controller.mf.ranges: q_min must be below q_max (empty range at joint 5)"),
     (["+experiment=demo", "robot=[{kind: hold}, {kind: mean}]"],
      "robot.1: 'mean' is a receiver, which can only be the first robot stage"),
+    # found by the fuzzer: a group's list with something else than option names crashed inside Hydra
+    (["+task=circle", "biodelay=d100", "spinal=[{kind:x}]"],
+     "spinal: a config group takes option names, got {'kind': 'x'} in the list"),
+    (["+task=circle", "delay=[45]"], "delay: a config group takes option names, got 45 in the list"),
 ]
 
 
