@@ -9,7 +9,7 @@ import pytest
 
 from cerebx.build import BuildContext
 from cerebx.controllers.base import ControlInput, SensorMsg
-from cerebx.controllers.snn.controller import SNNControllerImpl
+from cerebx.controllers.snn.controller import NetworkThread, SNNControllerImpl
 from cerebx.controllers.snn.schema import BoxEncoder, CFEncoder, SNNController
 from cerebx.errors import StateMismatchError
 from cerebx.recording.cdr import decode_spikes
@@ -355,3 +355,53 @@ def test_error_reference_lag_pairs_the_measurement_with_an_earlier_desired_sampl
     for c, t_ref in ((plain, t), (lagged, t - 0.050)):
         want = kpos * (0.3 * np.sin(np.pi * t_ref) - q) + kvel * (0.3 * np.cos(np.pi * t_ref) - qd_meas)
         np.testing.assert_allclose(c.last_error, want, rtol=1e-9, atol=1e-12)
+
+
+def test_next_chunk_is_queued_behind_the_one_in_flight_with_the_same_results(monkeypatch):
+    """The pipelined controller queues chunk k + 1 before it waits for chunk k: the network thread simulates the
+    chunks in order, each from where the one before ended, and the torques are those of the unpipelined run."""
+    submits: list[bool] = []
+    firsts: dict[bool, list[int]] = {True: [], False: []}
+    submit = NetworkThread.submit
+
+    def spy_submit(self, job, hand_over=True):
+        submits.append(hand_over)
+        submit(self, job, hand_over)
+
+    monkeypatch.setattr(NetworkThread, "submit", spy_submit)
+    runs = {}
+    for pipeline in (True, False):
+        ctrl = make_ctrl(pathway_delay_ms=50.0, pipeline=pipeline)
+        ctrl.reset(np.random.default_rng(0))
+        simulate = ctrl._simulate_packed
+
+        def spy(flat, in_off, first, simulate=simulate, seen=firsts[pipeline]):
+            seen.append(first)
+            return simulate(flat, in_off, first)
+
+        ctrl._simulate_packed = spy
+        runs[pipeline] = drive(ctrl, 300)
+        ctrl.end_trial(0)
+        assert ctrl._in_flight == 0
+    np.testing.assert_array_equal(runs[True], runs[False])
+    chunks = firsts[True]
+    assert chunks == list(range(0, 25 * len(chunks), 25))  # consecutive chunks of 25 steps, in order
+    assert submits[0] and not all(submits[1:])  # the first handed over, the later ones queued behind another
+
+
+def test_a_failed_chunk_is_raised_once_and_leaves_nothing_in_flight():
+    ctrl = make_ctrl(pathway_delay_ms=50.0)
+    ctrl.reset(np.random.default_rng(0))
+    step_packed, calls = ctrl.net.step_packed, []
+
+    def failing(flat, in_off):
+        calls.append(1)
+        if len(calls) == 3:
+            raise FloatingPointError("chunk 3 failed")
+        return step_packed(flat, in_off)
+
+    ctrl.net.step_packed = failing
+    with pytest.raises(FloatingPointError, match="chunk 3 failed"):
+        drive(ctrl, 300)
+    assert ctrl._in_flight == 0
+    ctrl.end_trial(0)  # nothing left to wait for
