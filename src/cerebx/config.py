@@ -106,12 +106,14 @@ def _group_lists(overrides: list[str]) -> list[str]:
     problems = []
     parser = OverridesParser.create()
     for text in overrides:
+        if _is_hydra(text):
+            continue
         try:
             o = parser.parse_override(text)
         except HydraException:
             continue  # Hydra refuses it with its own message
         value = None if o.is_sweep_override() else o.value()
-        if isinstance(value, list) and not _is_hydra(text) and _is_group(o.key_or_group.split("/")[-1]):
+        if isinstance(value, list) and _is_group(o.key_or_group.split("/")[-1]):
             bad = next((v for v in value if not isinstance(v, str)), None)
             if bad is not None:
                 problems.append(f"{o.key_or_group}: a config group takes option names, got {bad!r} in the list")

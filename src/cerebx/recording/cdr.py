@@ -6,7 +6,7 @@ format of older runs) a message was ~830 bytes of text: formatting 21 floats and
 the text cost the loop's thread ~3.9 us a message. In CDR it is 300 bytes written in place into a template,
 ~1.8 us. The spikes of a recorded population are logged every step too: ~150 DCN indices a step were ~740
 bytes of JSON, formatted and logged on the loop's thread (~8 us a step). In CDR they are encoded for a whole
-chunk of steps at once on the network's thread (``snn/decoder.py: chunk_spike_messages``), and the loop's
+chunk of steps at once on the network's thread (``recording/spike_chunks.py``), and the loop's
 thread only logs them. Everything else stays JSON.
 
 The layout (XCDR1, little endian, after the 4-byte encapsulation header; every value aligned to its size
