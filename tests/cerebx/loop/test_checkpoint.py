@@ -173,32 +173,53 @@ def test_ranges_outside_the_array_are_refused():
     checkpoint._gather(flat, np.array([0, 17]), 3)  # up to the last element
 
 
-def test_apply_writes_each_run_of_adjacent_ranges_at_once(tmp_path, monkeypatch):
+def test_apply_writes_the_ranges_in_place_without_a_write_call_per_range_and_flushes(tmp_path, monkeypatch):
     rows, cols = 40, 6
     old = np.arange(rows * cols, dtype=np.float32)
     before = np.zeros(8, np.int64)  # an array before it in the file
-    layout = checkpoint._layout({"a0": before, "a1": old})
+    after = np.arange(5, dtype=np.float64)  # and one after it
+    layout = checkpoint._layout({"a0": before, "a1": old, "a2": after})
     path = tmp_path / "x.arrays"
-    checkpoint._write_file(path, checkpoint._whole_parts([before, old]))
-    starts = np.array([0, 1, 2, 9, 20, 21, 39], np.int64) * cols  # first row, adjacent rows, last row
-    values = -np.arange(len(starts) * cols, dtype=np.float32)
-    writes = []
-    pwrite = checkpoint.os.pwrite
+    checkpoint._write_file(path, checkpoint._whole_parts([before, old, after]))
+    size = path.stat().st_size
+    rows_starts = np.array([0, 1, 2, 9, 20, 21, 39], np.int64) * cols  # first row, adjacent rows, last row
+    rows_values = -np.arange(len(rows_starts) * cols, dtype=np.float32)
+    odd_starts = np.array([1, 3], np.int64)  # ranges that are not rows
+    odd_values = np.array([-1.0, -2.0, -3.0, -4.0])
+    calls = {"pwrite": 0, "fsync": 0}
+    pwrite, fsync = checkpoint.os.pwrite, checkpoint.os.fsync
 
-    def counted(fd, data, offset):
-        writes.append((offset, len(data)))
+    def counted_pwrite(fd, data, offset):
+        calls["pwrite"] += 1
         return pwrite(fd, data, offset)
 
-    monkeypatch.setattr(checkpoint.os, "pwrite", counted)
-    checkpoint._apply_file(path, layout, [("a1", starts, cols, values)])
-    off, item = layout["a1"]["offset"], 4
-    assert writes == [(off, 3 * cols * item), (off + 9 * cols * item, cols * item),
-                      (off + 20 * cols * item, 2 * cols * item), (off + 39 * cols * item, cols * item)]
-    expect = old.copy()
-    checkpoint._scatter(expect, starts, cols, values)
+    def counted_fsync(fd):
+        calls["fsync"] += 1
+        return fsync(fd)
+
+    monkeypatch.setattr(checkpoint.os, "pwrite", counted_pwrite)
+    monkeypatch.setattr(checkpoint.os, "fsync", counted_fsync)
+    checkpoint._apply_file(path, layout, [("a1", rows_starts, cols, rows_values), ("a2", odd_starts, 2, odd_values)])
+    assert calls == {"pwrite": 0, "fsync": 1}
+    assert path.stat().st_size == size
+    expect, expect_after = old.copy(), after.copy()
+    checkpoint._scatter(expect, rows_starts, cols, rows_values)
+    checkpoint._scatter(expect_after, odd_starts, 2, odd_values)
     raw = path.read_bytes()
     np.testing.assert_array_equal(np.frombuffer(raw, np.int64, 8, 0), before)
-    np.testing.assert_array_equal(np.frombuffer(raw, np.float32, rows * cols, off), expect)
+    np.testing.assert_array_equal(np.frombuffer(raw, np.float32, rows * cols, layout["a1"]["offset"]), expect)
+    np.testing.assert_array_equal(np.frombuffer(raw, np.float64, 5, layout["a2"]["offset"]), expect_after)
+    assert expect_after.tolist() == [0.0, -1.0, -2.0, -3.0, -4.0]
+
+
+def test_apply_raises_a_bad_range_and_leaves_the_file_readable(tmp_path):
+    old = np.arange(12, dtype=np.float32)
+    layout = checkpoint._layout({"a0": old})
+    path = tmp_path / "x.arrays"
+    checkpoint._write_file(path, checkpoint._whole_parts([old]))
+    with pytest.raises(ValueError, match="outside"):
+        checkpoint._apply_file(path, layout, [("a0", np.array([11], np.int64), 3, np.zeros(3, np.float32))])
+    np.testing.assert_array_equal(np.frombuffer(path.read_bytes(), np.float32), old)
 
 
 def test_the_pickler_fast_paths_change_no_byte():
