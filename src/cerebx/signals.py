@@ -12,6 +12,7 @@ Names are dotted nouns: ``joint.q`` (rad), ``joint.qd`` (rad/s), ``joint.torque`
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -89,3 +90,42 @@ class Frame:
         self.tick, self.t_s, self.stamp_s = tick, t_s, t_s
         self.signals = signals
         self.sensed = sensed
+
+
+class Deferred(Mapping[str, float]):
+    """What a stage's or controller's ``end_trial`` returns when its values are ready only a little later (a
+    spiking network still simulating the steps it ran ahead of the loop: its statistics wait for them, the loop
+    need not).
+
+    It is a mapping like the dict it stands for. Reading it before it is :attr:`ready` calls ``settle``, which
+    must make it ready (e.g. collect what the network is computing); the closed loop instead writes the
+    trial's ``/weights`` once it is ready, with the time stamp of the trial's end."""
+
+    __slots__ = ("_values", "_settle")
+
+    def __init__(self, settle: Callable[[], None]):
+        self._values: dict[str, float] | None = None
+        self._settle: Callable[[], None] | None = settle
+
+    def set(self, values: dict[str, float]) -> None:
+        self._values, self._settle = values, None
+
+    @property
+    def ready(self) -> bool:
+        return self._values is not None
+
+    def _get(self) -> dict[str, float]:
+        if self._values is None and self._settle is not None:
+            self._settle()
+        if self._values is None:
+            raise RuntimeError("a trial's end-of-trial values were never set")
+        return self._values
+
+    def __getitem__(self, key: str) -> float:
+        return self._get()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._get())
+
+    def __len__(self) -> int:
+        return len(self._get())

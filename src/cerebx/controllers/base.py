@@ -8,6 +8,7 @@ joint torque stamped with its application time. The loop runs it as a brain-side
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -74,8 +75,9 @@ class Controller(ABC):
     def step(self, inp: ControlInput) -> TorqueMsg | CommandMsg:
         """One 2 ms control step: a joint torque, or the named signals the controller's schema declares."""
 
-    def end_trial(self, trial: int) -> dict[str, float]:
-        """Called after each trial; may return scalars to record (e.g. weight summaries)."""
+    def end_trial(self, trial: int) -> Mapping[str, float]:
+        """Called after each trial; may return scalars to record (e.g. weight summaries), or a
+        :class:`~cerebx.signals.Deferred` that has them a little later."""
         return {}
 
     def attach_recorder(self, recorder: Recorder) -> None:

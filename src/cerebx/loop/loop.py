@@ -24,19 +24,24 @@ physics               the plant advances one control step
 
 from __future__ import annotations
 
+from collections import deque
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from cerebx.loop.phases import DIVERGENCE_CHECK_TICKS, brain_phase, check_diverged, control_message, robot_phase
 from cerebx.metrics import TrialAccumulator, TrialMetrics
-from cerebx.recording.recorder import Recorder
+from cerebx.recording.cdr import JOINT_STATE
+from cerebx.recording.recorder import Recorder, stamps_ns, to_ns
 from cerebx.signals import Message
 
 if TYPE_CHECKING:
     from cerebx.build import BuildContext
 
 PHASES = ("events", "sense", "uplink", "brain", "downlink", "robot", "actuate", "measure", "record", "physics")
+
+DESIRED = "/joint_states/desired"
 
 # how brain-side output signals are named in /control (kept from the first recordings)
 RECORD_AS = {"joint.torque": "tau_controller"}
@@ -59,6 +64,7 @@ class ClosedLoop:
         self.decimation = cfg.recording.decimation
         self.record_joints = recorder is not None and cfg.recording.joint_states
         self.metrics: list[TrialMetrics] = []
+        self._weights_due: deque[tuple[float, int, list[Mapping[str, float]]]] = deque()  # /weights not yet written
         self.trials_done = 0
         self.tick = 0
         self._sensed: Message | None = None  # newest sensor message delivered to the brain side
@@ -89,9 +95,11 @@ class ClosedLoop:
                 self.scene.note(t_s, f"event {action.kind} {params}")
 
     def step(self, q_des: np.ndarray, qd_des: np.ndarray, acc: TrialAccumulator | None = None, trial: int = 0,
-             ee_des: np.ndarray | None = None, extra: dict[str, np.ndarray] | None = None) -> np.ndarray:
+             ee_des: np.ndarray | None = None, extra: dict[str, np.ndarray] | None = None,
+             desired: bytes | None = None) -> np.ndarray:
         """One tick, every phase in the order of :data:`PHASES`; returns the applied command. ``extra``:
-        further reference signals (``ref.<name>``) for the brain side."""
+        further reference signals (``ref.<name>``) for the brain side; ``desired``: the desired joint-state
+        message of this tick, encoded already (else it is encoded here)."""
         plant, link, rec = self.plant, self.link, self.rec
         tick = self.tick
         t = tick * self.dt_s
@@ -121,7 +129,10 @@ class ClosedLoop:
         # record
         if rec is not None and tick % self.decimation == 0:
             if self.record_joints:
-                rec.joint_states("/joint_states/desired", t, q_des, qd_des)
+                if desired is not None:
+                    rec.log_encoded(DESIRED, JOINT_STATE, desired, to_ns(t))
+                else:
+                    rec.joint_states(DESIRED, t, q_des, qd_des)
                 rec.joint_states("/joint_states/actual", t, q, qd, applied if applied.size == q.size else None)
             msg: dict[str, Any] = {"t": t, "trial": trial}
             for name, field in self._record_as:
@@ -152,24 +163,44 @@ class ClosedLoop:
             self.scene.start_trial(self.tick * self.dt_s, trial, ref.xyz)
         xyz = ref.xyz
         extra = [(f"ref.{name}", v) for name, v in ref.extra.items()]
+        desired: list[bytes] | list[None] = [None] * ref.steps
+        if rec is not None and self.record_joints:  # the trial's desired states, encoded at once
+            desired = rec.joint_state_messages(DESIRED, stamps_ns(self.tick, ref.steps, self.dt_s), ref.q, ref.qd)
         for i in range(ref.steps):
             self.step(ref.q[i], ref.qd[i], acc, trial, xyz[i] if xyz is not None else None,
-                      {name: v[i] for name, v in extra} if extra else None)
+                      {name: v[i] for name, v in extra} if extra else None, desired[i])
         check_diverged(self.plant, trial)
         m = acc.finish(trial)
         self.metrics.append(m)
         self.trials_done = trial + 1
-        extra: dict[str, float] = {}
-        for st in self.brain:
-            extra.update(st.end_trial(trial))
+        ends = [st.end_trial(trial) for st in self.brain]
         if rec is not None:
             rec.write("/trial_metrics", "cerebx.TrialMetrics", self.tick * self.dt_s,
                       {**m.__dict__, "label": ref.label})
-            if extra:
-                rec.write("/weights", "cerebx.WeightSummary", self.tick * self.dt_s, {"trial": trial, **extra})
+            self._weights_due.append((self.tick * self.dt_s, trial, ends))
+            self._write_weights(wait=False)
         if self.scene is not None:
             self.scene.end_trial(self.tick * self.dt_s, m)
         return m
+
+    def settle(self) -> None:
+        """Write every trial's ``/weights`` still waiting for its values (before a checkpoint and at the end:
+        a stage may still be computing them, see :class:`~cerebx.signals.Deferred`)."""
+        self._write_weights(wait=True)
+
+    def _write_weights(self, wait: bool) -> None:
+        """The waiting ``/weights`` messages in trial order, each with its trial's end as its time; without
+        ``wait`` only up to the first whose values are not ready yet."""
+        while self._weights_due:
+            t, trial, ends = self._weights_due[0]
+            if not wait and not all(getattr(e, "ready", True) for e in ends):
+                return
+            self._weights_due.popleft()
+            extra: dict[str, float] = {}
+            for e in ends:
+                extra.update(e)
+            if extra and self.rec is not None:
+                self.rec.write("/weights", "cerebx.WeightSummary", t, {"trial": trial, **extra})
 
     @property
     def sim_seconds(self) -> float:

@@ -115,6 +115,7 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
                 m = loop.run_trial(trial)
                 if resume.due(loop):
                     with phase_clock.span("checkpoint"):
+                        loop.settle()  # the checkpoint holds no /weights message still to write
                         ckpt.save(loop, wall_before + time.perf_counter() - wall0)
                 if bar is not None:
                     bar.set_postfix_str(f"trial {trial + 1}/{cfg.trials}  MAE {m.mae:.4f} rad")
@@ -142,6 +143,11 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             bar.close()
         if summary["status"] == "running":  # left by an exception that is not an Exception (SystemExit)
             summary["status"] = "failed"
+        if loop is not None:
+            try:
+                loop.settle()  # the last trials' /weights
+            except Exception as err:  # e.g. the network thread failed: the log must still be finished
+                log.error("could not write the last weight summaries: %s", err)
         wall = wall_before + time.perf_counter() - wall0
         if loop is not None:
             summary.update(trial_fields(loop.metrics, loop.sim_seconds))

@@ -41,6 +41,7 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
         wall, cpu = time.perf_counter() - t1, time.process_time() - c1
     finally:
         if rec is not None:
+            loop.settle()
             rec.close()
     sim = timed_trials * steps_per_trial * dt
     return {"overrides": overrides, "build_s": round(build_s, 3), "sim_seconds": sim,

@@ -76,8 +76,17 @@ the default level 3, and the files are no larger (joint states and control compr
 _NUMPY = orjson.OPT_SERIALIZE_NUMPY
 
 
-def _ns(t_s: float) -> int:
+def to_ns(t_s: float) -> int:
+    """A message's log time (ns) at simulated time ``t_s``."""
     return int(round(t_s * 1e9))
+
+
+def stamps_ns(first_tick: int, n: int, dt_s: float) -> np.ndarray:
+    """The log times (int64 ns) of ticks ``first_tick .. first_tick + n - 1`` of ``dt_s`` each: for each tick,
+    the ``int(round(tick * dt_s * 1e9))`` of the messages logged at its time ``tick * dt_s``, the same doubles
+    rounded the same way (half to even)."""
+    ticks = np.arange(first_tick, first_tick + n, dtype=np.int64)
+    return np.rint(ticks * dt_s * 1e9).astype(np.int64)
 
 
 def register_schema(name: str, schema: dict) -> None:
@@ -147,7 +156,7 @@ class Recorder:
 
     def write(self, topic: str, schema: str, t_s: float, msg: dict[str, Any]) -> None:
         """Log ``msg`` (numpy arrays allowed) on ``topic`` at simulated time ``t_s``."""
-        self._channel(topic, schema)(orjson.dumps(msg, option=_NUMPY), _ns(t_s))
+        self._channel(topic, schema)(orjson.dumps(msg, option=_NUMPY), to_ns(t_s))
 
     def joint_states(self, topic: str, t_s: float, q: np.ndarray, qd: np.ndarray,
                      effort: np.ndarray | None = None) -> None:
@@ -157,15 +166,29 @@ class Recorder:
         enc = self._joint_encoders.get(topic)
         if enc is None or enc.n != n:
             enc = self._joint_encoders[topic] = JointStateEncoder(self.joint_names[:n])
-        ns = _ns(t_s)
+        ns = to_ns(t_s)
         self._channel(topic, JOINT_STATE)(enc.encode(ns, q, qd, effort), ns)
+
+    def joint_state_messages(self, topic: str, t_ns: np.ndarray, q: np.ndarray, qd: np.ndarray) -> list[bytes]:
+        """The ``sensor_msgs/msg/JointState`` messages :meth:`joint_states` would log on ``topic`` at the times
+        ``t_ns`` (int64 ns, see :func:`stamps_ns`) for the rows of ``q`` and ``qd`` (effort 0), encoded at
+        once and not logged: :meth:`log_encoded` logs each (a trial's desired states, known from its start)."""
+        n = min(len(self.joint_names), q.shape[1], qd.shape[1])
+        enc = self._joint_encoders.get(topic)
+        if enc is None or enc.n != n:
+            enc = self._joint_encoders[topic] = JointStateEncoder(self.joint_names[:n])
+        return enc.encode_many(t_ns, q, qd)
+
+    def log_encoded(self, topic: str, schema: str, data: bytes, t_ns: int) -> None:
+        """Log a message encoded already (e.g. by :meth:`joint_state_messages`) at ``t_ns``."""
+        self._channel(topic, schema)(data, t_ns)
 
     def spike_messages(self, topics: Sequence[str], times_s: Sequence[float], data: bytes,
                        starts: Sequence[int]) -> None:
         """Log a chunk's spikes messages, encoded already (:func:`~cerebx.recording.spike_chunks.chunk_spike_messages`):
         message k = p * len(times_s) + s, ``data[starts[k]:starts[k + 1]]``, is population ``topics[p]``'s
         step s, logged at ``times_s[s]``."""
-        stamps = [_ns(t) for t in times_s]
+        stamps = [to_ns(t) for t in times_s]
         k = 0
         for topic in topics:
             log = self._channel(topic, SPIKES)

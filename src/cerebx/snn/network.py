@@ -299,14 +299,20 @@ class Network:
     def step_packed(self, flat: np.ndarray, in_off: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`step_many` of inputs already packed (:func:`pack`)."""
         n = len(in_off) - 1
+        idx, off = self.chunk_buffers(n)
+        total = kernels.run_chunk(self.t_sub, self.n_sub, flat, in_off, self.learn, self.n_threads, self._state,
+                                  idx, off)
+        self.t_sub += self.n_sub * n
+        return idx[:total].copy(), off
+
+    def chunk_buffers(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """The spike buffer and the step offsets :func:`~cerebx.snn.kernels.run_chunk` fills for ``n`` steps (the
+        buffer is reused: its spikes hold until the next chunk). A caller that runs the kernel itself, inside
+        compiled code of its own, takes its arguments from here and advances ``t_sub`` by ``n_sub * n``."""
         cap = n * self.out_idx.shape[0]
         if getattr(self, "_chunk_idx", None) is None or self._chunk_idx.shape[0] < cap:
             self._chunk_idx = np.zeros(cap, dtype=np.int32)
-        off = np.zeros(n + 1, dtype=np.int64)
-        total = kernels.run_chunk(self.t_sub, self.n_sub, flat, in_off, self.learn, self.n_threads, self._state,
-                                  self._chunk_idx, off)
-        self.t_sub += self.n_sub * n
-        return self._chunk_idx[:total].copy(), off
+        return self._chunk_idx, np.zeros(n + 1, dtype=np.int64)
 
     def step(self, inputs: np.ndarray) -> StepSpikes:
         """One 2 ms step; ``inputs`` are global indices of input fibres spiking at its start

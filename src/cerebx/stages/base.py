@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -48,8 +49,9 @@ class Stage(ABC):
         """Extra fields for this tick's ``/control`` message (e.g. the supervisor's torque)."""
         return {}
 
-    def end_trial(self, trial: int) -> dict[str, float]:
-        """Called after each trial; may return scalars to record (e.g. weight summaries)."""
+    def end_trial(self, trial: int) -> Mapping[str, float]:
+        """Called after each trial; may return scalars to record (e.g. weight summaries), or a
+        :class:`~cerebx.signals.Deferred` that has them a little later."""
         return {}
 
     def attach_recorder(self, recorder: Recorder) -> None:

@@ -20,7 +20,7 @@ from cerebx.recording.cdr import (
     encode_spikes,
 )
 from cerebx.recording.reader import read_messages
-from cerebx.recording.recorder import Recorder
+from cerebx.recording.recorder import Recorder, stamps_ns, to_ns
 from cerebx.recording.spike_chunks import chunk_spike_messages
 from cerebx.snn.decoder import chunk_select
 
@@ -141,3 +141,38 @@ def test_a_chunk_of_spikes_reads_back_per_population_and_step(tmp_path):
         for s, m in enumerate(got[topic]):
             step = idx[off[s]:off[s + 1]]
             assert m["indices"] == (step[(step >= base) & (step < base + 2500)] - base).tolist()
+
+
+@pytest.mark.parametrize("names", NAMES)
+def test_a_trials_joint_states_encoded_at_once_are_the_messages_encoded_one_by_one(names):
+    rng = np.random.default_rng(3)
+    n, steps = len(names), 257
+    q, qd = rng.normal(size=(steps, n + 2)), rng.normal(size=(steps, n + 2))  # wider: the first n are taken
+    first_tick = 1_999_873  # about an hour of 2 ms ticks: stamps with a carry into the seconds
+    stamps = stamps_ns(first_tick, steps, 0.002)
+    enc = JointStateEncoder(names)
+    one_by_one = [enc.encode(int(ns), q[i], qd[i], None) for i, ns in enumerate(stamps)]
+    assert JointStateEncoder(names).encode_many(stamps, q, qd) == one_by_one
+
+
+def test_the_stamps_of_a_trial_are_the_log_times_of_its_ticks():
+    for first, dt in [(0, 0.002), (123_456, 0.002), (10**7 - 500, 0.002), (77, 0.001), (5, 0.0025)]:
+        got = stamps_ns(first, 1000, dt)
+        assert got.dtype == np.int64
+        assert got.tolist() == [to_ns(k * dt) for k in range(first, first + 1000)]
+
+
+def test_a_message_encoded_ahead_is_logged_as_joint_states_logs_it(tmp_path):
+    names = NAMES[0]
+    q, qd = np.linspace(-1, 1, 21).reshape(3, 7), np.linspace(2, 3, 21).reshape(3, 7)
+    for way in ("now", "ahead"):
+        rec = Recorder(tmp_path / f"{way}.mcap", joint_names=names)
+        if way == "now":
+            for i in range(3):
+                rec.joint_states("/joint_states/desired", i * 0.002, q[i], qd[i])
+        else:
+            stamps = stamps_ns(0, 3, 0.002)
+            for data, ns in zip(rec.joint_state_messages("/joint_states/desired", stamps, q, qd), stamps):
+                rec.log_encoded("/joint_states/desired", JOINT_STATE, data, int(ns))
+        rec.close()
+    assert list(read_messages(tmp_path / "now.mcap")) == list(read_messages(tmp_path / "ahead.mcap"))

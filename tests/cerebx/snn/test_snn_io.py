@@ -14,8 +14,9 @@ from cerebx.controllers.snn.schema import BoxEncoder, CFEncoder, SNNController
 from cerebx.errors import StateMismatchError
 from cerebx.recording.cdr import decode_spikes
 from cerebx.schema.controller import GivenRanges
+from cerebx.signals import Deferred
 from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
-from cerebx.snn.encoders import ClimbingEncoder, MossyEncoder
+from cerebx.snn.encoders import ClimbingEncoder, EncoderPair, MossyEncoder
 from cerebx.snn.presets import network as full_network
 from cerebx.snn.topology import build_topology
 
@@ -248,13 +249,13 @@ def test_cf_pathway_delay_shorter_than_mf(pipeline):
     ctrl = make_ctrl(pathway_delay_ms=50.0, cf_pathway_delay_ms=40.0, pipeline=pipeline)
     ctrl.reset(np.random.default_rng(0))
     seen: list[np.ndarray] = []
-    step_packed = ctrl.net.step_packed
+    simulate = ctrl._simulate_packed
 
-    def spy(flat, in_off):
+    def spy(flat, in_off, first):
         seen.extend(flat[a:b] for a, b in zip(in_off[:-1], in_off[1:]))
-        return step_packed(flat, in_off)
+        return simulate(flat, in_off, first)
 
-    ctrl.net.step_packed = spy
+    ctrl._simulate_packed = spy
     for k in range(60):  # samples only at ticks 0-9, with a large error (CF near 10 Hz)
         t = k * 0.002
         q, qd = np.full(6, 0.2), np.zeros(6)
@@ -392,16 +393,113 @@ def test_next_chunk_is_queued_behind_the_one_in_flight_with_the_same_results(mon
 def test_a_failed_chunk_is_raised_once_and_leaves_nothing_in_flight():
     ctrl = make_ctrl(pathway_delay_ms=50.0)
     ctrl.reset(np.random.default_rng(0))
-    step_packed, calls = ctrl.net.step_packed, []
+    simulate, calls = ctrl._simulate_packed, []
 
-    def failing(flat, in_off):
+    def failing(flat, in_off, first):
         calls.append(1)
         if len(calls) == 3:
             raise FloatingPointError("chunk 3 failed")
-        return step_packed(flat, in_off)
+        return simulate(flat, in_off, first)
 
-    ctrl.net.step_packed = failing
+    ctrl._simulate_packed = failing
     with pytest.raises(FloatingPointError, match="chunk 3 failed"):
         drive(ctrl, 300)
     assert ctrl._in_flight == 0
     ctrl.end_trial(0)  # nothing left to wait for
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_encoders_stepped_together_give_their_indices_error_and_draws(seed):
+    """EncoderPair: one compiled call for the MF and CF encoders of a tick, against the encoders one by one
+    (global indices, the error, the bursts left and the generator's state after each tick)."""
+    rng = np.random.default_rng(seed)
+    n_joints, per_joint, first_mf, first_cf = 6, 100, 17, 5000
+    lo, hi = -np.ones((n_joints, 4)), np.ones((n_joints, 4))
+    kpos, kvel = rng.uniform(0.5, 2.0, n_joints), rng.uniform(0.0, 0.3, n_joints)
+    mf_a, mf_b = (MossyEncoder(BoxEncoder(fibers_per_signal=10), lo, hi) for _ in range(2))
+    cf_a, cf_b = (ClimbingEncoder(CFEncoder(), n_joints, per_joint, kpos, kvel, np.random.default_rng(seed))
+                  for _ in range(2))
+    pair = EncoderPair.of(mf_b, cf_b, first_mf, first_cf)
+    assert pair is not None
+    for _ in range(300):
+        q_des, qd_des, q, qd = (rng.uniform(-1.3, 1.3, 7) for _ in range(4))  # beyond the ranges too
+        q_des_cf, qd_des_cf = (q_des, qd_des) if rng.random() < 0.5 else (q_des + 0.1, qd_des - 0.2)
+        mf = (mf_a.active(q_des, q, qd_des, qd) + first_mf).astype(np.int32)
+        e = cf_a.error(q_des_cf, q, qd_des_cf, qd)
+        cf = (cf_a.active(e) + first_cf).astype(np.int32)
+        got = pair.active(q_des, qd_des, q_des_cf, qd_des_cf, q, qd)
+        assert got is not None
+        assert got[0].dtype == got[1].dtype == np.int32
+        np.testing.assert_array_equal(got[0], mf)
+        np.testing.assert_array_equal(got[1], cf)
+        assert got[2].tobytes() == e.tobytes()
+        np.testing.assert_array_equal(cf_b.burst_left, cf_a.burst_left)
+        assert cf_b.rng.bit_generator.state == cf_a.rng.bit_generator.state
+
+
+def test_the_encoder_pair_leaves_short_signals_and_plugin_encoders_to_the_encoders():
+    lo, hi = -np.ones((6, 4)), np.ones((6, 4))
+    mf = MossyEncoder(BoxEncoder(fibers_per_signal=10), lo, hi)
+    cf = ClimbingEncoder(CFEncoder(), 6, 10, np.ones(6), np.zeros(6), np.random.default_rng(0))
+    pair = EncoderPair.of(mf, cf, 0, 0)
+    z6, z5 = np.zeros(6), np.zeros(5)
+    assert pair.active(z6, z6, z6, z6, z6, z5) is None  # the controller then steps them one by one: their error
+    with pytest.raises(ValueError, match="6 joints"):
+        mf.active(z6, z6, z6, z5)
+
+    class OwnMossy(MossyEncoder):
+        pass
+
+    assert EncoderPair.of(OwnMossy(BoxEncoder(fibers_per_signal=10), lo, hi), cf, 0, 0) is None
+
+
+def test_a_trial_end_waits_for_the_chunks_in_flight_only_when_its_values_are_read():
+    """Without weight statistics due, end_trial returns a Deferred that the trial's last chunk completes when
+    the loop collects it; the values, and every torque after, are those of a trial end that waited."""
+    every = 3
+    waited, deferred = (make_ctrl(pathway_delay_ms=50.0, weight_summary_every_trials=every) for _ in range(2))
+    for c in (waited, deferred):
+        c.reset(np.random.default_rng(0))
+    t0, kinds = 0, []
+    for trial in range(6):
+        taus = [drive(c, 130, t0) for c in (waited, deferred)]
+        np.testing.assert_array_equal(*taus)
+        t0 += 130
+        waited._join()  # the way end_trial used to start: nothing in flight, so nothing deferred
+        a, b = waited.end_trial(trial), deferred.end_trial(trial)
+        assert isinstance(a, dict)
+        kinds.append(type(b).__name__)
+        if isinstance(b, Deferred):
+            assert trial % every and not b.ready and deferred._in_flight
+            drive(deferred, 60, t0)  # into the next trial, which collects the chunks: b is then complete
+            assert b.ready
+            drive(waited, 60, t0)
+            t0 += 60
+        assert dict(b) == a and list(b) == list(a) and a["dcn_rate_hz"] > 0
+    assert kinds == ["dict", "Deferred", "Deferred", "dict", "Deferred", "Deferred"]
+    np.testing.assert_array_equal(drive(waited, 100, t0), drive(deferred, 100, t0))
+
+
+def test_a_deferred_trial_end_read_at_once_or_cut_short_by_the_next_trial_waits_for_its_chunks():
+    waited, deferred = (make_ctrl(pathway_delay_ms=50.0, weight_summary_every_trials=0) for _ in range(2))
+    for c in (waited, deferred):
+        c.reset(np.random.default_rng(0))
+
+    def both(n, t0, trial):
+        np.testing.assert_array_equal(drive(waited, n, t0), drive(deferred, n, t0))
+        waited._join()
+        return waited.end_trial(trial), deferred.end_trial(trial)
+
+    a0, d0 = both(130, 0, 0)
+    assert isinstance(d0, Deferred) and not d0.ready
+    drive(waited, 3, 130)
+    drive(deferred, 3, 130)
+    assert deferred._closing is d0  # 3 ticks collected nothing: trial 1 ends while trial 0 still waits
+    waited._join()
+    a1, d1 = waited.end_trial(1), deferred.end_trial(1)
+    assert d0.ready and dict(d0) == a0
+    assert dict(d1) == a1
+    a2, d2 = both(130, 133, 2)
+    assert isinstance(d2, Deferred) and not d2.ready
+    assert d2["dcn_rate_hz"] == a2["dcn_rate_hz"] and d2.ready and not deferred._in_flight  # read: collected
+    np.testing.assert_array_equal(drive(waited, 100, 263), drive(deferred, 100, 263))

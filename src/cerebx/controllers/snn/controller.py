@@ -31,6 +31,7 @@ import threading
 import time
 import weakref
 from collections import deque
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -44,7 +45,10 @@ from cerebx.controllers.snn.schema import SNNController
 from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
 from cerebx.recording.spike_chunks import chunk_spike_messages
+from cerebx.signals import Deferred
 from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
+from cerebx.snn.encoders import EncoderPair
+from cerebx.snn.kernels import run_chunk
 from cerebx.snn.network import Network, pack
 from cerebx.snn.weight_stats import weight_stats
 
@@ -60,14 +64,16 @@ def encoder_ranges(cfg: SNNController, n_joints: int, task: Any = None) -> tuple
 
 class Chunk(NamedTuple):
     """A simulated chunk: its first step; per step the output (a torque or [M_ag, M_at]) and the DCN spike
-    count; the recorded populations' spikes as encoded messages and where each starts
-    (:func:`~cerebx.recording.spike_chunks.chunk_spike_messages`), None when none are recorded."""
+    count; the recorded populations' spikes as encoded messages (32-bit words) and the byte where each starts
+    (:func:`~cerebx.recording.spike_chunks.chunk_spike_messages`), None when none are recorded; the PF spikes
+    the LTD buffers dropped so far, after the chunk."""
 
     first: int
     out: np.ndarray
     counts: np.ndarray
-    spikes: bytes | None
-    starts: list[int] | None
+    spikes: np.ndarray | None
+    starts: np.ndarray | None
+    lost: int = 0
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
@@ -80,6 +86,19 @@ def _chunk_outputs(idx, off, lo, hi, per_joint, sign, alpha, rec_lo, rec_hi, fir
     local, ends = chunk_select(idx, off, rec_lo, rec_hi)
     words, starts = chunk_spike_messages(local, ends, first, step_s)
     return taus, counts, words, starts
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _run_chunk_outputs(t0, n_sub, flat, in_off, learn, par, net, idx_buf, off, lo, hi, per_joint, sign, alpha, rec_lo,
+                       rec_hi, first, step_s, pf_lost):  # pragma: no cover
+    """A whole chunk on the network thread in one compiled call: the network's steps
+    (:func:`~cerebx.snn.kernels.run_chunk`), then :func:`_chunk_outputs`, and the PF spikes dropped so far. The
+    thread needs the interpreter lock once a chunk, to hand the result over: each time it does, the loop's
+    thread, which holds the lock but for its MuJoCo steps, waits for it to let go and for its own wake-up."""
+    total = run_chunk(t0, n_sub, flat, in_off, learn, par, net, idx_buf, off)
+    taus, counts, words, starts = _chunk_outputs(idx_buf[:total], off, lo, hi, per_joint, sign, alpha, rec_lo,
+                                                 rec_hi, first, step_s)
+    return taus, counts, words, starts, pf_lost.sum()
 
 
 class NetworkThread:
@@ -200,7 +219,13 @@ class SNNControllerImpl(Controller):
         self._des: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._dcn_spikes = 0
         self._steps = 0
+        self._no_closing()
         self.last_error = np.zeros(self.n_ctrl)
+
+    def _no_closing(self) -> None:
+        """No trial waits for the chunks in flight to close (:meth:`end_trial`)."""
+        self._closing: Deferred | None = None
+        self._closing_steps = self._closing_left = 0
 
     # ------------------------------------------------------------------ network execution
     def _simulate(self, inputs: list[np.ndarray], first_step: int) -> Chunk:
@@ -216,33 +241,46 @@ class SNNControllerImpl(Controller):
         n = len(in_off) - 1
         if self._shed >= 2:
             self.net.t_sub += self.net.n_sub * n
-            return Chunk(first_step, np.zeros((n, self.width)), np.zeros(n, np.int64), None, None)
-        idx, off = self.net.step_packed(flat, in_off)
+            return Chunk(first_step, np.zeros((n, self.width)), np.zeros(n, np.int64), None, None,
+                         int(self.net.pf_lost.sum()))
         recording = bool(self.recorder is not None and self._shed < 3 and self.record)
         rec_lo, rec_hi = (self._record_lo, self._record_hi) if recording else (_NONE, _NONE)
-        if self.muscles:
-            step_of = np.repeat(np.arange(n), np.diff(off))
-            lo, hi = self.sl_dcn.start, self.sl_dcn.stop
-            sel = (idx >= lo) & (idx < hi)
-            taus = self.decoder.sides(idx[sel] - lo, step_of[sel], n, self.full_scale, self.cfg.decoder.saturate)
-            counts = np.bincount(step_of[sel], minlength=n)
-            words, starts = chunk_spike_messages(*chunk_select(idx, off, rec_lo, rec_hi), first_step, STEP_S)
-        else:
-            taus, counts, words, starts = _chunk_outputs(idx, off, self.sl_dcn.start, self.sl_dcn.stop,
-                                                         self.decoder.per_joint, self.decoder.sign, self._alpha,
-                                                         rec_lo, rec_hi, first_step, STEP_S)
+        if not self.muscles:
+            net = self.net
+            idx_buf, off = net.chunk_buffers(n)
+            taus, counts, words, starts, lost = _run_chunk_outputs(
+                net.t_sub, net.n_sub, flat, in_off, net.learn, net.n_threads, net._state, idx_buf, off,
+                self.sl_dcn.start, self.sl_dcn.stop, self.decoder.per_joint, self.decoder.sign, self._alpha, rec_lo,
+                rec_hi, first_step, STEP_S, net.pf_lost)
+            net.t_sub += net.n_sub * n
+            if not recording:
+                return Chunk(first_step, taus, counts, None, None, lost)
+            return Chunk(first_step, taus, counts, words, starts, lost)
+        idx, off = self.net.step_packed(flat, in_off)  # agonist/antagonist outputs: decoded here
+        step_of = np.repeat(np.arange(n), np.diff(off))
+        lo, hi = self.sl_dcn.start, self.sl_dcn.stop
+        sel = (idx >= lo) & (idx < hi)
+        taus = self.decoder.sides(idx[sel] - lo, step_of[sel], n, self.full_scale, self.cfg.decoder.saturate)
+        counts = np.bincount(step_of[sel], minlength=n)
+        words, starts = chunk_spike_messages(*chunk_select(idx, off, rec_lo, rec_hi), first_step, STEP_S)
+        lost = int(self.net.pf_lost.sum())
         if not recording:
-            return Chunk(first_step, taus, counts, None, None)
-        return Chunk(first_step, taus, counts, words.tobytes(), starts.tolist())
+            return Chunk(first_step, taus, counts, None, None, lost)
+        return Chunk(first_step, taus, counts, words, starts, lost)
 
     def _absorb(self, chunk: Chunk) -> None:
         """Queue a simulated chunk's outputs and log its recorded spikes (``_net_step`` is advanced by the
         caller, which may launch the next chunk first)."""
         self._ready.extend(chunk.out)
         self._dcn_spikes += int(chunk.counts.sum())
-        if chunk.spikes is not None:
+        if chunk.spikes is not None:  # made bytes here: the network's thread would need the interpreter lock
             times = [(chunk.first + i) * STEP_S for i in range(len(chunk.counts))]
-            self.recorder.spike_messages(self._spike_topics, times, chunk.spikes, chunk.starts)
+            self.recorder.spike_messages(self._spike_topics, times, chunk.spikes.tobytes(), chunk.starts.tolist())
+        if self._closing is not None:
+            self._closing_left -= 1
+            if not self._closing_left:  # the last chunk of the trial that ended: its counts are complete
+                closing, self._closing = self._closing, None
+                closing.set(self._trial_counts(self._closing_steps, chunk.lost))
 
     def _run_now(self) -> None:
         """Simulate the next pending input on this thread."""
@@ -308,6 +346,7 @@ class SNNControllerImpl(Controller):
         self._join()
         state = self.__dict__.copy()
         state["_thread"] = None
+        state.pop("_pair", None)  # made again from the encoders restored
         des = self._des
         if des:
             state["_des"] = ("stacked", np.fromiter(des, np.int64, len(des)),
@@ -324,15 +363,17 @@ class SNNControllerImpl(Controller):
             state["_des"] = {int(t): (q[i], qd[i]) for i, t in enumerate(ticks)}
         self.__dict__.update(state)
         self._in_flight, self._thread = 0, None
+        self._no_closing()  # pickled after every chunk was collected, so none was waiting (older code: none)
         self._derive_kernel_args()
 
     def _derive_kernel_args(self) -> None:
-        """The decoder's gains and the recorded populations' bounds as the chunk kernels take them, and their
-        topics."""
+        """The decoder's gains and the recorded populations' bounds as the chunk kernels take them, their
+        topics, and the encoders stepped together."""
         self._alpha = np.ascontiguousarray(np.broadcast_to(self.decoder.alpha, (self.n_ctrl,)), dtype=np.float64)
         self._record_lo = np.array([sl.start for sl in self.record.values()], np.int64)
         self._record_hi = np.array([sl.stop for sl in self.record.values()], np.int64)
         self._spike_topics = tuple(f"/spikes/{name}" for name in self.record)
+        self._pair = EncoderPair.of(self.mf, self.cf, self.sl_mf.start, self.sl_cf.start)
 
     def _on_network_thread(self, fn: Any, *args: Any) -> Any:
         """Run ``fn(*args)`` on the network thread, idle while no chunk is in flight (between trials); returns
@@ -359,14 +400,14 @@ class SNNControllerImpl(Controller):
         """Before the first tick of a wall-clock run: load (or compile) every kernel a step uses, changing no
         state, and leave out the periodic weight summaries (a pass over every plastic weight takes longer than
         the pathway delay leaves between two ticks; the learned state is still saved at the end)."""
-        self.net.step_many([])
-        _chunk_outputs(np.zeros(0, np.int32), np.zeros(1, np.int64), self.sl_dcn.start, self.sl_dcn.stop,
-                       self.decoder.per_joint, self.decoder.sign, self._alpha, self._record_lo, self._record_hi, 0,
-                       STEP_S)
+        self._simulate_packed(*pack([]), self._net_step)  # a chunk of no steps: the network's kernels, decoding
         z = np.zeros(self.n_ctrl)
         self.mf.active(z, z, z, z)
         self.cf.error(z, z, z, z)
         copy.deepcopy(self.cf).active(z)
+        pair = EncoderPair.of(copy.deepcopy(self.mf), copy.deepcopy(self.cf), self.sl_mf.start, self.sl_cf.start)
+        if pair is not None:
+            pair.active(z, z, z, z, z, z)
         self._summaries = False
 
     def shed(self, level: int) -> None:
@@ -400,12 +441,17 @@ class SNNControllerImpl(Controller):
             mf = cf = np.zeros(0, np.int32)
         else:
             q_des, qd_des = self._desired_at(s.stamp_s, inp)
-            mf = (self.mf.active(q_des, s.q, qd_des, s.qd) + self.sl_mf.start).astype(np.int32, copy=False)
+            q_des_cf, qd_des_cf = q_des, qd_des
             if self.cfg.error_reference_lag_ms:
-                q_des, qd_des = self._desired_at(s.stamp_s - self.cfg.error_reference_lag_ms / 1000.0, inp)
-            e = self.cf.error(q_des, s.q, qd_des, s.qd)
-            self.last_error = e
-            cf = (self.cf.active(e) + self.sl_cf.start).astype(np.int32, copy=False)
+                q_des_cf, qd_des_cf = self._desired_at(s.stamp_s - self.cfg.error_reference_lag_ms / 1000.0, inp)
+            both = self._pair.active(q_des, qd_des, q_des_cf, qd_des_cf, s.q, s.qd) if self._pair else None
+            if both is not None:
+                mf, cf, self.last_error = both
+            else:
+                mf = (self.mf.active(q_des, s.q, qd_des, s.qd) + self.sl_mf.start).astype(np.int32, copy=False)
+                e = self.cf.error(q_des_cf, s.q, qd_des_cf, s.qd)
+                self.last_error = e
+                cf = (self.cf.active(e) + self.sl_cf.start).astype(np.int32, copy=False)
         self._mf_lag.append(mf)
         self._cf_lag.append(cf)
         self._pending.append(np.concatenate([self._mf_lag.popleft(), self._cf_lag.popleft()]))
@@ -422,20 +468,44 @@ class SNNControllerImpl(Controller):
         return TorqueMsg(stamp, tau)
 
     # ------------------------------------------------------------------ reporting
-    def end_trial(self, trial: int) -> dict[str, float]:
-        self._join()  # weights and counters must not change while they are read
-        out: dict[str, float] = {}
-        n_dcn = self.sl_dcn.stop - self.sl_dcn.start
-        if self._steps:
-            out["dcn_rate_hz"] = self._dcn_spikes / (n_dcn * self._steps * STEP_S)
-        self._dcn_spikes = self._steps = 0
+    def end_trial(self, trial: int) -> Mapping[str, float]:
+        """The trial's DCN rate, the PF spikes the LTD buffers dropped so far and, every
+        ``weight_summary_every_trials``, the plastic weights' statistics: of the network once the chunks in
+        flight are done, which run ahead into the next trial by up to the pathway delay.
+
+        Without weight statistics due, the loop need not wait for those chunks: a :class:`Deferred` is
+        returned, which the last of them completes when the loop collects it (a few ticks into the next
+        trial). The loop's thread and the network's then go on across the trial's end, where waiting cost both
+        ~3 ms a trial (the network idle until 22 ticks of the next trial had given it a chunk's inputs)."""
+        if self._closing is not None:  # the trial before is still waiting (a trial shorter than the chunks)
+            self._join()
         every = self.cfg.weight_summary_every_trials
-        if every and trial % every == 0 and self._summaries and self._shed < 3:
+        weights = bool(every and trial % every == 0 and self._summaries and self._shed < 3)
+        if self.pipeline and self._in_flight and not weights:
+            self._closing = Deferred(self._join)
+            self._closing_steps, self._closing_left = self._steps, self._in_flight
+            self._steps = 0
+            return self._closing
+        self._join()  # weights and counters must not change while they are read
+        out = self._trial_counts(self._steps, None)
+        self._steps = 0
+        if weights:
             beside = self._on_network_thread if self.pipeline else None
             for name in self.net.plastic_projections:
                 stats = weight_stats(self.net.weights(name), beside)
                 out.update(zip((f"w_{name}_mean", f"w_{name}_std", f"w_{name}_min", f"w_{name}_max"), stats))
         lost = int(self.net.pf_lost.sum())
+        if lost:
+            out["ltd_pf_spikes_dropped"] = float(lost)
+        return out
+
+    def _trial_counts(self, steps: int, lost: int | None) -> dict[str, float]:
+        """The DCN rate over the ``steps`` ticks of the trial that ended (the DCN spike count restarts), and
+        the dropped PF spikes when ``lost`` is given."""
+        out: dict[str, float] = {}
+        if steps:
+            out["dcn_rate_hz"] = self._dcn_spikes / ((self.sl_dcn.stop - self.sl_dcn.start) * steps * STEP_S)
+        self._dcn_spikes = 0
         if lost:
             out["ltd_pf_spikes_dropped"] = float(lost)
         return out
