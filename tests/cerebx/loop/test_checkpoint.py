@@ -4,7 +4,9 @@ changed ranges in later ones, and a crash at any point leaving one whole checkpo
 from __future__ import annotations
 
 import io
+import os
 import pickle
+import threading
 from types import SimpleNamespace
 
 import cloudpickle
@@ -396,3 +398,38 @@ def test_the_checkpointer_writes_ahead_only_when_a_checkpoint_is_due(tmp_path):
     assert sorted(p.name for p in ck.run_dir.iterdir()) == [
         "checkpoint.10.arrays", "checkpoint.journal", "checkpoint.pkl", "checkpoint.pkl.json"]
     np.testing.assert_array_equal(_load(ck.run_dir)[1]["ctx"]["net"].w, net.w)
+
+
+@pytest.mark.skipif(not checkpoint._can_restore_priority(), reason="needs a thread that can take its priority back")
+def test_the_writer_writes_at_idle_priority_and_gets_its_priority_back_when_waited_for():
+    started, go_on = threading.Event(), threading.Event()
+    seen = []
+
+    class Job:
+        def write(self):
+            seen.append(os.sched_getscheduler(0))
+            started.set()
+            go_on.wait(10)
+            seen.append(os.sched_getscheduler(0))
+
+    writer = checkpoint.Writer()
+    writer.submit(Job())
+    started.wait(10)
+    threading.Timer(0.2, go_on.set).start()  # still writing when the loop waits for it
+    writer.wait()
+    assert seen == [os.SCHED_IDLE, os.SCHED_OTHER]
+    assert os.sched_getscheduler(0) == os.SCHED_OTHER  # the loop's own thread is left as it was
+
+
+def test_a_writer_that_could_not_get_its_priority_back_writes_at_the_loops(monkeypatch):
+    monkeypatch.setattr(checkpoint, "_can_restore_priority", lambda: False)
+    seen = []
+
+    class Job:
+        def write(self):
+            seen.append(os.sched_getscheduler(0) if hasattr(os, "sched_getscheduler") else None)
+
+    writer = checkpoint.Writer()
+    writer.submit(Job())
+    writer.wait()
+    assert seen[0] != getattr(os, "SCHED_IDLE", -1)
