@@ -7,9 +7,10 @@ checkpoints, the learning run, and the learning run again with ``recording.phase
 its per-call timers cost a few microseconds per step, so the factors come from the untimed run). Rounds
 alternate the cases, so a change in the host's load hits all of them alike; the numbers are medians over rounds.
 
-Factors are simulated seconds per second: ``rt_factor`` what ``cerebx run`` prints (from the run's start to its
-summary: build, trials, checkpoints, the final state); ``process_rt_factor`` from the launch of the command to
-its exit (start-up and exit included); ``cpu_rt_factor`` per CPU second of the run (all threads), which depends
+Factors are simulated seconds per second: ``rt_factor`` what ``cerebx run`` prints (from the run's start to the
+end of its last trial: build, trials, checkpoints; the learned state written after it and the log's closing
+are not in it); ``process_rt_factor`` from the launch of the command to its exit (start-up, the learned state
+and exit included); ``cpu_rt_factor`` per CPU second of the run (all threads), which depends
 much less on what else the host is running than the wall-clock factors.
 """
 
