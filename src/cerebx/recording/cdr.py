@@ -123,7 +123,7 @@ class JointStateEncoder:
         np.ndarray((m,), "<i4", block, 4, (size,))[:] = sec
         np.ndarray((m,), "<u4", block, 8, (size,))[:] = nsec
         for off, values in zip(self._offsets, (q, qd)):
-            np.ndarray((m, n), "<f8", block, off, (size, 8))[:] = np.asarray(values)[:, :n]
+            np.ndarray((m, n), "<f8", block, off, (size, 8))[:] = np.asarray(values)[:m, :n]
         raw = block.tobytes()
         return [raw[k:k + size] for k in range(0, m * size, size)]
 
