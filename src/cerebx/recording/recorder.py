@@ -163,21 +163,22 @@ class Recorder:
         """A ``sensor_msgs/msg/JointState`` message: the joints named, or the first n of them when fewer
         values are given (as zip would pair them); effort 0 when none is given."""
         n = min(len(self.joint_names), len(q), len(qd), len(q) if effort is None else len(effort))
-        enc = self._joint_encoders.get(topic)
-        if enc is None or enc.n != n:
-            enc = self._joint_encoders[topic] = JointStateEncoder(self.joint_names[:n])
         ns = to_ns(t_s)
-        self._channel(topic, JOINT_STATE)(enc.encode(ns, q, qd, effort), ns)
+        self._channel(topic, JOINT_STATE)(self._joint_encoder(topic, n).encode(ns, q, qd, effort), ns)
 
     def joint_state_messages(self, topic: str, t_ns: np.ndarray, q: np.ndarray, qd: np.ndarray) -> list[bytes]:
         """The ``sensor_msgs/msg/JointState`` messages :meth:`joint_states` would log on ``topic`` at the times
         ``t_ns`` (int64 ns, see :func:`stamps_ns`) for the rows of ``q`` and ``qd`` (effort 0), encoded at
         once and not logged: :meth:`log_encoded` logs each (a trial's desired states, known from its start)."""
         n = min(len(self.joint_names), q.shape[1], qd.shape[1])
+        return self._joint_encoder(topic, n).encode_many(t_ns, q, qd)
+
+    def _joint_encoder(self, topic: str, n: int) -> JointStateEncoder:
+        """The encoder of ``topic``'s messages for its first ``n`` joints (made again when ``n`` changes)."""
         enc = self._joint_encoders.get(topic)
         if enc is None or enc.n != n:
             enc = self._joint_encoders[topic] = JointStateEncoder(self.joint_names[:n])
-        return enc.encode_many(t_ns, q, qd)
+        return enc
 
     def log_encoded(self, topic: str, schema: str, data: bytes, t_ns: int) -> None:
         """Log a message encoded already (e.g. by :meth:`joint_state_messages`) at ``t_ns``."""

@@ -73,7 +73,7 @@ class Chunk(NamedTuple):
     counts: np.ndarray
     spikes: np.ndarray | None
     starts: np.ndarray | None
-    lost: int = 0
+    lost: int
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
@@ -253,17 +253,15 @@ class SNNControllerImpl(Controller):
                 self.sl_dcn.start, self.sl_dcn.stop, self.decoder.per_joint, self.decoder.sign, self._alpha, rec_lo,
                 rec_hi, first_step, STEP_S, net.pf_lost)
             net.t_sub += net.n_sub * n
-            if not recording:
-                return Chunk(first_step, taus, counts, None, None, lost)
-            return Chunk(first_step, taus, counts, words, starts, lost)
-        idx, off = self.net.step_packed(flat, in_off)  # agonist/antagonist outputs: decoded here
-        step_of = np.repeat(np.arange(n), np.diff(off))
-        lo, hi = self.sl_dcn.start, self.sl_dcn.stop
-        sel = (idx >= lo) & (idx < hi)
-        taus = self.decoder.sides(idx[sel] - lo, step_of[sel], n, self.full_scale, self.cfg.decoder.saturate)
-        counts = np.bincount(step_of[sel], minlength=n)
-        words, starts = chunk_spike_messages(*chunk_select(idx, off, rec_lo, rec_hi), first_step, STEP_S)
-        lost = int(self.net.pf_lost.sum())
+        else:  # agonist/antagonist outputs: decoded here
+            idx, off = self.net.step_packed(flat, in_off)
+            step_of = np.repeat(np.arange(n), np.diff(off))
+            lo, hi = self.sl_dcn.start, self.sl_dcn.stop
+            sel = (idx >= lo) & (idx < hi)
+            taus = self.decoder.sides(idx[sel] - lo, step_of[sel], n, self.full_scale, self.cfg.decoder.saturate)
+            counts = np.bincount(step_of[sel], minlength=n)
+            words, starts = chunk_spike_messages(*chunk_select(idx, off, rec_lo, rec_hi), first_step, STEP_S)
+            lost = int(self.net.pf_lost.sum())
         if not recording:
             return Chunk(first_step, taus, counts, None, None, lost)
         return Chunk(first_step, taus, counts, words, starts, lost)
