@@ -54,6 +54,7 @@ import logging
 import mmap
 import os
 import pickle
+import sys
 import threading
 import time
 import zlib
@@ -63,6 +64,7 @@ from typing import Any
 
 import cloudpickle
 import numpy as np
+from numba import njit
 
 from cerebx import phase_clock, runfiles
 
@@ -278,11 +280,13 @@ class Checkpoint:
 def _apply_file(path: Path, layout: dict[str, dict[str, Any]], changes: Changes) -> None:
     """Write the changed ranges into the arrays file in place, then flush it to the disk.
 
-    The file is mapped and each array's ranges are written by one numpy assignment (:func:`_scatter`), which
-    runs without the interpreter lock. One ``pwrite`` per run of ranges (600-800 for the full network's 10
-    trials of learning) needed the lock back after each: the writer's thread and the loop's took it from each
-    other hundreds of times a checkpoint, which stalled the loop by a millisecond or more each time, for the
-    ~0.1 s the writing took."""
+    The file is mapped and each array's ranges are copied in by compiled code without the interpreter lock
+    (:func:`_scatter`), page faults included; then the file is flushed with ``fsync``, which lets go of the lock
+    too. On Linux the map's pages are the file's pages in the page cache, so ``fsync`` writes them; the map's own
+    flush (``msync``) would hold the lock the whole time (40-50 ms for a checkpoint of the full network), and so
+    would a numpy assignment into the map (~15 ms): the loop's thread, waiting for the lock, left the network's
+    idle. One ``pwrite`` per run of ranges (600-800 of them) took the lock back after each, stalling the loop a
+    millisecond or more each time."""
     with open(path, "r+b") as fh:
         mm = mmap.mmap(fh.fileno(), 0)
         try:
@@ -290,7 +294,8 @@ def _apply_file(path: Path, layout: dict[str, dict[str, Any]], changes: Changes)
                 item = layout[key]
                 count = int(np.prod(item["shape"], dtype=np.int64))
                 _scatter(np.frombuffer(mm, np.dtype(item["dtype"]), count, item["offset"]), starts, length, values)
-            mm.flush()
+            if sys.platform != "linux":  # elsewhere the map may not be the file's cache
+                mm.flush()
         finally:
             try:
                 mm.close()
@@ -370,6 +375,8 @@ def prime(run_dir: Path, seq: int, state: Any, store: ArrayStore, persistent: di
     _dumps(state, store, persistent)  # finds the tracked arrays (and takes their changed ranges)
     if not store.used:
         return None
+    for key in store.used:  # the writer's compiled copy, loaded here: loading holds the interpreter lock
+        _warm_scatter(store.arrays[key].dtype)
     store.ahead = ArraysFile(run_dir, name, {k: store.arrays[k] for k in _ordered(store.used)},
                              settle=committed is not None)
     return store.ahead
@@ -436,16 +443,28 @@ def _gather(flat: np.ndarray, starts: np.ndarray, length: int) -> np.ndarray:
 
 
 def _scatter(flat: np.ndarray, starts: np.ndarray, length: int, values: np.ndarray) -> None:
-    """``flat[s:s + length]`` = the next ``length`` values, for s in ``starts`` (the inverse of :func:`_gather`)."""
+    """``flat[s:s + length]`` = the next ``length`` values, for s in ``starts`` (the inverse of :func:`_gather`),
+    in compiled code without the interpreter lock."""
     starts = _check_ranges(flat, starts, length)
     if values.shape != (len(starts) * length,) or values.dtype != flat.dtype:
         raise ValueError(f"{values.shape} {values.dtype} values for {len(starts)} ranges of {length} {flat.dtype}")
-    view = _rows(flat, starts, length)
-    if view is not None:
-        view[0][view[1]] = values.reshape(-1, length)
-        return
-    for i, s in enumerate(starts.tolist()):
-        flat[s:s + length] = values[i * length:(i + 1) * length]
+    if len(starts) and length:
+        _put_ranges(flat, starts, length, values)
+
+
+def _warm_scatter(dtype: np.dtype) -> None:
+    """Load (or compile) :func:`_scatter`'s compiled code for arrays of ``dtype``, here and now: that holds the
+    interpreter lock for tens of milliseconds, which the writer's thread must not do while the trials run."""
+    flat = np.zeros(2, dtype)
+    _scatter(flat, np.zeros(1, np.int64), 1, flat[:1].copy())
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _put_ranges(flat, starts, length, values):  # pragma: no cover - numba
+    k = 0
+    for s in starts:
+        flat[s:s + length] = values[k:k + length]
+        k += length
 
 
 def _layout(arrays: dict[str, np.ndarray]) -> dict[str, dict[str, Any]]:

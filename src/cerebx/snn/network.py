@@ -42,6 +42,13 @@ def pack(inputs: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     return flat, in_off
 
 
+_SCRATCH = ("col_buf", "acc", "acc_j", "out_idx", "out_t", "scr_f", "scr_i")
+"""The kernels' scratch buffers: each is written before it is read (``acc`` is all zeros between calls)."""
+_CACHES = ("c_k", "c_q", "c_l")
+"""The sparse projections' delivery caches (``kernels._build_runs``), valid while ``sp_c``'s epoch is current."""
+_LEFT_OUT = "cerebx.left-out"
+
+
 class Network:
     """Flat-array spiking network (see :mod:`cerebx.snn.kernels` for the numerics).
 
@@ -257,9 +264,33 @@ class Network:
         return out
 
     def __getstate__(self) -> dict:
+        """The state without what a checkpoint need not keep (~10 MB of the full network's ~20 MB pickle,
+        which the loop's thread pickles while the network waits): the kernels' scratch buffers (written before
+        they are read; ``acc`` is all zeros between calls) and the sparse delivery caches (rebuilt on first
+        use), each left as its dtype and shape; the kernels' handles on the arrays are made again too."""
         state = self.__dict__.copy()
         state.pop("_chunk_idx", None)  # step_many's output scratch (rebuilt on use)
+        state.pop("arrays", None)
+        state.pop("_state", None)
+        for name in _SCRATCH + _CACHES:
+            a = state[name]
+            state[name] = (_LEFT_OUT, a.dtype.str, a.shape)
         return state
+
+    def __setstate__(self, state: dict) -> None:
+        """A state of :meth:`__getstate__`, or of earlier code (every array in it, and the kernels' handles)."""
+        state = dict(state)
+        stale = False
+        for name in _SCRATCH + _CACHES:
+            v = state.get(name)
+            if isinstance(v, tuple) and v and v[0] == _LEFT_OUT:
+                state[name] = np.zeros(v[2], np.dtype(v[1]))
+                stale = stale or name in _CACHES
+        self.__dict__.update(state)
+        if stale:
+            self.sp_c[:, 0] = 0  # no cache is valid (epochs start at 1): each is rebuilt when first used
+        self.arrays = self._kernel_arrays()
+        self._state = kernels.kernel_state(self.arrays)
 
     # ------------------------------------------------------------------ access
     def index(self, pop: str) -> slice:
