@@ -271,6 +271,14 @@ def test_a_pickled_network_goes_on_as_the_original():
     np.testing.assert_array_equal(a.dense_w, b.dense_w)
     for k in ("V", "g", "ref"):
         np.testing.assert_array_equal(getattr(a, k), getattr(b, k))
+    # a checkpoint of earlier code pickled every array and the kernels' handles: it loads and goes on too
+    old = {k: v for k, v in a.__dict__.items() if k != "_chunk_idx"}
+    c = Network.__new__(Network)
+    c.__setstate__(pickle.loads(pickle.dumps(old)))
+    sa, sc = _drive(a, 50, seed=2), _drive(c, 50, seed=2)
+    for (ia, _), (ic, _) in zip(sa, sc, strict=True):
+        np.testing.assert_array_equal(ia, ic)
+    np.testing.assert_array_equal(a.dense_w, c.dense_w)
 
 
 def test_delivery_caches_and_compaction_are_exact_and_consistent():
