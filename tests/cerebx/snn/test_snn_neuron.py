@@ -212,6 +212,16 @@ def _drive(net: Network, n_steps: int, seed: int = 0) -> list[tuple[np.ndarray, 
     return out
 
 
+def _assert_same(sa: list, sb: list, a: Network, b: Network) -> None:
+    """The spikes of two drives, and the two networks' weights and neuron states, are equal bit for bit."""
+    for (ia, ta), (ib, tb) in zip(sa, sb, strict=True):
+        np.testing.assert_array_equal(ia, ib)
+        np.testing.assert_array_equal(ta, tb)
+    np.testing.assert_array_equal(a.dense_w, b.dense_w)
+    for k in ("V", "g", "ref"):
+        np.testing.assert_array_equal(getattr(a, k), getattr(b, k))
+
+
 def test_skipping_resting_neurons_is_exact():
     """Integrating only the non-resting GCs (compact list) gives bit-identical spikes, weights and
     state to integrating all of them, and neurons without input leave the list."""
@@ -222,12 +232,7 @@ def test_skipping_resting_neurons_is_exact():
     gi = a.topo.index["gc"]
     assert a.pop_i[gi, 4] == 1 and b.pop_i[gi, 4] == 0
     sa, sb = _drive(a, 400), _drive(b, 400)
-    for (ia, ta), (ib, tb) in zip(sa, sb, strict=True):
-        np.testing.assert_array_equal(ia, ib)
-        np.testing.assert_array_equal(ta, tb)
-    np.testing.assert_array_equal(a.dense_w, b.dense_w)
-    for k in ("V", "g", "ref"):
-        np.testing.assert_array_equal(getattr(a, k), getattr(b, k))
+    _assert_same(sa, sb, a, b)
     assert sum(len(i) for i, _ in sa) > 100
     assert 0 < a.n_act[gi] < gc.stop - gc.start  # only part of the GCs are off rest
     for _ in range(100):  # no input for 200 ms: every GC is back exactly at rest and off the list
@@ -265,20 +270,12 @@ def test_a_pickled_network_goes_on_as_the_original():
     b = pickle.loads(pickle.dumps(a))
     assert not b.sp_c[:, 0].any() and b.out_idx.shape == a.out_idx.shape
     sa, sb = _drive(a, 200, seed=1), _drive(b, 200, seed=1)
-    for (ia, ta), (ib, tb) in zip(sa, sb, strict=True):
-        np.testing.assert_array_equal(ia, ib)
-        np.testing.assert_array_equal(ta, tb)
-    np.testing.assert_array_equal(a.dense_w, b.dense_w)
-    for k in ("V", "g", "ref"):
-        np.testing.assert_array_equal(getattr(a, k), getattr(b, k))
+    _assert_same(sa, sb, a, b)
     # a checkpoint of earlier code pickled every array and the kernels' handles: it loads and goes on too
     old = {k: v for k, v in a.__dict__.items() if k != "_chunk_idx"}
     c = Network.__new__(Network)
     c.__setstate__(pickle.loads(pickle.dumps(old)))
-    sa, sc = _drive(a, 50, seed=2), _drive(c, 50, seed=2)
-    for (ia, _), (ic, _) in zip(sa, sc, strict=True):
-        np.testing.assert_array_equal(ia, ic)
-    np.testing.assert_array_equal(a.dense_w, c.dense_w)
+    _assert_same(_drive(a, 50, seed=2), _drive(c, 50, seed=2), a, c)
 
 
 def test_delivery_caches_and_compaction_are_exact_and_consistent():
