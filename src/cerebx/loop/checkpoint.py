@@ -284,7 +284,7 @@ def _apply_file(path: Path, layout: dict[str, dict[str, Any]], changes: Changes)
     (:func:`_scatter`), page faults included; then the file is flushed with ``fsync``, which lets go of the lock
     too. On Linux the map's pages are the file's pages in the page cache, so ``fsync`` writes them; the map's own
     flush (``msync``) would hold the lock the whole time (40-50 ms for a checkpoint of the full network), and so
-    would a numpy assignment into the map (~15 ms): the loop's thread, waiting for the lock, left the network's
+    would a numpy assignment into the map (~15 ms): the loop's thread, waiting for the lock, left the network
     idle. One ``pwrite`` per run of ranges (600-800 of them) took the lock back after each, stalling the loop a
     millisecond or more each time."""
     with open(path, "r+b") as fh:
