@@ -28,7 +28,7 @@ from cerebx.loop.loop import ClosedLoop
 from cerebx.phase_clock import PhaseClock
 
 PLANT_CALLS = ("sense", "actuate", "true_state", "end_effector", "step", "is_diverged")
-RECORDER_CALLS = ("write", "joint_states", "log_encoded", "spike_messages")
+RECORDER_CALLS = ("write", "joint_states", "log_encoded", "spike_messages", "idle")
 
 
 def _timed(fn: Callable, clock: PhaseClock, phase: str) -> Callable:

@@ -75,6 +75,9 @@ the default level 3, and the files are no larger (joint states and control compr
 
 _NUMPY = orjson.OPT_SERIALIZE_NUMPY
 
+EARLY_CHUNK = 0.6
+"""The fraction of a chunk's size (in message bytes) from which :meth:`Recorder.idle` finishes the chunk."""
+
 
 def to_ns(t_s: float) -> int:
     """A message's log time (ns) at simulated time ``t_s``."""
@@ -136,6 +139,8 @@ class Recorder:
                                 compression_level=ZSTD_LEVEL if compression == "zstd" else 0)
         self._w = foxglove.open_mcap(self.path, allow_overwrite=True, context=self._ctx, writer_options=opts)
         self._logs: dict[str, Callable[[bytes, int], None]] = {}
+        self._early = int(EARLY_CHUNK * chunk_size_kb * 1024) if compression != "none" else 0
+        self._pending = 0  # message bytes logged since the last chunk this recorder finished (an estimate)
         self._joint_encoders: dict[str, JointStateEncoder] = {}
         self.joint_names = tuple(joint_names)
         self.live = live  # a LiveView (recording/live.py) whose server also gets every channel, or None
@@ -156,7 +161,9 @@ class Recorder:
 
     def write(self, topic: str, schema: str, t_s: float, msg: dict[str, Any]) -> None:
         """Log ``msg`` (numpy arrays allowed) on ``topic`` at simulated time ``t_s``."""
-        self._channel(topic, schema)(orjson.dumps(msg, option=_NUMPY), to_ns(t_s))
+        data = orjson.dumps(msg, option=_NUMPY)
+        self._pending += len(data)
+        self._channel(topic, schema)(data, to_ns(t_s))
 
     def joint_states(self, topic: str, t_s: float, q: np.ndarray, qd: np.ndarray,
                      effort: np.ndarray | None = None) -> None:
@@ -164,7 +171,9 @@ class Recorder:
         values are given (as zip would pair them); effort 0 when none is given."""
         n = min(len(self.joint_names), len(q), len(qd), len(q) if effort is None else len(effort))
         ns = to_ns(t_s)
-        self._channel(topic, JOINT_STATE)(self._joint_encoder(topic, n).encode(ns, q, qd, effort), ns)
+        data = self._joint_encoder(topic, n).encode(ns, q, qd, effort)
+        self._pending += len(data)
+        self._channel(topic, JOINT_STATE)(data, ns)
 
     def joint_state_messages(self, topic: str, t_ns: np.ndarray, q: np.ndarray, qd: np.ndarray) -> list[bytes]:
         """The ``sensor_msgs/msg/JointState`` messages :meth:`joint_states` would log on ``topic`` at the times
@@ -182,6 +191,7 @@ class Recorder:
 
     def log_encoded(self, topic: str, schema: str, data: bytes, t_ns: int) -> None:
         """Log a message encoded already (e.g. by :meth:`joint_state_messages`) at ``t_ns``."""
+        self._pending += len(data)
         self._channel(topic, schema)(data, t_ns)
 
     def spike_messages(self, topics: Sequence[str], times_s: Sequence[float], data: bytes,
@@ -190,12 +200,26 @@ class Recorder:
         message k = p * len(times_s) + s, ``data[starts[k]:starts[k + 1]]``, is population ``topics[p]``'s
         step s, logged at ``times_s[s]``."""
         stamps = [to_ns(t) for t in times_s]
+        self._pending += len(data)
         k = 0
         for topic in topics:
             log = self._channel(topic, SPIKES)
             for ns in stamps:
                 log(data[starts[k]:starts[k + 1]], ns)
                 k += 1
+
+    def idle(self) -> None:
+        """The caller is about to wait (the loop's thread, for the network's next chunk): a moment to compress
+        the chunk being filled, if it holds at least :data:`EARLY_CHUNK` of a chunk's size. The writer
+        compresses a chunk when a message fills it, in the middle of a tick, where the network thread then
+        waits for the loop's thread to hand it its next inputs (~0.3 ms a 256 kB chunk with zstd, seven a
+        ``make_run`` trial); finishing it here lets the compression run while the loop would wait anyway (the
+        flush lets go of the interpreter lock). Whether it does depends only on the messages logged, so the
+        file stays the same from run to run; its messages are the same either way, only the chunks are
+        smaller."""
+        if self._early and self._pending >= self._early:
+            self._pending = 0
+            self._w.flush()
 
     def metadata(self, name: str, data: dict[str, str]) -> None:
         self._w.write_metadata(name, {k: str(v) for k, v in data.items()})

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import threading
 import time
 from dataclasses import dataclass
 
@@ -16,7 +17,9 @@ from cerebx.snn.topology import (
     KIND_INPUT,
     KIND_LIF_AMPA,
     P_EL,
+    Topology,
     build_topology,
+    fill_dense,
 )
 
 COMPACT_MIN = 4096  # AMPA-only populations this large integrate only their non-resting neurons
@@ -73,7 +76,20 @@ class Network:
         # without it (numba issue 8578)
         threads = numba.get_num_threads()
         self.n_threads = threads if parallel else 1
-        self.topo = topo = build_topology(cfg)
+        self.topo = topo = build_topology(cfg, fill=False)
+        # the weights' first touch beside the rest of the set-up (mostly the kernels' loading, which holds the
+        # interpreter lock that the fill lets go of): joined before anything reads them
+        filling = threading.Thread(target=fill_dense, args=(topo,), name="cerebx-weights", daemon=True)
+        filling.start()
+        try:
+            self._set_up(cfg, topo, pf_ring, compact_min)
+        finally:
+            filling.join()
+        self.reset_state()
+        self.build_s = time.perf_counter() - t_start
+
+    def _set_up(self, cfg: NetworkConfig, topo: Topology, pf_ring: int, compact_min: int) -> None:
+        """Every array but the weights' values, and the kernels' handle on them."""
         self.n_sub = topo.n_sub
         self.fingerprint = cfg.fingerprint()
         n = topo.n_neurons
@@ -148,8 +164,6 @@ class Network:
         self._all_changed = True  # every weight counts as changed until the first changed_ranges()
         self.arrays = self._kernel_arrays()
         self._state = kernels.kernel_state(self.arrays)
-        self.reset_state()
-        self.build_s = time.perf_counter() - t_start
 
     def _kernel_arrays(self) -> kernels.NetworkArrays:
         """The kernels' view of this network: the same array objects, grouped (state is only ever

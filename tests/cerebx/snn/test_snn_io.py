@@ -166,6 +166,10 @@ def test_controller_records_spikes_when_recorder_has_spikes():
     class Rec:
         def __init__(self):
             self.calls = []
+            self.idles = 0
+
+        def idle(self):
+            self.idles += 1
 
         def spike_messages(self, topics, times_s, data, starts):
             k = 0
@@ -186,6 +190,8 @@ def test_controller_records_spikes_when_recorder_has_spikes():
     # one message per simulated network step, stamped with that step's time
     np.testing.assert_allclose(times, np.arange(len(times)) * 0.002)
     assert len(times) >= 30 - ctrl.k_delay
+    # the loop's thread offered the recorder each wait for a chunk (its moment to compress the log's chunk)
+    assert ctrl.pipeline and rec.idles == len(times) // ctrl.chunk
 
 
 def test_save_load_roundtrip_and_mismatch(tmp_path):

@@ -315,6 +315,8 @@ class SNNControllerImpl(Controller):
             self._launch()
         while self._in_flight:
             self._in_flight -= 1
+            if self.recorder is not None:
+                self.recorder.idle()  # the log's chunk compressed while this thread would wait
             try:
                 with phase_clock.charge("wait"):
                     chunk = self._thread.result()  # an exception of the network thread is raised here
