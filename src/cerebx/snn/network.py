@@ -264,18 +264,33 @@ class Network:
     def changed_ranges(self) -> list[tuple[np.ndarray, np.ndarray, int]]:
         """The weights written since the last call, as (array, start offsets, length) ranges: the rows of
         the plastic projections the kernels marked (LTP, LTD), or all of ``dense_w`` after a load. Lets a
-        checkpoint rewrite only those (``loop/checkpoint.py``); the call starts a new interval."""
+        checkpoint rewrite only those (``loop/checkpoint.py``); the call starts a new interval.
+
+        The arrays the network never writes after its build (:meth:`_fixed`) are reported too, whole after a
+        load and with no range since: a checkpoint then keeps them in its arrays file, written once per
+        process, instead of in every pickle (4.1 of the full network's 9.2 MB)."""
+        fixed = [a for a in self._fixed() if a.size]
         if self._all_changed:
             self._all_changed = False
             self.pl_dirty[:] = 0
-            return [(self.dense_w, np.zeros(1, np.int64), self.dense_w.size)]
+            whole = np.zeros(1, np.int64)
+            return [(self.dense_w, whole, self.dense_w.size), *((a, whole, a.size) for a in fixed)]
         out = []
         for r, d in enumerate(self.pl_i[:, 0]):
             n_pre, n_post, w_off = (int(x) for x in self.de_i[d, [1, 3, 4]])
             rows = np.flatnonzero(self.pl_dirty[r, :n_pre])
             out.append((self.dense_w, w_off + rows.astype(np.int64) * n_post, n_post))
         self.pl_dirty[:] = 0
-        return out
+        none = np.zeros(0, np.int64)
+        return out + [(a, none, a.size) for a in fixed]
+
+    def _fixed(self) -> list[np.ndarray]:
+        """The arrays no kernel or method writes once the network is built: the sparse projections' tables
+        (the network's and the topology's own) and the resting potentials."""
+        arrays = [self.sp_ptr, self.sp_post, self.sp_w, self.el]
+        for s in self.topo.sparse:
+            arrays += [s.ptr, s.post, s.w]
+        return arrays
 
     def __getstate__(self) -> dict:
         """The state without what a checkpoint need not keep (~10 MB of the full network's ~20 MB pickle,

@@ -434,3 +434,44 @@ def test_a_writer_that_could_not_get_its_priority_back_writes_at_the_loops(monke
     writer.submit(Job())
     writer.wait()
     assert seen[0] != getattr(os, "SCHED_IDLE", -1)
+
+
+def test_the_networks_fixed_arrays_go_into_the_arrays_file_once_and_come_back(tmp_path):
+    """The spiking network reports the arrays it never writes after its build (its sparse tables, resting
+    potentials) as tracked: the first checkpoint puts them in the arrays file, later pickles only name them, and
+    a loaded network goes on as the original. Driving the network leaves them as they were."""
+    from cerebx.snn.network import Network
+    from cerebx.snn.presets import network as full_network
+
+    net = Network(full_network(fibers=5, per_joint=20), parallel=False)
+    fixed = [a.copy() for a in net._fixed()]
+    mf = net.index("mf")
+    rng = np.random.default_rng(0)
+
+    def drive(n, network):
+        for _ in range(n):
+            network.step(rng.choice(np.arange(mf.start, mf.stop, dtype=np.int32), 12, replace=False))
+
+    drive(50, net)
+    store = checkpoint.ArrayStore()
+    first = _write(tmp_path, 10, {"net": net}, store)
+    assert first.whole is not None and len(first.whole) == 1 + len(net._fixed())
+    drive(50, net)
+    plain = len(pickle.dumps(net))
+    second = _write(tmp_path, 20, {"net": net}, store)
+    fixed_bytes = sum(a.nbytes for a in net._fixed())
+    assert second.whole is None and len(second.stream) < plain - fixed_bytes + 1024
+    assert all(len(starts) == 0 for key, starts, _, _ in second.changes if key != store.key_of[id(net.dense_w)])
+    for a, b in zip(net._fixed(), fixed):
+        np.testing.assert_array_equal(a, b)
+    _, state = _load(tmp_path)
+    loaded = state["net"]
+    for a, b in zip(loaded._fixed(), fixed):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(loaded.dense_w, net.dense_w)
+    rng_a, rng_b = np.random.default_rng(5), np.random.default_rng(5)
+    for _ in range(40):
+        sa = net.step(rng_a.choice(np.arange(mf.start, mf.stop, dtype=np.int32), 12, replace=False))
+        sb = loaded.step(rng_b.choice(np.arange(mf.start, mf.stop, dtype=np.int32), 12, replace=False))
+        np.testing.assert_array_equal(sa.idx, sb.idx)
+    np.testing.assert_array_equal(loaded.dense_w, net.dense_w)
