@@ -407,7 +407,7 @@ def test_the_writer_writes_at_idle_priority_and_gets_its_priority_back_when_wait
     seen = []
 
     class Job:
-        def write(self):
+        def write(self, pace):
             seen.append(os.sched_getscheduler(0))
             started.set()
             go_on.wait(10)
@@ -427,7 +427,7 @@ def test_a_writer_that_could_not_get_its_priority_back_writes_at_the_loops(monke
     seen = []
 
     class Job:
-        def write(self):
+        def write(self, pace):
             seen.append(os.sched_getscheduler(0) if hasattr(os, "sched_getscheduler") else None)
 
     writer = checkpoint.Writer()
@@ -475,3 +475,38 @@ def test_the_networks_fixed_arrays_go_into_the_arrays_file_once_and_come_back(tm
         sb = loaded.step(rng_b.choice(np.arange(mf.start, mf.stop, dtype=np.int32), 12, replace=False))
         np.testing.assert_array_equal(sa.idx, sb.idx)
     np.testing.assert_array_equal(loaded.dense_w, net.dense_w)
+
+
+def test_a_paced_write_writes_the_same_file_a_piece_at_a_time(tmp_path, monkeypatch):
+    monkeypatch.setattr(checkpoint, "PACE_PIECE", 1000)
+    naps = []
+
+    class Counting(checkpoint.Pace):
+        def nap(self):
+            naps.append(1)
+
+    parts = [b"head\n", np.arange(1500, dtype=np.float32), memoryview(b"x" * 10)]
+    checkpoint._write_file(tmp_path / "plain", parts)
+    checkpoint._write_file(tmp_path / "paced", parts, Counting())
+    assert (tmp_path / "paced").read_bytes() == (tmp_path / "plain").read_bytes()
+    assert len(naps) == 1 + 6 + 1  # 5 bytes, 6000 bytes in pieces of 1000, 10 bytes
+    assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_waiting_for_the_writer_drops_the_naps_of_a_paced_checkpoint(monkeypatch):
+    """A nap would last a minute here: the loop's wait for the writer must not sit through them."""
+    monkeypatch.setattr(checkpoint, "PACE_NAP_S", 60.0)
+    napped = []
+
+    class Job:
+        def write(self, pace):
+            for _ in range(3):
+                pace.nap()
+                napped.append(1)
+
+    writer = checkpoint.Writer()
+    writer.submit(Job())
+    waiting = threading.Thread(target=writer.wait, daemon=True)
+    waiting.start()
+    waiting.join(timeout=20)
+    assert not waiting.is_alive() and napped == [1, 1, 1]
