@@ -21,6 +21,7 @@ from cerebx.snn.topology import (
     build_topology,
     fill_dense,
 )
+from cerebx.snn.weight_stats import Beside, RunCache, weight_stats
 
 COMPACT_MIN = 4096  # AMPA-only populations this large integrate only their non-resting neurons
 PF_RING = 1 << 16  # buffered PF arrivals per plastic projection (must cover the kernel window)
@@ -144,6 +145,9 @@ class Network:
         self.pf_lost = np.zeros(len(pl), dtype=np.int64)
         n_pre = [int(self.de_i[r.dense, 1]) for r in pl]
         self.pl_dirty = np.zeros((len(pl), max(n_pre + [1])), dtype=np.uint8)
+        # rows the kernels marked that a checkpoint took from pl_dirty since the last weight statistics
+        self._stats_dirty = np.zeros_like(self.pl_dirty)
+        self._stats_cache: dict[str, RunCache] = {}
         self.kernel_window_sub = longest
         self.col_buf = np.zeros(n, dtype=np.int64)
         self.acc = np.zeros(n, dtype=np.float64)
@@ -260,6 +264,7 @@ class Network:
         self._set_neurons(arrays["V"], arrays["g"], arrays["ref"])
         self.t_sub = int(arrays["t_sub"])
         self._all_changed = True
+        self._stats_cache = {}
 
     def changed_ranges(self) -> list[tuple[np.ndarray, np.ndarray, int]]:
         """The weights written since the last call, as (array, start offsets, length) ranges: the rows of
@@ -270,6 +275,7 @@ class Network:
         load and with no range since: a checkpoint then keeps them in its arrays file, written once per
         process, instead of in every pickle (4.1 of the full network's 9.2 MB)."""
         fixed = [a for a in self._fixed() if a.size]
+        np.bitwise_or(self._stats_dirty, self.pl_dirty, out=self._stats_dirty)
         if self._all_changed:
             self._all_changed = False
             self.pl_dirty[:] = 0
@@ -299,6 +305,7 @@ class Network:
         use), each left as its dtype and shape; the kernels' handles on the arrays are made again too."""
         state = self.__dict__.copy()
         state.pop("_chunk_idx", None)  # step_many's output scratch (rebuilt on use)
+        state["_stats_cache"] = {}  # the weight statistics' first pass is read whole after a load
         state.pop("arrays", None)
         state.pop("_state", None)
         for name in _SCRATCH + _CACHES:
@@ -316,6 +323,8 @@ class Network:
                 state[name] = np.zeros(v[2], np.dtype(v[1]))
                 stale = stale or name in _CACHES
         self.__dict__.update(state)
+        if "_stats_dirty" not in state:  # pickled by earlier code
+            self._stats_dirty, self._stats_cache = np.zeros_like(self.pl_dirty), {}
         if stale:
             self.sp_c[:, 0] = 0  # no cache is valid (epochs start at 1): each is rebuilt when first used
         self.arrays = self._kernel_arrays()
@@ -333,6 +342,21 @@ class Network:
             if d.name == projection:
                 return self.topo.dense_block(d)
         raise KeyError(f"{projection!r} is not an all-to-all projection")
+
+    def weight_stats(self, projection: str, beside: Beside | None = None) -> tuple[float, float, float, float]:
+        """(mean, std, min, max) of a plastic projection's weights (:func:`~cerebx.snn.weight_stats.weight_stats`):
+        its first pass reads again only the runs of the rows the kernels wrote since the last call (the rows they
+        mark for checkpoints), the rest from that call; after a load, all. Weights written through
+        :meth:`weights` are not seen: set them with :meth:`load_arrays`."""
+        r = self.plastic_projections.index(projection)
+        n_pre, n_post = (int(x) for x in self.de_i[self.pl_i[r, 0], [1, 3]])
+        w = self.weights(projection)
+        cache = self._stats_cache.get(projection)
+        if cache is None or cache.bufsize != np.getbufsize():
+            cache = self._stats_cache[projection] = RunCache(w.size, np.getbufsize())
+        rows = np.flatnonzero(self._stats_dirty[r, :n_pre] | self.pl_dirty[r, :n_pre])
+        self._stats_dirty[r] = 0
+        return weight_stats(w, beside, cache, cache.runs_of(rows * n_post, n_post))
 
     @property
     def plastic_projections(self) -> list[str]:

@@ -173,6 +173,68 @@ def _total_min_max(w, sums, lo_k, hi_k):
     return total, mm[0], mm[1]
 
 
+@njit(cache=True, nogil=True, boundscheck=False)
+def _update_runs(w, bufsize, runs, sums, lo_keys, hi_keys):
+    """For each run ``r`` in ``runs`` (of ``bufsize`` values of the flat float32 ``w``): its pairwise sum into
+    ``sums[r]`` and its min and max keys (:func:`_key`) into ``lo_keys[r]``, ``hi_keys[r]``; as
+    :func:`_runs_min_max`, a run at a time."""
+    bits = w.view(np.int32)
+    for j in range(runs.size):
+        r = runs[j]
+        lo = r * bufsize
+        hi = min(lo + bufsize, w.size)
+        sums[r] = _sum(w[lo:hi])
+        b = bits[lo:hi]
+        lo_k = hi_k = _key(b[0])
+        for i in range(b.size):
+            k = _key(b[i])
+            lo_k = min(lo_k, k)
+            hi_k = max(hi_k, k)
+        lo_keys[r] = lo_k
+        hi_keys[r] = hi_k
+
+
+class RunCache:
+    """The first pass of :func:`weight_stats` kept between calls on one array: each run's sum and min and max
+    keys, so that a later call reads again only the runs written since (``changed``). The learning weights of the
+    full network change in ~2,000 of 60,000 rows per 10 trials, which touch about a third of the runs."""
+
+    def __init__(self, size: int, bufsize: int):
+        n_runs = -(-size // bufsize)
+        self.size, self.bufsize = size, bufsize
+        self.sums = np.zeros(n_runs)
+        self.lo_keys = np.zeros(n_runs, np.int32)
+        self.hi_keys = np.zeros(n_runs, np.int32)
+        self.filled = False
+
+    def runs_of(self, starts: np.ndarray, length: int) -> np.ndarray:
+        """The runs that the ranges ``flat[s:s + length]`` (s in ``starts``) touch, in order."""
+        if not len(starts) or not length:
+            return np.zeros(0, np.int64)
+        starts = np.asarray(starts, np.int64)
+        first, last = starts // self.bufsize, (starts + length - 1) // self.bufsize
+        edge = np.zeros(len(self.sums) + 1, np.int64)
+        np.add.at(edge, first, 1)
+        np.add.at(edge, last + 1, -1)
+        return np.flatnonzero(np.cumsum(edge[:-1]))
+
+
+def _cached_sum_min_max(w: np.ndarray, cache: RunCache, changed: np.ndarray | None,
+                        beside: Beside | None) -> tuple[float, Any, Any]:
+    """:func:`_sum_min_max` of ``w`` from ``cache``, whose runs ``changed`` (all of them when None or while the
+    cache is not filled) are read again first; with ``beside`` half of those on the other thread."""
+    runs = np.arange(len(cache.sums), dtype=np.int64) if changed is None or not cache.filled else changed
+    if beside is None or runs.size * cache.bufsize < SPLIT_MIN:
+        _update_runs(w, cache.bufsize, runs, cache.sums, cache.lo_keys, cache.hi_keys)
+    else:
+        half = runs.size // 2
+        other = beside(_update_runs, w, cache.bufsize, runs[half:], cache.sums, cache.lo_keys, cache.hi_keys)
+        _update_runs(w, cache.bufsize, runs[:half], cache.sums, cache.lo_keys, cache.hi_keys)
+        other()
+    cache.filled = True
+    return _total_min_max(w, cache.sums, cache.lo_keys.min(), cache.hi_keys.max())
+
+
 Beside = Callable[..., Callable[[], Any]]
 """Runs ``fn(*args)`` on another thread and returns a function that waits for its result."""
 
@@ -212,7 +274,8 @@ def std_f64(w: np.ndarray, mean: float, beside: Beside | None = None) -> float:
     return float(np.sqrt(total / flat.size))
 
 
-def weight_stats(w: np.ndarray, beside: Beside | None = None) -> tuple[float, float, float, float]:
+def weight_stats(w: np.ndarray, beside: Beside | None = None, cache: RunCache | None = None,
+                 changed: np.ndarray | None = None) -> tuple[float, float, float, float]:
     """(mean, std, min, max) of ``w`` as ``w.mean(dtype=float64)``, ``w.std(dtype=float64)``, ``w.min()``,
     ``w.max()`` give them.
 
@@ -222,11 +285,18 @@ def weight_stats(w: np.ndarray, beside: Beside | None = None) -> tuple[float, fl
     see: where 0.0 and -0.0 both hold the min (or max), numpy reports either, by its vector lane order, this
     -0.0 for the min and 0.0 for the max. The weights hold no -0.0: the plasticity kernels clip at the lower
     bound by writing the bound.
+
+    With ``cache`` (a :class:`RunCache` of ``w``'s size and numpy's buffer size) the first pass reads only the
+    runs in ``changed`` (:meth:`RunCache.runs_of` of the ranges written since the last call with that cache)
+    and takes the other runs' sums and extremes from the cache: the same numbers.
     """
     if w.dtype != np.float32 or not w.flags.c_contiguous or w.size == 0:
         mean = w.mean(dtype=np.float64)
         return float(mean), std_f64(w, mean), float(w.min()), float(w.max())
     flat = w.reshape(-1)
-    total, mn, mx = _sum_min_max(flat, np.getbufsize(), beside)
+    if cache is not None and cache.size == flat.size and cache.bufsize == np.getbufsize():
+        total, mn, mx = _cached_sum_min_max(flat, cache, changed, beside)
+    else:
+        total, mn, mx = _sum_min_max(flat, np.getbufsize(), beside)
     mean = total / flat.size
     return float(mean), std_f64(flat, mean, beside), float(mn), float(mx)

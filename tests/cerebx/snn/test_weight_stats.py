@@ -131,3 +131,68 @@ def test_two_threads_find_a_nan_or_an_extreme_in_either_half(monkeypatch):
         assert weight_stats(w, on_a_thread) == numpy_stats(w)
         w[at] = 9.0
         assert weight_stats(w, on_a_thread) == numpy_stats(w)
+
+
+@pytest.mark.parametrize("beside", [None, on_a_thread])
+@pytest.mark.parametrize("shape", [(10_000, 600), (37, 8193), (3, 20_000), (1000, 7)])
+def test_a_cached_first_pass_that_reads_only_the_written_rows_gives_numpy_s_stats(shape, beside, monkeypatch):
+    """Rows rewritten between calls (a few, many, none, the last one, a NaN and back), with the cache told
+    which: the same numbers as numpy each time."""
+    monkeypatch.setattr(ws, "SPLIT_MIN", 1)
+    rng = np.random.default_rng(shape[0])
+    w = next(patterns(int(np.prod(shape)), seed=1)).reshape(shape)
+    n_pre, n_post = shape
+    cache = ws.RunCache(w.size, np.getbufsize())
+    assert weight_stats(w, beside, cache, None) == numpy_stats(w)
+    for rows in (rng.choice(n_pre, max(1, n_pre // 30), replace=False), np.arange(n_pre), np.zeros(0, int),
+                 np.array([n_pre - 1]), rng.choice(n_pre, max(1, n_pre // 3), replace=False)):
+        w[rows] = (rng.random((len(rows), n_post)) * 5).astype(np.float32)
+        got = weight_stats(w, beside, cache, cache.runs_of(np.sort(rows) * n_post, n_post))
+        assert got == numpy_stats(w)
+    w[n_pre // 2, 0] = np.nan
+    got = weight_stats(w, beside, cache, cache.runs_of(np.array([n_pre // 2 * n_post]), n_post))
+    assert all(math.isnan(x) for x in got)
+    w[n_pre // 2, 0] = -3.0
+    got = weight_stats(w, beside, cache, cache.runs_of(np.array([n_pre // 2 * n_post]), n_post))
+    assert got == numpy_stats(w)
+
+
+def test_the_runs_of_ranges_are_every_buffer_they_touch():
+    cache = ws.RunCache(100, 10)
+    assert cache.runs_of(np.array([0]), 10).tolist() == [0]
+    assert cache.runs_of(np.array([5, 9, 95]), 2).tolist() == [0, 1, 9]
+    assert cache.runs_of(np.array([15]), 31).tolist() == [1, 2, 3, 4]
+    assert cache.runs_of(np.zeros(0, np.int64), 10).tolist() == []
+
+
+def test_the_network_s_statistics_follow_its_learning_and_checkpoints():
+    """The spiking network's own statistics (cached first pass, rows from the kernels' marks, checkpoints taking
+    those marks in between, a load of other weights) equal numpy's on its weights after every stretch."""
+    from cerebx.snn.network import Network
+    from cerebx.snn.presets import network as full_network
+
+    net = Network(full_network(fibers=5, per_joint=20), parallel=False)
+    mf, cf = net.index("mf"), net.index("cf")
+    rng = np.random.default_rng(0)
+    name = net.plastic_projections[0]
+    seen = set()
+    F = (mf.stop - mf.start) // 24
+    bins = rng.integers(F, size=(6, 4))
+    for stretch in range(6):
+        for k in range(60):  # each joint's 4 signals box-coded, moving every 20 ms; CF at ~10 Hz
+            if k % 10 == 0:
+                bins = np.clip(bins + rng.integers(-1, 2, size=bins.shape), 0, F - 1)
+            ids = (np.arange(6)[:, None] * 4 * F + np.arange(4)[None, :] * F + bins).ravel() + mf.start
+            cfs = np.flatnonzero(rng.random(cf.stop - cf.start) < 0.02) + cf.start
+            net.step(np.concatenate([ids, cfs]).astype(np.int32))
+        if stretch % 2:
+            net.changed_ranges()  # a checkpoint takes the marks
+        if stretch == 4:
+            arrays = net.state_arrays()
+            arrays = {k: v.copy() for k, v in arrays.items()}
+            arrays["dense_w"][:] = rng.random(arrays["dense_w"].size).astype(np.float32) * 3
+            net.load_arrays(arrays)
+        stats = net.weight_stats(name)
+        assert stats == numpy_stats(net.weights(name)), stretch
+        seen.add(stats)
+    assert len(seen) == 6  # the network learned in every stretch

@@ -50,7 +50,6 @@ from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
 from cerebx.snn.encoders import EncoderPair
 from cerebx.snn.kernels import run_chunk
 from cerebx.snn.network import Network, pack
-from cerebx.snn.weight_stats import weight_stats
 
 STEP_S = 0.002
 STATE_VERSION = 1
@@ -492,7 +491,7 @@ class SNNControllerImpl(Controller):
         if weights:
             beside = self._on_network_thread if self.pipeline else None
             for name in self.net.plastic_projections:
-                stats = weight_stats(self.net.weights(name), beside)
+                stats = self.net.weight_stats(name, beside)
                 out.update(zip((f"w_{name}_mean", f"w_{name}_std", f"w_{name}_min", f"w_{name}_max"), stats))
         lost = int(self.net.pf_lost.sum())
         if lost:
