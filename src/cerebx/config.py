@@ -253,10 +253,15 @@ def _can_make(folder: Path) -> str | None:
         return f"{missing[-1].parent} exists and is not a folder"  # an ancestor
     try:
         folder.mkdir(parents=True)
+    except FileExistsError:  # made meanwhile by another cerebx started at the same moment (two sweeps)
+        return None if folder.is_dir() else "it exists and is not a folder"
     except OSError as err:
         return f"cannot be created ({err.strerror})"
     for d in missing:
-        d.rmdir()
+        try:
+            d.rmdir()
+        except OSError:  # another process put its run in it meanwhile (or removed it): left as it is
+            break
     return None
 
 

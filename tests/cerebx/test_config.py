@@ -235,3 +235,24 @@ def test_delayed_default_receiver_is_the_snn_delays_one(load):
     assert explicit.robot[0].model_dump() == auto.robot[0].model_dump()
     assert explicit.robot[0].model_dump() == {**explicit.robot[0].model_dump(), **DELAYED_SNN_RECEIVER}
     assert explicit.controller.model_dump() == {**auto.controller.model_dump(), "efferent": "stamp"}
+
+
+def test_a_run_folder_made_meanwhile_by_another_cerebx_is_no_problem(tmp_path, monkeypatch):
+    """Two sweeps started at once: both find runs/multirun missing, the other one makes it first."""
+    from pathlib import Path
+
+    from cerebx import config
+
+    folder = tmp_path / "runs" / "multirun"
+    real_mkdir = Path.mkdir
+
+    def made_by_the_other(self, *args, **kwargs):
+        monkeypatch.setattr(Path, "mkdir", real_mkdir)
+        real_mkdir(self, parents=True, exist_ok=True)
+        raise FileExistsError(17, "File exists", str(self))
+
+    monkeypatch.setattr(Path, "mkdir", made_by_the_other)
+    assert config._can_make(folder) is None
+    monkeypatch.setattr(Path, "mkdir", real_mkdir)
+    (tmp_path / "file").write_text("x")
+    assert config._can_make(tmp_path / "file") == "it exists and is not a folder"

@@ -6,7 +6,8 @@ A checkpoint is
 - ``checkpoint.pkl``: one line of JSON, the head (:func:`read_head`), then the pickled state (cloudpickle).
   Written to a temporary file, flushed to the disk, then renamed over the old one: that rename commits it.
 - ``checkpoint.<n>.arrays``: the arrays an object of the state tracks (a ``changed_ranges()`` method, e.g. the
-  spiking network's weights, 145 MB for the full network), stored beside the pickle, which refers to them by
+  spiking network's weights, 145 MB for the full network, and its fixed tables, reported once and never
+  changed), stored beside the pickle, which refers to them by
   key. The first checkpoint a process writes puts them whole into a new file (``<n>``: its trial count),
   unless the file was written ahead (below); each later one writes only the ranges changed since (a few % of
   the PF-PC rows per 10 trials), first into ``checkpoint.journal`` (flushed to the disk), then commits the

@@ -217,7 +217,7 @@ class Recorder:
         flush lets go of the interpreter lock). Whether it does depends only on the messages logged, so the
         file stays the same from run to run; its messages are the same either way, only the chunks are
         smaller."""
-        if self._early and self._pending >= self._early:
+        if self._early and self._pending >= self._early and not self.closed:
             self._pending = 0
             self._w.flush()
 

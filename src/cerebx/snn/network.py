@@ -80,12 +80,22 @@ class Network:
         self.topo = topo = build_topology(cfg, fill=False)
         # the weights' first touch beside the rest of the set-up (mostly the kernels' loading, which holds the
         # interpreter lock that the fill lets go of): joined before anything reads them
-        filling = threading.Thread(target=fill_dense, args=(topo,), name="cerebx-weights", daemon=True)
+        failed: list[BaseException] = []
+
+        def fill() -> None:
+            try:
+                fill_dense(topo)
+            except BaseException as err:  # raised here once joined: the weights would be left unwritten
+                failed.append(err)
+
+        filling = threading.Thread(target=fill, name="cerebx-weights", daemon=True)
         filling.start()
         try:
             self._set_up(cfg, topo, pf_ring, compact_min)
         finally:
             filling.join()
+        if failed:
+            raise failed[0]
         self.reset_state()
         self.build_s = time.perf_counter() - t_start
 

@@ -62,3 +62,12 @@ def test_the_same_messages_and_idles_give_the_same_file(tmp_path):
     _log(tmp_path / "a.mcap", idle_every=3)
     _log(tmp_path / "b.mcap", idle_every=3)
     assert (tmp_path / "a.mcap").read_bytes() == (tmp_path / "b.mcap").read_bytes()
+
+
+def test_idle_after_close_does_nothing(tmp_path):
+    rec = Recorder(tmp_path / "x.mcap", chunk_size_kb=CHUNK_KB)
+    for k in range(100):
+        rec.write("/control", "cerebx.Control", k * 0.002, {"t": k * 0.002, "tau_controller": list(range(30))})
+    rec.close()
+    rec.idle()  # e.g. a network chunk collected after the log was finished
+    assert len(_read(tmp_path / "x.mcap")[0]) == 100

@@ -315,3 +315,15 @@ def test_delivery_caches_and_compaction_are_exact_and_consistent():
     np.testing.assert_array_equal(a.dense_w, b.dense_w)
     for key in ("V", "g", "ref"):
         np.testing.assert_array_equal(getattr(a, key), getattr(b, key))
+
+
+def test_a_failed_first_write_of_the_weights_fails_the_build(monkeypatch):
+    """The weights are first written on a thread beside the rest of the build: its failure is the build's."""
+    import cerebx.snn.network as network_module
+
+    def broken(topo):
+        raise MemoryError("no room for the weights")
+
+    monkeypatch.setattr(network_module, "fill_dense", broken)
+    with pytest.raises(MemoryError, match="no room"):
+        Network(full_network(fibers=5, per_joint=20), parallel=False)
