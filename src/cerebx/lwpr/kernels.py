@@ -496,18 +496,15 @@ def _update_output(sub, cfg, wk, y):
 
 
 @njit(**_INLINE)
-def _normalise_input(cfg, wk, x):
-    """The input divided by its normalisation into the workspace; returns its dimension."""
+def _update_sample(st, cfg, wk, x, y, out):
+    """One training pair for every output (each with a free slot); out gets the predictions.
+
+    The input's normalisation is written out here and in :func:`_predict_sample` rather than shared: as an
+    inlined helper that returned the input's dimension it cost 15-35 % of the updates' speed (2-D cross
+    870-880 k -> 710-760 k updates/s, 1-D 2.9 -> 1.9-2.0 M)."""
     n = x.shape[0]
     for i in range(n):
         wk.xn[i] = x[i] / cfg[N_HP + i]
-    return n
-
-
-@njit(**_INLINE)
-def _update_sample(st, cfg, wk, x, y, out):
-    """One training pair for every output (each with a free slot); out gets the predictions."""
-    n = _normalise_input(cfg, wk, x)
     for d in range(y.shape[0]):
         norm = cfg[N_HP + n + d]
         out[d] = _update_output(_sub(st, d), cfg, wk, y[d] / norm) * norm
@@ -580,7 +577,9 @@ def _predict_output(sub, cfg, wk, act):
 
 @njit(**_INLINE)
 def _predict_sample(st, cfg, wk, x, out, act):
-    n = _normalise_input(cfg, wk, x)
+    n = x.shape[0]
+    for i in range(n):
+        wk.xn[i] = x[i] / cfg[N_HP + i]
     for d in range(out.shape[0]):
         out[d] = _predict_output(_sub(st, d), cfg, wk, act[d]) * cfg[N_HP + n + d]
 
