@@ -134,27 +134,6 @@ def _key(x):
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def _runs_min_max(w, bufsize, first, last, sums):
-    """Runs ``first:last`` of ``bufsize`` values of the flat float32 ``w``: each run's pairwise sum into
-    ``sums[run]``, and the min and max keys (:func:`_key`) over those runs.
-
-    Each run is summed, then scanned for min and max while it is still in the cache. The scan compares integer
-    keys of the bits: a float min that must mind NaN stays scalar, an integer one is vectorised, three to four
-    times faster."""
-    bits = w.view(np.int32)
-    lo_k = hi_k = _key(bits[first * bufsize])
-    for r in range(first, last):
-        lo = r * bufsize
-        sums[r] = _sum(w[lo : lo + bufsize])
-        b = bits[lo : lo + bufsize]
-        for i in range(b.size):
-            k = _key(b[i])
-            lo_k = min(lo_k, k)
-            hi_k = max(hi_k, k)
-    return lo_k, hi_k
-
-
-@njit(cache=True, nogil=True, boundscheck=False)
 def _total_min_max(w, sums, lo_k, hi_k):
     """(the mean's sum: the runs' sums added in order to 0.0, as numpy adds its buffers; min; max). A NaN in
     ``w`` makes the sum NaN, and only then is ``w`` searched for one, which is then the min and the max, as
@@ -176,8 +155,11 @@ def _total_min_max(w, sums, lo_k, hi_k):
 @njit(cache=True, nogil=True, boundscheck=False)
 def _update_runs(w, bufsize, runs, sums, lo_keys, hi_keys):
     """For each run ``r`` in ``runs`` (of ``bufsize`` values of the flat float32 ``w``): its pairwise sum into
-    ``sums[r]`` and its min and max keys (:func:`_key`) into ``lo_keys[r]``, ``hi_keys[r]``; as
-    :func:`_runs_min_max`, a run at a time."""
+    ``sums[r]`` and its min and max keys (:func:`_key`) into ``lo_keys[r]``, ``hi_keys[r]``.
+
+    Each run is summed, then scanned for min and max while it is still in the cache. The scan compares integer
+    keys of the bits: a float min that must mind NaN stays scalar, an integer one is vectorised, three to four
+    times faster."""
     bits = w.view(np.int32)
     for j in range(runs.size):
         r = runs[j]
@@ -221,8 +203,9 @@ class RunCache:
 
 def _cached_sum_min_max(w: np.ndarray, cache: RunCache, changed: np.ndarray | None,
                         beside: Beside | None) -> tuple[float, Any, Any]:
-    """:func:`_sum_min_max` of ``w`` from ``cache``, whose runs ``changed`` (all of them when None or while the
-    cache is not filled) are read again first; with ``beside`` half of those on the other thread."""
+    """(sum as ``w.mean(dtype=float64)`` adds it, min, max) of the flat float32 ``w`` from ``cache``, whose runs
+    ``changed`` (all of them when None or while the cache is not filled) are read again first; with ``beside``
+    half of those on the other thread."""
     runs = np.arange(len(cache.sums), dtype=np.int64) if changed is None or not cache.filled else changed
     if beside is None or runs.size * cache.bufsize < SPLIT_MIN:
         _update_runs(w, cache.bufsize, runs, cache.sums, cache.lo_keys, cache.hi_keys)
@@ -245,17 +228,7 @@ SPLIT_MIN = 1 << 20
 def _sum_min_max(w: np.ndarray, bufsize: int, beside: Beside | None = None) -> tuple[float, Any, Any]:
     """(sum as ``w.mean(dtype=float64)`` adds it, min, max) of the flat float32 ``w`` (size >= 1), one pass;
     with ``beside`` the second half of the runs is read on the other thread."""
-    n_runs = -(-w.size // bufsize)
-    sums = np.empty(n_runs)
-    if beside is None or w.size < SPLIT_MIN:
-        lo_k, hi_k = _runs_min_max(w, bufsize, 0, n_runs, sums)
-    else:
-        half = n_runs // 2
-        other = beside(_runs_min_max, w, bufsize, half, n_runs, sums)
-        lo_k, hi_k = _runs_min_max(w, bufsize, 0, half, sums)
-        lo2, hi2 = other()
-        lo_k, hi_k = min(lo_k, lo2), max(hi_k, hi2)
-    return _total_min_max(w, sums, lo_k, hi_k)
+    return _cached_sum_min_max(w, RunCache(w.size, bufsize), None, beside)
 
 
 def std_f64(w: np.ndarray, mean: float, beside: Beside | None = None) -> float:
