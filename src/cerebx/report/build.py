@@ -11,7 +11,10 @@ the learning behind it has converged (``report/convergence.py``) and the command
 an unconverged figure carries a badge on its images and in its caption. Besides index.html and the tables,
 ``figures.json`` holds every drawn figure (title, caption, table, notes, shape checks, convergence, files)
 and how the report was made (command, profile, cerebx version, the runs' count and dates), for tools that
-publish a report elsewhere.
+publish a report elsewhere. ``paper_vs_cerebx.csv`` gives each number beside the paper's, and for a headline
+number learned from several seeds its 95 % interval and whether the paper's number is inside
+(``report/stats.py``); a failing shape check whose cause is written up links to it (``explained_at``,
+``report/explain.py``).
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ from cerebx.errors import CerebxError
 from cerebx.report import figures
 from cerebx.report.badge import stamp
 from cerebx.report.delays import delay_rows
+from cerebx.report.explain import explain, load_explanations
 from cerebx.report.plot import fmt
 from cerebx.report.registry import Figure, FigureSpec, MissingRuns, all_figures
 from cerebx.report.runs import RunSet, find_run_dirs, load_runs
@@ -59,6 +63,23 @@ def _html_table(rows: list[list[str]]) -> str:
 def _converged(fig: Figure, quantity: str) -> str:
     """The ``converged`` cell of one paper-vs-cerebx row: yes, no (why), or – when nothing learns."""
     return "–" if fig.convergence is None else fig.convergence.flag(quantity)
+
+
+PAPER_HEADER = ["figure", "quantity", "paper", "cerebx", "converged", "seeds", "ci_low", "ci_high", "paper_in_ci"]
+
+
+def paper_row(name: str, fig: Figure, row: list[str]) -> list[str]:
+    """One row of ``paper_vs_cerebx.csv``: the figure's table row, whether it converged, and its interval over
+    seeds when the figure gives one for this quantity (else one seed's number and – for the interval)."""
+    quantity = str(row[0])
+    iv = fig.intervals.get(quantity)
+    if iv is None:
+        tail = ["1", "–", "–", "–"]
+    elif iv.has_interval:
+        tail = [str(iv.n), f"{iv.low:.4g}", f"{iv.high:.4g}", iv.paper_in_ci]
+    else:
+        tail = [str(iv.n), "–", "–", "–"]
+    return [name, *row, _converged(fig, quantity), *tail]
 
 
 def _badge(fig: Figure) -> str | None:
@@ -144,6 +165,8 @@ def figure_entry(spec: FigureSpec, fig: Figure, out: Path) -> dict[str, Any]:
             value = [dataclasses.asdict(c) for c in value]
         elif f.name == "convergence" and value is not None:
             value = value.as_json()
+        elif f.name == "intervals":
+            value = {k: iv.as_json() for k, iv in value.items()}
         entry[f.name] = value
     return entry
 
@@ -169,6 +192,8 @@ def build_from(runs: RunSet, out: Path, names: list[str] | None = None, log=lamb
     """Draw every figure (or the named ones) from ``runs`` into ``out``; ``problems``: lines already found
     (unreadable runs); the rest as :func:`build`."""
     problems = list(problems or [])
+    profile = profile or profile_of([r.dir for r in runs])
+    known = load_explanations()
     out.mkdir(parents=True, exist_ok=True)
     fig_dir = out / "figures"
     specs = all_figures()
@@ -178,7 +203,7 @@ def build_from(runs: RunSet, out: Path, names: list[str] | None = None, log=lamb
     chosen = [specs[n] for n in names] if names else list(specs.values())
     drawn: list[tuple[FigureSpec, Figure]] = []
     missing: list[str] = []
-    paper_rows = [["figure", "quantity", "paper", "cerebx", "converged"]]
+    paper_rows = [PAPER_HEADER]
     for spec in chosen:
         t0 = time.monotonic()
         try:
@@ -189,12 +214,12 @@ def build_from(runs: RunSet, out: Path, names: list[str] | None = None, log=lamb
         except Exception as err:  # one broken figure must not cost the others
             problems.append(f"{spec.name}: could not be drawn ({type(err).__name__}: {err})")
             continue
+        explain(spec.name, fig, profile, known)
         badge = _badge(fig)
         took = f"  {spec.name}: {len(fig.files)} image(s) in {time.monotonic() - t0:.1f} s"
         log(took + (f"; {badge}" if badge else ""))
         drawn.append((spec, fig))
-        for row in fig.table[1:]:
-            paper_rows.append([spec.name, *row, _converged(fig, str(row[0]))])
+        paper_rows += [paper_row(spec.name, fig, row) for row in fig.table[1:]]
     toc, sections = [], []
     for spec, fig in drawn:
         toc.append(f"<li><a href='#{spec.name}'>{html.escape(spec.title)}</a></li>")
@@ -219,7 +244,7 @@ def build_from(runs: RunSet, out: Path, names: list[str] | None = None, log=lamb
     _write_table(out, "paper_vs_cerebx", paper_rows)
     _write_table(out, "shapes", shape_rows(drawn))
     _write_table(out, "delays", delay_rows(runs))
-    made = provenance(runs, command, profile or profile_of([r.dir for r in runs]))
+    made = provenance(runs, command, profile)
     (out / "figures.json").write_text(json.dumps(
         {**made, "figures": [figure_entry(spec, fig, out) for spec, fig in drawn], "not_drawn": missing},
         indent=1, ensure_ascii=False, default=str) + "\n")

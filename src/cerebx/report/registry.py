@@ -7,6 +7,12 @@ takes the run set and an output stem (``reports/figures/<name>``), draws from th
 (``report.plot.save``) and returns a :class:`Figure` with its caption, a table of the paper's numbers
 beside cerebx's, the paper's shapes tested on the runs (:class:`Check`) and the convergence of the learning
 behind it (``report.convergence``). When no run it needs is there it raises :class:`MissingRuns`.
+
+A headline number learned from several independent seeds is given as an :class:`~cerebx.report.stats.Interval`
+(``Figure.intervals``, keyed by its table row's quantity): ``paper_vs_cerebx.csv`` then carries its 95 %
+interval and whether the paper's number falls inside. A check that fails in a profile and whose cause is
+written up is linked to that page by the plugin's explanations file (:func:`explanations`): the report
+sets its ``explained_at``.
 """
 
 from __future__ import annotations
@@ -19,6 +25,7 @@ from pathlib import Path
 from cerebx import registry
 from cerebx.report.convergence import Convergence
 from cerebx.report.runs import RunSet
+from cerebx.report.stats import Interval
 
 
 class MissingRuns(Exception):
@@ -33,6 +40,8 @@ class Check:
     claim: str
     holds: bool | None
     numbers: str = ""
+    # where a failing check's cause is shown (a docs page and anchor, from the plugin's explanations file)
+    explained_at: str | None = None
 
 
 @dataclass
@@ -45,6 +54,8 @@ class Figure:
     checks: list[Check] = field(default_factory=list)
     # the plateau tests of the learning behind the figure; None: nothing learns in its runs
     convergence: Convergence | None = None
+    # headline quantities over independently learned seeds, keyed by the quantity of their table row
+    intervals: dict[str, Interval] = field(default_factory=dict)
 
     @property
     def shape_holds(self) -> bool | None:
@@ -63,6 +74,7 @@ class FigureSpec:
 
 FIGURES: dict[str, FigureSpec] = {}
 STUDY_FILES: list[Path] = []
+EXPLANATION_FILES: list[Path] = []
 
 
 def figure(name: str, title: str, studies: tuple[str, ...]) -> Callable:
@@ -80,6 +92,14 @@ def studies(path: Path) -> None:
     path = Path(path).resolve()
     if path not in STUDY_FILES:
         STUDY_FILES.append(path)
+
+
+def explanations(path: Path) -> None:
+    """Register an explanations file (YAML, ``report/explain.py``): for checks that fail, the docs page that
+    shows why, with the runs that show the cause."""
+    path = Path(path).resolve()
+    if path not in EXPLANATION_FILES:
+        EXPLANATION_FILES.append(path)
 
 
 def load_reports() -> None:

@@ -1,7 +1,9 @@
 """Run folders as the report sees them: summary, resolved config and log, selected by content.
 
 Figures never look at folder names: they ask for "circle runs of the snn controller under a constant
-delay" and get whatever runs match, so any past run folder can be re-plotted.
+delay" and get whatever runs match, so any past run folder can be re-plotted. Where a study was learned from
+several seeds, the figure's curves are drawn from the lowest seed (:meth:`RunSet.best` prefers it) and its
+headline numbers are taken over every seed (:meth:`RunSet.seeds`).
 """
 
 from __future__ import annotations
@@ -59,6 +61,10 @@ class Run:
     @property
     def task(self) -> str:
         return self.summary["task"]
+
+    @property
+    def seed(self) -> int:
+        return int(self.summary.get("seed") or 0)
 
     @property
     def controller(self) -> str:
@@ -231,10 +237,18 @@ class RunSet(list):
         return None
 
     def best(self) -> Run | None:
-        """The run to show when several match: completed first, then the most trials, then the newest."""
+        """The run to show when several match: completed first, then the most trials, then the lowest seed
+        (a study's first seed; its other seeds give the intervals), then the newest."""
         if not self:
             return None
-        return max(self, key=lambda r: (r.completed, r.trials, _mtime(r.dir)))
+        return max(self, key=lambda r: (r.completed, r.trials, -r.seed, _mtime(r.dir)))
+
+    def seeds(self) -> dict[int, RunSet]:
+        """The runs of each seed, sorted by seed."""
+        groups: dict[int, RunSet] = {}
+        for r in self:
+            groups.setdefault(r.seed, RunSet()).append(r)
+        return {k: groups[k] for k in sorted(groups)}
 
     def by(self, key: Callable[[Run], Any], pick: Callable[[RunSet], Run | None] | None = None) -> dict[Any, Run]:
         """One run for each value of ``key`` (runs where it is None are left out), sorted by value; ``pick``

@@ -8,6 +8,11 @@ Jobs run with ``resume=auto``: a job whose folder holds a completed summary with
 from the configuration its presets compose to now and after the run it starts from, is reused, one that
 left a checkpoint continues from it, anything else runs again. Studies run ``jobs``
 at a time, each after the study whose learned state it starts from.
+
+A study whose profile asks for ``seeds: n`` is learned n times independently: its first seed (the preset's)
+in its own folder, seed k (k = 1 .. n − 1) as the study ``<study>~seed<k>`` in ``<profile>/<study>~seed<k>``,
+each starting from the same seed of the study it starts from (or from that study's first seed when it has
+fewer). The figures draw their curves from the first seed and take their headline numbers over all of them.
 """
 
 from __future__ import annotations
@@ -51,6 +56,8 @@ class ProfileSpec(Strict):
     trials: int = Field(ge=1, description="trials of every job")
     args: list[str] = Field(default_factory=list, description="extra overrides in this profile")
     init_from: str | None = Field("inherit", description="start from this study's run instead (null: scratch)")
+    seeds: int = Field(1, ge=1, le=20, description="independently learned seeds (seed 0 .. seeds-1; each more "
+                       "seed k runs as the study <name>~seed<k>)")
 
 
 class PlateauSpec(Strict):
@@ -97,12 +104,33 @@ def load_studies(*paths: Path) -> dict[str, StudySpec]:
             studies[name], where[name] = spec, path
     for name, s in studies.items():
         for prof in PROFILES:
+            if getattr(s, prof).seeds > 1 and any(_key(a) == "seed" for a in [*s.args, *getattr(s, prof).args]):
+                raise ConfigError(f"{where[name]}: studies.{name}.{prof}.seeds: the study sets its seed itself "
+                                  "(give seeds or seed=, not both)")
             src = _init_from(s, prof)
             if src is not None and (src not in studies or _sweep_of(studies[src], prof) not in (
                     [[]], _sweep_of(s, prof))):
                 raise ConfigError(f"{where[name]}: studies.{name}.init_from: {src!r} is not a single-run study "
                                   "or one with the same sweep")
     return studies
+
+
+REPLICA = "~seed"  # <study>~seed<k>: seed k of a study learned from several seeds
+
+
+def with_replicas(studies: dict[str, StudySpec], profile: str) -> dict[str, StudySpec]:
+    """``studies`` and, after each whose ``profile`` asks for several seeds, one study per further seed (the
+    same arguments and ``seed=k``, starting from seed k of the study it starts from when that has one)."""
+    out: dict[str, StudySpec] = {}
+    for name, s in studies.items():
+        out[name] = s
+        for k in range(1, getattr(s, profile).seeds):
+            src = _init_from(s, profile)
+            if src is not None and src in studies and getattr(studies[src], profile).seeds > k:
+                src = f"{src}{REPLICA}{k}"
+            one = getattr(s, profile).model_copy(update={"seeds": 1, "init_from": src})
+            out[f"{name}{REPLICA}{k}"] = s.model_copy(update={"args": [*s.args, f"seed={k}"], profile: one})
+    return out
 
 
 def profile_of(run_dirs: list[Path]) -> str | None:
@@ -246,7 +274,7 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
     """Every job of the named studies (all by default) and of the studies they start from, in order."""
     if profile not in PROFILES:
         raise ConfigError(f"--profile: {profile!r} is not one of {', '.join(PROFILES)}")
-    studies = load_studies() if studies is None else studies
+    studies = with_replicas(load_studies() if studies is None else studies, profile)
     wanted: list[str] = []
 
     def want(n: str) -> None:
@@ -257,6 +285,8 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
             want(src)
         if n not in wanted:
             wanted.append(n)
+        for k in range(1, getattr(studies[n], profile).seeds):
+            want(f"{n}{REPLICA}{k}")
 
     for n in names if names is not None else list(studies):
         want(n)

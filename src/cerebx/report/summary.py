@@ -15,13 +15,13 @@ CLASS = {True: "ok", False: "bad", None: "na"}
 
 def shape_rows(drawn: list[tuple[FigureSpec, Figure]]) -> list[list[str]]:
     """Every shape check of the drawn figures, a row each (``shapes.csv``)."""
-    rows = [["figure", "claim", "holds", "numbers", "converged"]]
+    rows = [["figure", "claim", "holds", "numbers", "converged", "explained_at"]]
     for spec, fig in drawn:
         learning = fig.convergence
         conv = ("–" if learning is None else "unknown" if not learning.known
                 else "yes" if learning.converged else "no")
-        rows += [[spec.name, c.claim, {True: "yes", False: "no", None: "–"}[c.holds], c.numbers, conv]
-                 for c in fig.checks]
+        rows += [[spec.name, c.claim, {True: "yes", False: "no", None: "–"}[c.holds], c.numbers, conv,
+                  c.explained_at or "–"] for c in fig.checks]
     return rows
 
 
@@ -50,7 +50,14 @@ def summary_table(chosen: list[FigureSpec], drawn: dict[str, Figure]) -> str:
 def checks_list(checks: list[Check]) -> str:
     """A figure's shape checks as an HTML list, each with its numbers."""
     return "".join(f"<li class={CLASS[c.holds]}>{MARK[c.holds]} {html.escape(c.claim)}"
-                   f"{': ' + html.escape(c.numbers) if c.numbers else ''}</li>" for c in checks)
+                   f"{': ' + html.escape(c.numbers) if c.numbers else ''}{_why(c)}</li>" for c in checks)
+
+
+def _why(c: Check) -> str:
+    """The link to a failing check's explanation (docs-relative), or nothing."""
+    if not c.explained_at:
+        return ""
+    return f" <span class=na>(why: <code>{html.escape(c.explained_at)}</code>)</span>"
 
 
 def shape_cell(fig: Figure) -> str:
@@ -59,10 +66,11 @@ def shape_cell(fig: Figure) -> str:
         return "<td class=na>no shape check</td>"
     failed = [c for c in told if not c.holds]
     items = "".join(f"<li class={'ok' if c.holds else 'bad'}>{'✓' if c.holds else '✗'} {html.escape(c.claim)}"
-                    f"{' (' + html.escape(c.numbers) + ')' if c.numbers and not c.holds else ''}</li>"
+                    f"{' (' + html.escape(c.numbers) + ')' if c.numbers and not c.holds else ''}{_why(c)}</li>"
                     for c in sorted(told, key=lambda c: c.holds))
+    explained = sum(1 for c in failed if c.explained_at)
     verdict = (f"holds ({len(told)} of {len(told)})" if not failed
-               else f"does not hold ({len(failed)} of {len(told)} fail)")
+               else f"does not hold ({len(failed)} of {len(told)} fail, {explained} explained)")
     return f"<td class={'bad' if failed else 'ok'}><b>{verdict}</b><ul class=checks>{items}</ul></td>"
 
 

@@ -1,0 +1,78 @@
+"""Where a failing shape check is explained: each plugin's explanations file (registered with
+``registry.explanations``) links a figure's check, named by the start of its claim, to the docs page and anchor
+that shows its cause with the runs behind it. The report copies the link into the check's ``explained_at``
+(``figures.json``, ``shapes.csv``, index.html) when the check fails; a passing check keeps none.
+
+    explanations:
+      - figure: fig3_4
+        claim: "ANN MAE at 40 ms"              # the start of the check's claim
+        at: reproductions/thesis-ch3.md#the-ann-at-40-ms   # docs-relative page and anchor
+        profiles: [full]                        # where it applies (default: every profile)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+from pathlib import Path
+
+import yaml
+from pydantic import Field, ValidationError
+
+from cerebx.errors import ConfigError
+from cerebx.report.registry import EXPLANATION_FILES, Check, Figure, load_reports
+from cerebx.schema.base import Strict
+from cerebx.schema.experiment import format_errors
+
+PROFILES = ("quick", "full")
+
+
+class Explanation(Strict):
+    """One check's explanation."""
+
+    figure: str = Field(min_length=1, description="the figure's registered name")
+    claim: str = Field(min_length=1, description="the start of the check's claim")
+    at: str = Field(pattern=r"^[\w./-]+\.md#[\w-]+$", description="docs-relative page and anchor (page.md#anchor)")
+    profiles: list[str] = Field(default_factory=lambda: list(PROFILES), description="the profiles it applies to")
+
+
+class ExplanationsFile(Strict):
+    explanations: list[Explanation] = Field(default_factory=list)
+
+
+def load_explanations(*paths: Path) -> list[Explanation]:
+    """The explanations of ``paths`` (default: every plugin's registered file)."""
+    if not paths:
+        load_reports()
+        paths = tuple(EXPLANATION_FILES)
+    out: list[Explanation] = []
+    for path in paths:
+        out += _read(Path(path))
+    return out
+
+
+@functools.lru_cache(maxsize=16)
+def _read(path: Path) -> tuple[Explanation, ...]:
+    try:
+        raw = yaml.safe_load(path.read_text()) or {}
+        return tuple(ExplanationsFile.model_validate(raw).explanations)
+    except OSError as err:
+        raise ConfigError(f"{path}: {err.strerror}") from None
+    except yaml.YAMLError as err:
+        raise ConfigError(f"{path}: not valid YAML ({str(err).splitlines()[0]})") from None
+    except ValidationError as err:
+        raise ConfigError([f"{path}: {line}" for line in format_errors(err)]) from None
+
+
+def explain(name: str, fig: Figure, profile: str | None, known: list[Explanation]) -> None:
+    """Set ``explained_at`` on each failing check of figure ``name`` that an explanation for ``profile`` names
+    (an unknown profile: explanations of any profile apply)."""
+    mine = [e for e in known if e.figure == name and (profile is None or profile in e.profiles)]
+    fig.checks = [_with_link(c, mine) for c in fig.checks]
+
+
+def _with_link(check: Check, mine: list[Explanation]) -> Check:
+    if check.holds is not False:
+        return dataclasses.replace(check, explained_at=None)
+    hit = next((e for e in mine if check.claim.startswith(e.claim)), None)
+    return dataclasses.replace(check, explained_at=None if hit is None else f"docs/{hit.at}")
