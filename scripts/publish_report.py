@@ -11,6 +11,13 @@ from its runs without running anything: ``cerebx report RUNS --out REPORT_DIR``)
     README.md          what the folder is, with the stamp and the list of figures
     <figure>.md        one per figure: images, caption, table and notes (a page includes it with --8<--)
     figures/<f>.png    the images, PNG only, reduced to a 256-colour palette (a few MB for every figure)
+    checks.md          every figure's shape checks: how many hold, fail with an explanation, fail without
+    page_<page>.md     for each reproduction page (docs/reproductions/<page>.md, found by the figures it
+                       includes): the table it opens with, its paper numbers beside cerebx's interval over
+                       seeds (inside or not) and its figures' checks
+
+and rewrites the README's hero block (between ``<!-- hero:start -->`` and ``<!-- hero:end -->``) from the
+hero figure's entry (``--hero``, default fig3_4): its image, caption and the paper's ratios beside cerebx's.
 
 A docs page includes a figure with ``--8<-- "docs/results/<figure>.md"`` and the stamp with
 ``--8<-- "docs/results/stamp.md"``; the snippets' image links are relative to the including page
@@ -21,6 +28,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import re
 import shlex
 import shutil
 import sys
@@ -31,7 +40,11 @@ from typing import Any
 
 from PIL import Image
 
-KNOWN = {"name", "title", "studies", "module", "files", "caption", "table", "notes"}
+KNOWN = {"name", "title", "studies", "module", "files", "caption", "table", "notes", "checks", "intervals",
+         "convergence"}
+HERO_START, HERO_END = "<!-- hero:start -->", "<!-- hero:end -->"
+# the hero table's rows: the quantities of the hero figure's table whose quantity starts with one of these
+HERO_ROWS = ("PD average MAE ÷ SNN", "ANN average MAE ÷ SNN", "SNN MAE ratio", "SNN average MAE over")
 PROFILE_TEXT = {
     "quick": "the quick profile (shortened trial counts, minutes to hours on two cores: not every learning curve "
              "has levelled off; `cerebx report --profile full` runs the papers' counts)",
@@ -72,20 +85,33 @@ def _day(iso: str | None) -> str:
     return datetime.fromisoformat(iso).date().isoformat() if iso else "unknown"
 
 
+def _hours(seconds: Any) -> str:
+    if not isinstance(seconds, int | float):
+        return "unknown"
+    return f"{seconds / 3600:.1f} h" if seconds >= 5400 else f"{seconds / 60:.0f} min"
+
+
 def stamp(report: dict[str, Any]) -> str:
-    """One admonition saying how the published report was made."""
+    """One admonition saying how the published report was made: the command, profile, date, commit, wall
+    time, the runs (count, dates, versions, summed run time, size on disk)."""
     runs = report.get("runs") or {}
     first, last = _day(runs.get("first_started_at")), _day(runs.get("last_started_at"))
     dates = first if first == last else f"{first} and {last}"
     versions = ", ".join(runs.get("versions") or []) or "unknown"
     profile = report.get("profile")
     source = PROFILE_TEXT.get(profile, f"the {profile} profile" if profile else "runs given on the command line")
+    commit = f", commit `{report['commit']}`" if report.get("commit") else ""
+    size = f", {runs['disk_bytes'] / 1e9:.1f} GB on disk" if runs.get("disk_bytes") else ""
+    took = ""
+    if report.get("wall_seconds"):
+        summed = f"; its runs took {_hours(runs['wall_seconds'])} summed" if runs.get("wall_seconds") else ""
+        took = f" The command took {_hours(report['wall_seconds'])} of wall time{summed}."
     return "\n".join([
         '!!! info "Where these figures and tables come from"',
         f"    `{report.get('command') or 'cerebx report'}` drew them on {_day(report.get('built_at'))} (cerebx "
-        f"{report.get('cerebx_version', 'unknown')}) from {runs.get('count', 0)} runs of {source}, started "
-        f"{'on' if first == last else 'between'} {dates} by cerebx {versions}. `scripts/publish_report.py` "
-        "copied them here; none is typed by hand.",
+        f"{report.get('cerebx_version', 'unknown')}{commit}) from {runs.get('count', 0)} runs of {source}, started "
+        f"{'on' if first == last else 'between'} {dates} by cerebx {versions}{size}.{took} "
+        "`scripts/publish_report.py` copied them here; none is typed by hand.",
         "",
     ])
 
@@ -149,6 +175,115 @@ def readme(report: dict[str, Any]) -> str:
         stamp(report), "| figure | title | images |", "|---|---|---|", rows, ""])
 
 
+def _checks(entry: dict[str, Any]) -> tuple[int, int, int, int]:
+    """(told, held, failed and explained, failed unexplained) of a figure's shape checks."""
+    told = [c for c in entry.get("checks") or [] if c.get("holds") is not None]
+    failed = [c for c in told if not c["holds"]]
+    explained = sum(1 for c in failed if c.get("explained_at"))
+    return len(told), len(told) - len(failed), explained, len(failed) - explained
+
+
+def _doc_link(at: str, link_base: str) -> str:
+    """A docs-relative ``docs/<page>#anchor`` as a link from a page one folder below docs/."""
+    return f"{link_base.rsplit('/', 1)[0]}/{at.removeprefix('docs/')}"
+
+
+def _why(check: dict[str, Any], link_base: str) -> str:
+    at = check.get("explained_at")
+    return f"[why]({_doc_link(at, link_base)})" if at else "**not explained**"
+
+
+def checks_markdown(figures: list[dict[str, Any]], link_base: str = "../results") -> str:
+    """Per figure: its checks, how many hold, and each failing one with its explanation (or none)."""
+    out = ["| figure | checks | hold | fail, explained | fail, not explained | converged |",
+           "|---|---|---|---|---|---|"]
+    totals = [0, 0, 0, 0]
+    for e in figures:
+        counts = _checks(e)
+        totals = [a + b for a, b in zip(totals, counts, strict=True)]
+        conv = e.get("convergence") or {}
+        converged = "–" if not conv else ("yes" if conv.get("converged") else "no")
+        out.append(f"| `{e['name']}` | {counts[0]} | {counts[1]} | {counts[2]} | {counts[3]} | {converged} |")
+    out.append(f"| all | {totals[0]} | {totals[1]} | {totals[2]} | {totals[3]} | |")
+    failing = [(e["name"], c) for e in figures for c in e.get("checks") or [] if c.get("holds") is False]
+    if failing:
+        out += ["", "Checks that fail:", ""]
+        out += [f"- `{name}`: {_text(c['claim'])} ({_text(c.get('numbers') or '')}): " + _why(c, link_base)
+                for name, c in failing]
+    return "\n".join(out) + "\n"
+
+
+def intervals_markdown(figures: list[dict[str, Any]]) -> str:
+    """The headline numbers: the paper's beside cerebx's mean and 95 % interval over seeds, and whether the
+    paper's number falls inside (– with one seed or no paper number)."""
+    rows = [(e["name"], q, iv, next((r[1] for r in e.get("table") or [] if r and r[0] == q), "–"))
+            for e in figures for q, iv in (e.get("intervals") or {}).items()]
+    if not rows:
+        return ""
+    out = ["| figure | quantity | paper | cerebx, mean [95 % interval] | seeds | paper inside |",
+           "|---|---|---|---|---|---|"]
+    for name, q, iv, paper in rows:
+        lo, hi = iv.get("ci_low"), iv.get("ci_high")
+        ci = f"{iv['mean']:.4g} [{lo:.4g}, {hi:.4g}]" if lo is not None and hi is not None else f"{iv['mean']:.4g}"
+        out.append(f"| `{name}` | {_cell(q)} | {_cell(paper)} | {ci} | {iv.get('n', 1)} "
+                   f"| {iv.get('paper_in_ci', '–')} |")
+    inside = sum(1 for *_, iv, _p in rows if iv.get("paper_in_ci") == "yes")
+    judged = sum(1 for *_, iv, _p in rows if iv.get("paper_in_ci") in ("yes", "no"))
+    return "\n".join(out) + f"\n\nThe paper's number falls inside cerebx's interval in {inside} of {judged} rows " \
+        "that have both.\n"
+
+
+INCLUDE = re.compile(r'--8<-- "docs/results/([\w-]+)\.md"')
+
+
+def reproduction_pages(pages_dir: Path) -> dict[str, list[str]]:
+    """Each reproduction page's stem and the figures it includes (in order)."""
+    out: dict[str, list[str]] = {}
+    for page in sorted(Path(pages_dir).glob("*.md")):
+        names = [n for n in INCLUDE.findall(page.read_text()) if n != "stamp" and not n.startswith("page_")]
+        if names:
+            out[page.stem] = names
+    return out
+
+
+def page_markdown(names: list[str], report: dict[str, Any], link_base: str) -> str:
+    """What a reproduction page opens with: its paper numbers beside cerebx's intervals, and its checks."""
+    figures = [e for e in report.get("figures") or [] if e["name"] in names]
+    if not figures:
+        return "No figure of this page was drawn in the published report.\n"
+    told, held, explained, unexplained = (sum(c) for c in zip(*(_checks(e) for e in figures), strict=True))
+    head = (f"**In the published report ({report.get('profile') or 'runs'} profile):** {held} of {told} shape checks "
+            f"hold, {explained} fail with an explanation, {unexplained} fail without one.\n\n")
+    intervals = intervals_markdown(figures)
+    return head + (intervals + "\n" if intervals else "") + checks_markdown(figures, link_base)
+
+
+def hero_block(report: dict[str, Any], name: str, image_path: str) -> str | None:
+    """The README's hero: the hero figure's image, its caption's first sentence, and its ratio rows."""
+    entry = next((e for e in report.get("figures") or [] if e["name"] == name), None)
+    if entry is None or not entry.get("files"):
+        return None
+    rows = [r for r in entry.get("table") or [] if r and str(r[0]).startswith(HERO_ROWS)]
+    caption = str(entry.get("caption", "")).split(". ")[0]
+    out = [f"![{_text(entry['title'])}]({image_path}/{Path(entry['files'][0]).name})", "",
+           f"*{_text(caption)}. Drawn by `cerebx report` from cerebx's own runs ({report.get('profile')} profile, "
+           f"{_day(report.get('built_at'))}, commit `{report.get('commit') or 'unknown'}`); its reproduction page "
+           "puts every number of the paper beside cerebx's, with the checks that hold and those that do not.*", ""]
+    if rows:
+        out += [table_markdown([["quantity", "paper", "cerebx"], *[r[:3] for r in rows]])]
+    return "\n".join(out)
+
+
+def update_readme(readme_path: Path, block: str) -> bool:
+    """Replace the README's hero block with ``block``; False when the README has no hero markers."""
+    text = readme_path.read_text()
+    if HERO_START not in text or HERO_END not in text:
+        return False
+    a, b = text.index(HERO_START) + len(HERO_START), text.index(HERO_END)
+    readme_path.write_text(text[:a] + "\n" + block.rstrip() + "\n" + text[b:])
+    return True
+
+
 def _png(src: Path, dst: Path) -> None:
     """A palette PNG of ``src`` (matplotlib figures keep their look at 256 colours, at a third of the size)."""
     with Image.open(src) as im:
@@ -156,18 +291,26 @@ def _png(src: Path, dst: Path) -> None:
             dst, optimize=True)
 
 
-def render(report: dict[str, Any], link_base: str = "../results") -> dict[str, str]:
-    """Every text file the published folder holds, by name, made from the report's figures.json alone."""
+def render(report: dict[str, Any], link_base: str = "../results",
+           pages: dict[str, list[str]] | None = None) -> dict[str, str]:
+    """Every text file the published folder holds, by name, made from the report's figures.json alone
+    (``pages``: each reproduction page's figures, for its opening table)."""
     report = {**report, "command": portable(report.get("command"))}
     files = {"figures.json": json.dumps(report, indent=1, ensure_ascii=False) + "\n",
-             "stamp.md": stamp(report), "README.md": readme(report)}
+             "stamp.md": stamp(report), "README.md": readme(report),
+             "checks.md": checks_markdown(report.get("figures") or [], link_base)}
     for entry in report.get("figures") or []:
         files[f"{entry['name']}.md"] = figure_markdown(entry, report, link_base)
+    for page, names in (pages or {}).items():
+        files[f"page_{page}.md"] = page_markdown(names, report, link_base)
     return files
 
 
-def publish(report_dir: Path, out: Path, link_base: str = "../results") -> list[str]:
-    """Replace ``out`` with the published form of the report in ``report_dir``; returns the figure names."""
+def publish(report_dir: Path, out: Path, link_base: str = "../results", pages_dir: Path | None = None,
+            readme_path: Path | None = None, hero: str = "fig3_4") -> list[str]:
+    """Replace ``out`` with the published form of the report in ``report_dir`` (with an opening table for
+    each reproduction page of ``pages_dir``, and the hero block of ``readme_path`` rewritten); returns the
+    figure names."""
     report_dir, out = Path(report_dir), Path(out)
     report = load_report(report_dir)
     images = [(report_dir / f, Path(f).name) for e in report.get("figures") or [] for f in e.get("files") or []]
@@ -179,10 +322,16 @@ def publish(report_dir: Path, out: Path, link_base: str = "../results") -> list[
     if out.exists():
         shutil.rmtree(out)
     (out / "figures").mkdir(parents=True)
-    for name, text in render(report, link_base).items():
+    pages = reproduction_pages(pages_dir) if pages_dir is not None and Path(pages_dir).is_dir() else {}
+    for name, text in render(report, link_base, pages).items():
         (out / name).write_text(text)
     for src, name in images:
         _png(src, out / "figures" / name)
+    if readme_path is not None and readme_path.is_file():
+        rel = Path(os.path.relpath(out, readme_path.parent)).as_posix()
+        block = hero_block({**report, "command": portable(report.get("command"))}, hero, f"{rel}/figures")
+        if block is not None:
+            update_readme(readme_path, block)
     return [e["name"] for e in report.get("figures") or []]
 
 
@@ -192,9 +341,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", type=Path, default=Path("docs/results"), help="published folder (default docs/results)")
     ap.add_argument("--link-base", default="../results",
                     help="the published folder as the including pages see it (default ../results)")
+    ap.add_argument("--pages", type=Path, default=Path("docs/reproductions"),
+                    help="the reproduction pages whose opening tables to write (default docs/reproductions)")
+    ap.add_argument("--readme", type=Path, default=Path("README.md"),
+                    help="the README whose hero block to rewrite (default README.md; a missing one is skipped)")
+    ap.add_argument("--hero", default="fig3_4", help="the hero figure (default fig3_4)")
     a = ap.parse_args(argv)
     try:
-        names = publish(a.report, a.out, a.link_base)
+        names = publish(a.report, a.out, a.link_base, a.pages, a.readme, a.hero)
     except PublishError as err:
         print(f"publish_report: {err}", file=sys.stderr)
         return 2

@@ -69,7 +69,7 @@ def test_every_registered_figure_is_published_and_on_its_page():
 
 def test_published_files_are_what_the_publishing_step_makes_of_their_report():
     report = _published()
-    expected = publisher.render(report)
+    expected = publisher.render(report, pages=publisher.reproduction_pages(PAGES))
     assert expected["figures.json"] == (RESULTS / "figures.json").read_text()
     for name, text in expected.items():
         assert (RESULTS / name).read_text() == text, f"docs/results/{name} differs from its report: publish again"
@@ -159,3 +159,40 @@ def test_publishing_a_report_built_from_synthetic_runs(tmp_path, monkeypatch):
         publisher.publish(report, tmp_path / "docs")
     with pytest.raises(publisher.PublishError, match="figures.json: not found"):
         publisher.publish(tmp_path / "runs", tmp_path / "elsewhere")
+
+
+def _entry(name: str, checks: list[dict], intervals: dict | None = None, table: list | None = None) -> dict:
+    return {"name": name, "title": name, "files": [f"figures/{name}.png"], "caption": "Cap one. Cap two.",
+            "table": table or [], "checks": checks, "intervals": intervals or {}}
+
+
+def test_checks_pages_and_hero_are_made_from_figures_json(tmp_path):
+    ok = {"claim": "SNN below PD", "holds": True, "numbers": "", "explained_at": None}
+    why = {"claim": "ANN above SNN", "holds": False, "numbers": "1 vs 2",
+           "explained_at": "docs/reproductions/thesis-ch3.md#the-ann"}
+    bare = {"claim": "levels off", "holds": False, "numbers": "", "explained_at": None}
+    iv = {"mean": 3.5, "ci_low": 3.1, "ci_high": 3.9, "n": 3, "paper_in_ci": "yes"}
+    table = [["quantity", "paper", "cerebx"], ["PD average MAE ÷ SNN average MAE", "3 to 4× larger", "3.5"],
+             ["unrelated", "1", "1"]]
+    report = {"profile": "full", "commit": "abc123", "built_at": "2026-11-27T12:00:00+00:00",
+              "figures": [_entry("fig3_4", [ok, why], {"PD average MAE ÷ SNN average MAE": iv}, table),
+                          _entry("fig3_3", [bare])]}
+    checks = publisher.checks_markdown(report["figures"])
+    assert "| `fig3_4` | 2 | 1 | 1 | 0 |" in checks and "| all | 3 | 1 | 1 | 1 |" in checks
+    assert "[why](../reproductions/thesis-ch3.md#the-ann)" in checks and "levels off (): **not explained**" in checks
+    page = publisher.page_markdown(["fig3_4"], report, "../results")
+    assert page.startswith("**In the published report (full profile):** 1 of 2 shape checks hold, 1 fail with")
+    assert "| `fig3_4` | PD average MAE ÷ SNN average MAE | 3 to 4× larger | 3.5 [3.1, 3.9] | 3 | yes |" in page
+    pages = tmp_path / "pages"
+    pages.mkdir()
+    (pages / "ch3.md").write_text('--8<-- "docs/results/stamp.md"\n--8<-- "docs/results/fig3_4.md"\n')
+    assert publisher.reproduction_pages(pages) == {"ch3": ["fig3_4"]}
+    readme = tmp_path / "README.md"
+    readme.write_text("# x\n<!-- hero:start -->\nold\n<!-- hero:end -->\nrest\n")
+    block = publisher.hero_block(report, "fig3_4", "docs/results/figures")
+    assert publisher.update_readme(readme, block)
+    text = readme.read_text()
+    assert "old" not in text and text.endswith("<!-- hero:end -->\nrest\n")
+    assert "![fig3_4](docs/results/figures/fig3_4.png)" in text and "commit `abc123`" in text
+    assert "| PD average MAE ÷ SNN average MAE | 3 to 4× larger | 3.5 |" in text and "unrelated" not in text
+    assert not publisher.update_readme(pages / "ch3.md", block)  # no markers: left alone

@@ -25,6 +25,7 @@ import dataclasses
 import html
 import json
 import shlex
+import subprocess
 import sys
 import time
 from collections import defaultdict
@@ -134,20 +135,46 @@ def _iso(t: float) -> str:
     return datetime.fromtimestamp(t, timezone.utc).isoformat(timespec="seconds")
 
 
-def provenance(runs: RunSet, command: str | None, profile: str | None) -> dict[str, Any]:
-    """How a report was made: the command, the profile, this cerebx's version, when, and the runs it drew
-    from (how many, the first and last start time their summaries record, the versions that ran them)."""
+def source_commit() -> str | None:
+    """The commit of the cerebx checkout this report runs from (with ``-dirty`` when it has uncommitted
+    changes), or None outside a git checkout."""
+    here = Path(__file__).resolve().parent
+    try:
+        out = subprocess.run(["git", "-C", str(here), "describe", "--always", "--dirty", "--abbrev=12"],
+                             capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None if out.returncode == 0 else None
+
+
+def _disk_bytes(d: Path) -> int:
+    try:
+        return sum(f.stat().st_size for f in d.rglob("*") if f.is_file())
+    except OSError:
+        return 0
+
+
+def provenance(runs: RunSet, command: str | None, profile: str | None,
+               wall_seconds: float | None = None) -> dict[str, Any]:
+    """How a report was made: the command, the profile, this cerebx's version and commit, when, how long the
+    command took (``wall_seconds``: running the missing studies and drawing), and the runs it drew from (how
+    many, the first and last start time their summaries record, the versions that ran them, their summed wall
+    time and their size on disk)."""
     started = sorted(float(t) for r in runs if isinstance(t := r.summary.get("started_at"), int | float))
     return {
         "command": command,
         "profile": profile,
         "cerebx_version": __version__,
+        "commit": source_commit(),
         "built_at": _iso(time.time()),
+        "wall_seconds": None if wall_seconds is None else round(wall_seconds, 1),
         "runs": {
             "count": len(runs),
             "first_started_at": _iso(started[0]) if started else None,
             "last_started_at": _iso(started[-1]) if started else None,
             "versions": sorted({str(v) for r in runs if (v := r.summary.get("version"))}),
+            "wall_seconds": round(sum(float(r.summary.get("wall_seconds") or 0.0) for r in runs), 1),
+            "disk_bytes": sum(_disk_bytes(r.dir) for r in runs),
         },
     }
 
@@ -178,17 +205,18 @@ def _img(png: Path, caption: str) -> str:
 
 
 def build(run_dirs: list[Path], out: Path, names: list[str] | None = None, log=lambda line: None,
-          command: str | None = None, profile: str | None = None) -> tuple[Path, list[str], int]:
+          command: str | None = None, profile: str | None = None,
+          started: float | None = None) -> tuple[Path, list[str], int]:
     """Draw every figure (or the named ones) from ``run_dirs`` into ``out``; returns (index, problems, runs).
     ``command`` and ``profile`` are recorded in figures.json (the profile is read from the runs' folders
-    when not given)."""
+    when not given), and the wall time since ``started`` (a ``time.monotonic()``) when given."""
     runs, problems = load_runs(run_dirs)
-    return build_from(runs, out, names, log, problems, command, profile)
+    return build_from(runs, out, names, log, problems, command, profile, started)
 
 
 def build_from(runs: RunSet, out: Path, names: list[str] | None = None, log=lambda line: None,
                problems: list[str] | None = None, command: str | None = None,
-               profile: str | None = None) -> tuple[Path, list[str], int]:
+               profile: str | None = None, started: float | None = None) -> tuple[Path, list[str], int]:
     """Draw every figure (or the named ones) from ``runs`` into ``out``; ``problems``: lines already found
     (unreadable runs); the rest as :func:`build`."""
     problems = list(problems or [])
@@ -244,7 +272,7 @@ def build_from(runs: RunSet, out: Path, names: list[str] | None = None, log=lamb
     _write_table(out, "paper_vs_cerebx", paper_rows)
     _write_table(out, "shapes", shape_rows(drawn))
     _write_table(out, "delays", delay_rows(runs))
-    made = provenance(runs, command, profile)
+    made = provenance(runs, command, profile, None if started is None else time.monotonic() - started)
     (out / "figures.json").write_text(json.dumps(
         {**made, "figures": [figure_entry(spec, fig, out) for spec, fig in drawn], "not_drawn": missing},
         indent=1, ensure_ascii=False, default=str) + "\n")
@@ -338,7 +366,7 @@ def main(argv: list[str]) -> int:
             for p in a.runs or [Path("runs")]:
                 dirs.extend(find_run_dirs(p) if p.is_dir() and not (p / runfiles.SUMMARY).exists() else [p])
         index, problems, n = build(dirs, a.out, names, log=print, command=shlex.join(["cerebx", "report", *argv]),
-                                   profile=a.profile)
+                                   profile=a.profile, started=t0)
     except CerebxError as err:
         for line in str(err).splitlines():
             print(line, file=sys.stderr)
