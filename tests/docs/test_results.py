@@ -192,7 +192,7 @@ def test_checks_pages_and_hero_are_made_from_figures_json(tmp_path):
     block = publisher.hero_block(report, "fig3_4", "docs/results/figures")
     assert publisher.update_readme(readme, block)
     text = readme.read_text()
-    assert "old" not in text and text.endswith("<!-- hero:end -->\nrest\n")
+    assert "\nold\n" not in text and text.endswith("<!-- hero:end -->\nrest\n")
     assert "![fig3_4](docs/results/figures/fig3_4.png)" in text and "commit `abc123`" in text
     assert "| PD average MAE ÷ SNN average MAE | 3 to 4× larger | 3.5 |" in text and "unrelated" not in text
     assert not publisher.update_readme(pages / "ch3.md", block)  # no markers: left alone
