@@ -22,6 +22,7 @@ import numpy as np
 from cerebx.report.convergence import Convergence, learning_convergence
 from cerebx.report.plot import panel_letter, save
 from cerebx.report.runs import Run, RunSet
+from cerebx.report.stats import Interval
 from cerebx.report.studies import study_plateau
 
 THESIS_KERNEL_MS = 150.0  # chapter 3 ([D]) kernel peak
@@ -55,6 +56,20 @@ def learnt(runs: RunSet, curves: Iterable[tuple[str, Run | None, str]],
     thesis's shape appears)."""
     return learning_convergence([(label, r, study_plateau(study)) for label, r, study in curves if r is not None],
                                 runs, rows, own)
+
+
+def seed_runs(runs: RunSet, pick: Callable[[RunSet], Run | None], like: Run | None = None) -> list[Run]:
+    """The run ``pick`` chooses among each seed's runs, lowest seed first (a study learned from several seeds:
+    one run per seed); with ``like``, only those with as many trials as it (a seed still learning is left out)."""
+    out = [r for rs in runs.seeds().values() if (r := pick(rs)) is not None]
+    return [r for r in out if like is None or r.trials == like.trials]
+
+
+def with_intervals(table: list[list[str]], intervals: dict[str, Interval], nd: int = 3) -> list[list[str]]:
+    """The table with "; over seeds <mean [low, high] (n seeds)>" after the cerebx cell of each row that has an
+    interval over several seeds."""
+    return [row if row[0] not in intervals or not intervals[row[0]].has_interval
+            else [*row[:-1], f"{row[-1]}; over seeds {intervals[row[0]].text(nd)}"] for row in table]
 
 
 def snn_rows(quantity: str) -> bool:

@@ -15,7 +15,8 @@ import numpy as np  # noqa: E402
 from cerebx.metrics import final_mae  # noqa: E402
 from cerebx.report.plot import save  # noqa: E402
 from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
-from cerebx.report.runs import RunSet  # noqa: E402
+from cerebx.report.runs import Run, RunSet  # noqa: E402
+from cerebx.report.stats import Interval  # noqa: E402
 from cerebx_thesis.report import stages  # noqa: E402
 from cerebx_thesis.report.common import (  # noqa: E402
     CH2_KERNEL_MS,
@@ -27,11 +28,24 @@ from cerebx_thesis.report.common import (  # noqa: E402
     baselines,
     from_scratch,
     learnt,
+    seed_runs,
     short_path,
     snn_rows,
 )
 
 CONVERGENCE_TOL = 0.10
+
+
+# §2.3.1: "the cerebellar controller needed about 300 trials (i.e., 600 seconds) to converge" (circle)
+PAPER_CONVERGED_TRIAL = {"circle": 300}
+ABOUT = 0.5  # "about 300 trials": within ±50 % of it (constructed)
+# §2.3.2: the eight's MAE at the initial stage (Fig. 2.7 a, t1 = 18-20 s) "was high (0.165 rad)"
+PAPER_EIGHT_INITIAL = 0.165
+
+
+def seed_stage_runs(runs: RunSet, task: str, run: Run) -> list[Run]:
+    """One run of each seed learning ``task`` from scratch with chapter 2's kernel, as long as ``run``."""
+    return seed_runs(runs, lambda rs: from_scratch(rs, task, CH2_KERNEL_MS), like=run)
 
 
 def _trajectory_learning(runs: RunSet, stem: Path, task: str, fig_no: str, study: str) -> Figure:
@@ -40,12 +54,20 @@ def _trajectory_learning(runs: RunSet, stem: Path, task: str, fig_no: str, study
     if run is None:
         raise MissingRuns(f"no {task} run of snn learning from scratch (study {study})")
     base = baselines(runs, task)
-    table, wins = stages.stage_table(run, task, base)
+    seeds = seed_stage_runs(runs, task, run)
+    table, wins, intervals = stages.stage_table(run, task, base, seeds)
     files = [stages.stages_figure(run.dir, run.summary, stem.with_name(stem.name + "_stages")),
              stages.mae_per_joint_figure(run.summary, [b.summary for _, b in base],
                                          stem.with_name(stem.name + "_mae"),
                                          labels=[name for name, _ in base], windows=wins)]
     ks = stages.stage_trials(run.trials)
+    checks = stages.stage_checks(task, stages.seed_means(intervals), base)
+    if task == "circle":
+        checks.append(_converged_check(run, task))
+    if task == "eight":
+        table.append([f"SNN MAE at the initial stage, trial {ks[0]} (rad)", f"{PAPER_EIGHT_INITIAL:.3f}",
+                      f"{run.mae[ks[0]]:.3f}"])
+        checks.append(_initial_high_check(run, ks[0], base))
     notes = [] if base else [f"no {task} baseline runs (pd / position_factory without delay): MAE figure without "
                              "baselines"]
     conv = learnt(runs, [(task, run, LEARN_STUDY[task])], snn_rows)
@@ -55,8 +77,42 @@ def _trajectory_learning(runs: RunSet, stem: Path, task: str, fig_no: str, study
                f"Stage figure (a–f): trials {', '.join(map(str, ks))} (thesis: 18–20 s, 318–320 s, 998–1000 s, "
                "scaled by fraction of the run); end-effector density of the previous 10 trials. "
                "MAE figure (g): MAE per trial of each joint and their mean; shaded: the table windows "
-               f"({', '.join(f'{a}–{b}' for a, b in wins)}); {baseline_text(base)}.")
-    return Figure(files, caption, table, notes, stages.stage_checks(run, task, base, wins), conv)
+               f"({', '.join(f'{a}–{b}' for a, b in wins)}); {baseline_text(base)}."
+               + _seeds_text(seeds))
+    return Figure(files, caption, table, notes, checks, conv, intervals)
+
+
+def _seeds_text(seeds: list[Run]) -> str:
+    if len(seeds) < 2:
+        return ""
+    return (f" Stage MAE over {len(seeds)} independently learned seeds ({', '.join(str(r.seed) for r in seeds)}): "
+            "mean and 95 % interval in the table; the checks decide on the mean over seeds; figures show the "
+            "first seed.")
+
+
+def _converged_check(run: Run, task: str) -> Check:
+    """§2.3.1: the circle converged in about 300 trials (judged on runs at least as long as the thesis's)."""
+    paper = PAPER_CONVERGED_TRIAL[task]
+    lo, hi = paper * (1 - ABOUT), paper * (1 + ABOUT)
+    claim = (f"{task}: the SNN converges in about {paper} trials (thesis; constructed: the first trial whose running "
+             f"mean is within {CONVERGENCE_TOL:.0%} of the final level, between {lo:g} and {hi:g})")
+    total = stages.PAPER_STAGES[task][0]
+    if run.trials < total:
+        return Check(claim, None, f"run of {run.trials} trials, shorter than the thesis's {total}")
+    k, _, _ = convergence_trial(run.mae)
+    return Check(claim, None if k is None else lo <= k <= hi, "not reached" if k is None else f"trial {k}")
+
+
+def _initial_high_check(run: Run, k: int, base: list[tuple[str, Run]]) -> Check:
+    """§2.3.2: the eight's MAE at the initial stage was high (0.165 rad): above the factory position
+    controller's (0.063 rad in Table 2.3)."""
+    factory = next((b for name, b in base if name == "factory position"), None)
+    claim = (f"eight: MAE at the initial stage high, above the factory position controller's (thesis: "
+             f"{PAPER_EIGHT_INITIAL} vs {stages.PAPER_STAGES['eight'][2].split()[0]} rad)")
+    if factory is None or not factory.mae.size:
+        return Check(claim, None, "no factory position run")
+    f = float(factory.mae.mean())
+    return Check(claim, bool(run.mae[k] > f), f"trial {k}: {run.mae[k]:.3f} vs {f:.3f} rad")
 
 
 @figure("fig2_6", "Circle learnt from scratch: stages and MAE per joint (Fig. 2.6, Table 2.3)",
@@ -86,12 +142,15 @@ def table2_3(runs: RunSet, stem: Path) -> Figure:
     fig, axes = plt.subplots(1, len(found), figsize=(4.6 * len(found), 3.8), squeeze=False)
     table = [["quantity", "paper", "cerebx"]]
     checks: list[Check] = []
+    intervals: dict[str, Interval] = {}
+    seeds = {task: seed_stage_runs(runs, task, run) for task, run in found.items()}
     for ax, (task, run) in zip(axes[0], found.items(), strict=True):
         total, ref, factory = stages.PAPER_STAGES[task]
         base = baselines(runs, task)
-        rows, wins = stages.stage_table(run, task, base)
-        checks += stages.stage_checks(run, task, base, wins)
+        rows, wins, ivs = stages.stage_table(run, task, base, seeds[task])
+        checks += stages.stage_checks(task, stages.seed_means(ivs), base)
         table += [[f"{task}: {q}", p, c] for q, p, c in rows[1:]]
+        intervals |= {f"{task}: {q}": iv for q, iv in ivs.items()}
         x = np.arange(len(ref))
         ours = [run.mae[lo:hi] for lo, hi in wins]
         ax.bar(x - 0.2, [m for *_, m, _ in ref], 0.4, yerr=[sd for *_, sd in ref], capsize=3, color="0.6",
@@ -109,16 +168,53 @@ def table2_3(runs: RunSet, stem: Path) -> Figure:
         ax.set_title(TASK_NAMES[task])
         ax.grid(alpha=0.3, axis="y")
         ax.legend(fontsize=7)
+    checks += _across_tasks(found, seeds)
     fig.suptitle("Thesis Tables 2.3 / 2.4 beside cerebx: MAE (mean ± std) per learning stage")
     fig.tight_layout()
+    n_seeds = max(len(v) for v in seeds.values())
     caption = ("Thesis Tables 2.3 (circle, eight) and 2.4 (reaching): the cerebellar controller's position MAE "
                "(mean ± std over the trials of each window) at the initial, intermediate and final stage of "
                "learning from scratch, beside the factory position controller. Runs shorter than the thesis's "
                "use the same fractions of their length (the window in brackets). Runs: "
-               + ", ".join(f"{t} {short_path(r)}" for t, r in found.items()) + ".")
+               + ", ".join(f"{t} {short_path(r)}" for t, r in found.items()) + "."
+               + (f" Each stage's mean over up to {n_seeds} independently learned seeds with its 95 % interval "
+                  "follows in the table; the checks decide on the mean over seeds; the bars show the first seed."
+                  if n_seeds > 1 else ""))
     notes = [f"{t}: no run learning from scratch" for t in stages.PAPER_STAGES if t not in found]
     conv = learnt(runs, [(t, r, LEARN_STUDY[t]) for t, r in found.items()], snn_rows)
-    return Figure([save(fig, stem)], caption, table, notes, checks, conv)
+    return Figure([save(fig, stem)], caption, table, notes, checks, conv, intervals)
+
+
+def _final_std(seeds: list[Run], task: str) -> float:
+    """The trial-to-trial std of the MAE in the final stage window, mean over the seeds."""
+    return float(np.mean([stages.stage_slices(r, task)[-1].std() for r in seeds]))
+
+
+def _across_tasks(found: dict[str, Run], seeds: dict[str, list[Run]]) -> list[Check]:
+    """Tables 2.3 / 2.4 across tasks: the eight converges more slowly than the circle (its intermediate stage
+    further from its initial one); reaching has the higher std between trials at the final stage and needs more
+    trials to reach stability than the circle and the eight."""
+    checks = []
+    means = {t: np.mean([stages.stage_means(r, t) for r in seeds[t]], axis=0) for t in found}
+    if {"circle", "eight"} <= set(found):
+        paper = {t: stages.PAPER_STAGES[t][1][1][2] / stages.PAPER_STAGES[t][1][0][2] for t in ("circle", "eight")}
+        ours = {t: float(means[t][1] / means[t][0]) for t in ("circle", "eight")}
+        checks.append(Check("the eight converges more slowly than the circle: intermediate / initial stage MAE "
+                            f"higher (thesis: {paper['eight']:.2f} vs {paper['circle']:.2f})",
+                            ours["eight"] > ours["circle"],
+                            f"eight {ours['eight']:.2f}, circle {ours['circle']:.2f}"))
+    others = [t for t in ("circle", "eight") if t in found]
+    if "reaching" in found and others:
+        std = {t: _final_std(seeds[t], t) for t in found}
+        checks.append(Check("reaching: higher std between trials at the final stage than " + " and ".join(others)
+                            + " (thesis: 0.006 vs 0.003 rad)", all(std["reaching"] > std[t] for t in others),
+                            ", ".join(f"{t} {v:.4f}" for t, v in std.items()) + " rad"))
+        k = {t: convergence_trial(found[t].mae)[0] for t in found}
+        claim = ("reaching needs more trials to reach stability than " + " and ".join(others) + " (constructed: "
+                 f"the first trial whose running mean is within {CONVERGENCE_TOL:.0%} of the final level)")
+        decided = None if any(v is None for v in k.values()) else all(k["reaching"] > k[t] for t in others)
+        checks.append(Check(claim, decided, ", ".join(f"{t} trial {v}" for t, v in k.items())))
+    return checks
 
 
 def convergence_trial(mae: np.ndarray, tol: float = CONVERGENCE_TOL) -> tuple[int | None, int, float | None]:

@@ -1,6 +1,7 @@
 """The learning process at an initial, intermediate and final stage, shared by the learning-from-scratch
 and reaching figures: thesis Fig. 2.6 / 2.7 a-f and g, drawn from a run's MCAP (time-windowed reads
-through the file's index), and the stage windows of Tables 2.3 / 2.4 beside the run's."""
+through the file's index), and the stage windows of Tables 2.3 / 2.4 beside the run's. Where the task was
+learned from several seeds, each stage's mean MAE is also given over the seeds (mean and 95 % interval)."""
 
 from __future__ import annotations
 
@@ -18,6 +19,8 @@ from cerebx.recording.reader import read_messages  # noqa: E402
 from cerebx.report.plot import mean_std, panel_letter, save  # noqa: E402
 from cerebx.report.registry import Check  # noqa: E402
 from cerebx.report.runs import Run  # noqa: E402
+from cerebx.report.stats import Interval, interval  # noqa: E402
+from cerebx_thesis.report.common import with_intervals  # noqa: E402
 
 # thesis stages for a 500-trial run: t1 = 18-20 s, t2 = 318-320 s, t3 = 998-1000 s
 STAGE_FRACTIONS = (0.02, 0.32, 1.0)
@@ -171,35 +174,65 @@ def scaled_windows(n: int, total: int, windows: list[tuple[int, int, float, floa
     return out
 
 
-def stage_table(run: Run, task: str, base: list[tuple[str, Run]]) -> tuple[list[list[str]], list[tuple[int, int]]]:
-    """Rows of Table 2.3 / 2.4 for ``task`` beside ours, and the windows used."""
+def stage_slices(run: Run, task: str) -> list[np.ndarray]:
+    """The run's MAE per trial in each stage window of Table 2.3 / 2.4 for ``task`` (the thesis's windows,
+    scaled to the run's length)."""
+    total, ref, _ = PAPER_STAGES[task]
+    return [run.mae[lo:hi] for lo, hi in scaled_windows(run.trials, total, ref)]
+
+
+def stage_means(run: Run, task: str) -> list[float]:
+    """The run's mean MAE in each stage window: the headline numbers of Table 2.3 / 2.4, one seed's."""
+    return [float(m.mean()) for m in stage_slices(run, task)]
+
+
+def stage_intervals(seeds: list[Run], task: str) -> list[Interval]:
+    """Each stage's mean MAE over the seeds' runs (one run per seed), with the thesis's mean."""
+    _, ref, _ = PAPER_STAGES[task]
+    per_seed = [stage_means(r, task) for r in seeds]
+    return [interval([v[i] for v in per_seed], paper=m) for i, (*_, m, _) in enumerate(ref)]
+
+
+def stage_table(run: Run, task: str, base: list[tuple[str, Run]], seeds: list[Run] | None = None
+                ) -> tuple[list[list[str]], list[tuple[int, int]], dict[str, Interval]]:
+    """Rows of Table 2.3 / 2.4 for ``task`` beside ours, the windows used, and each stage's interval over
+    ``seeds`` (one run of each seed; default: ``run`` alone) keyed by its row's quantity."""
     total, ref, factory = PAPER_STAGES[task]
     wins = scaled_windows(run.trials, total, ref)
     rows = [["quantity", "paper", "cerebx"]]
-    for (a, b, m, s), (lo, hi) in zip(ref, wins, strict=True):
+    intervals: dict[str, Interval] = {}
+    for (a, b, m, s), (lo, hi), mae, iv in zip(ref, wins, stage_slices(run, task),
+                                               stage_intervals(seeds or [run], task), strict=True):
         ours = f"trials {lo}–{hi}" if hi - lo > 1 else f"trial {lo}"
         used = "" if (lo, hi) == (a, b) else f" [cerebx: {ours} of {run.trials}]"
-        rows.append([f"SNN MAE (rad), trials {a}–{b}{used}", f"{m:.3f} ± {s:.3f}", mean_std(run.mae[lo:hi])])
+        quantity = f"SNN MAE (rad), trials {a}–{b}{used}"
+        rows.append([quantity, f"{m:.3f} ± {s:.3f}", mean_std(mae)])
+        intervals[quantity] = iv
     for name, b in base:
         paper = factory if name == "factory position" else "not in the thesis table"
         nd = 4 if name == "factory position" else 3
         rows.append([f"{name} MAE (rad), all trials [cerebx: {b.n_measured} trials]", paper, mean_std(b.mae, nd)])
     if not any(name == "factory position" for name, _ in base):
         rows.append(["factory position MAE (rad), all trials", factory, "not run"])
-    return rows, wins
+    return with_intervals(rows, intervals), wins, intervals
 
 
-def stage_checks(run: Run, task: str, base: list[tuple[str, Run]], wins: list[tuple[int, int]]) -> list[Check]:
-    """The shapes of Tables 2.3 / 2.4 for ``task``: the SNN's MAE falls from stage to stage and its final
-    stage is below the factory position controller's."""
-    means = [float(run.mae[lo:hi].mean()) for lo, hi in wins]
+def stage_checks(task: str, means: list[float], base: list[tuple[str, Run]]) -> list[Check]:
+    """The shapes of Tables 2.3 / 2.4 for ``task`` on its stage means (one seed's, or the mean over seeds): the
+    SNN's MAE falls from stage to stage and its final stage is below the factory position controller's."""
     checks = [Check(f"{task}: SNN MAE falls from stage to stage", all(a > b for a, b in zip(means, means[1:])),
                     " → ".join(f"{m:.3f}" for m in means) + " rad")]
     factory = next((b for name, b in base if name == "factory position"), None)
-    claim = f"{task}: SNN MAE of the final stage below the factory position controller's"
+    claim = (f"{task}: SNN MAE of the final stage below the factory position controller's (thesis: "
+             f"{PAPER_STAGES[task][1][-1][2]:.3f} vs {PAPER_STAGES[task][2].split()[0]} rad)")
     if factory is None or not factory.mae.size:
         checks.append(Check(claim, None, "no factory position run"))
     else:
         f = float(factory.mae.mean())
         checks.append(Check(claim, means[-1] < f, f"{means[-1]:.3f} vs {f:.3f} rad"))
     return checks
+
+
+def seed_means(intervals: dict[str, Interval]) -> list[float]:
+    """The stage means the checks decide on: each stage's mean over the seeds (the table's order)."""
+    return [iv.mean for iv in intervals.values()]

@@ -1,0 +1,81 @@
+"""Headline numbers of the thesis's figures over independently learned seeds, from fabricated run summaries:
+Tables 2.3 / 2.4 per stage, Fig. 3.6's slope, Fig. 4.6 A per cocontraction; and the checks of their claims."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cerebx.report.runs import Run, RunSet
+from cerebx_thesis.report import stages
+from cerebx_thesis.report.learning import table2_3
+
+pytestmark = pytest.mark.unit
+
+
+def _learner(tmp: Path, name: str, task: str, mae, seed: int = 0, kernel_ms: float = 100.0) -> Run:
+    """An snn run learning ``task`` from scratch with one PF-PC kernel peaking at ``kernel_ms``."""
+    cfg = {"init_from": None, "events": [], "controller": {"network": {"projections": {
+        "pf_pc": {"plasticity": {"kind": "kernel_stdp", "kernel_peak_ms": kernel_ms}}}}}}
+    summary = {"task": task, "controller": "snn", "delay": "none", "status": "completed", "seed": seed,
+               "trials_completed": len(mae), "mae_per_trial": list(mae), "sim_seconds": 2.0 * len(mae)}
+    return Run(tmp / name, summary, cfg)
+
+
+def _factory(tmp: Path, task: str, level: float) -> Run:
+    summary = {"task": task, "controller": "position", "delay": "none", "status": "completed", "seed": 0,
+               "presets": {"controller": "position_factory"}, "trials_completed": 5, "mae_per_trial": [level] * 5,
+               "sim_seconds": 10.0}
+    return Run(tmp / f"factory_{task}", summary, {"events": []})
+
+
+def _curve(n: int, start: float, end: float, tau: float) -> np.ndarray:
+    return end + (start - end) * np.exp(-np.arange(n) / tau)
+
+
+def test_stage_intervals_take_each_seeds_stage_means_with_the_thesis_mean(tmp_path):
+    runs = [_learner(tmp_path, f"s{k}", "circle", np.full(500, 0.02 + 0.001 * k), seed=k) for k in range(3)]
+    ivs = stages.stage_intervals(runs, "circle")
+    assert [iv.n for iv in ivs] == [3, 3, 3]
+    assert ivs[2].mean == pytest.approx(0.021) and ivs[2].values == pytest.approx((0.020, 0.021, 0.022))
+    assert [iv.paper for iv in ivs] == [(0.115, 0.115), (0.036, 0.036), (0.019, 0.019)]
+    assert ivs[2].paper_in_ci == "yes"  # 0.021 ± 4.303 · 0.001 / √3 holds 0.019
+    # a 300-trial run's windows are the thesis's scaled by 300 / 500
+    short = _learner(tmp_path, "short", "circle", np.r_[np.full(60, 0.1), np.full(240, 0.02)])
+    assert stages.stage_means(short, "circle") == pytest.approx([0.1, 0.02, 0.02])
+
+
+def test_table2_3_gives_every_stage_over_seeds_and_checks_the_tables_claims(tmp_path):
+    runs = RunSet()
+    for k in range(3):
+        runs.append(_learner(tmp_path, f"c{k}", "circle", _curve(500, 0.12, 0.019 + 0.001 * k, 40), seed=k))
+        runs.append(_learner(tmp_path, f"e{k}", "eight", _curve(500, 0.11, 0.017, 80), seed=k))
+    runs.append(_learner(tmp_path, "e_short", "eight", _curve(400, 0.11, 0.017, 80), seed=3))  # still learning
+    runs.append(_learner(tmp_path, "other_kernel", "circle", np.full(500, 0.5), seed=1, kernel_ms=150.0))
+    runs += [_factory(tmp_path, "circle", 0.077), _factory(tmp_path, "eight", 0.063)]
+    fig = table2_3(RunSet(runs), tmp_path / "t")
+    key = "circle: SNN MAE (rad), trials 400–500"
+    assert fig.intervals[key].n == 3 and fig.intervals[key].mean == pytest.approx(0.020, abs=1e-4)
+    assert fig.intervals["eight: SNN MAE (rad), trials 400–500"].n == 3  # the 400-trial seed is left out
+    row = next(r for r in fig.table if r[0] == key)
+    assert row[1] == "0.019 ± 0.003" and "; over seeds 0.020 [" in row[2] and "(3 seeds)" in row[2]
+    holds = {c.claim.split(" (")[0]: c.holds for c in fig.checks}
+    assert holds["circle: SNN MAE falls from stage to stage"]
+    assert holds["eight: SNN MAE of the final stage below the factory position controller's"]
+    # the eight learns with twice the circle's time constant: further from done at the intermediate stage
+    assert holds["the eight converges more slowly than the circle: intermediate / initial stage MAE higher"]
+
+
+def test_reaching_is_checked_for_its_spread_and_the_trials_it_needs(tmp_path):
+    rng = np.random.default_rng(0)
+    reach = _curve(1000, 0.15, 0.02, 150) + rng.uniform(-0.005, 0.005, 1000)
+    runs = RunSet([_learner(tmp_path, "c", "circle", _curve(500, 0.12, 0.02, 30)),
+                   _learner(tmp_path, "e", "eight", _curve(500, 0.11, 0.02, 30)),
+                   _learner(tmp_path, "r", "reaching", reach)])
+    fig = table2_3(runs, tmp_path / "t")
+    holds = {c.claim.split(" (")[0]: c.holds for c in fig.checks}
+    assert holds["reaching: higher std between trials at the final stage than circle and eight"]
+    assert holds["reaching needs more trials to reach stability than circle and eight"]
+    assert holds["reaching: SNN MAE of the final stage below the factory position controller's"] is None  # no run
