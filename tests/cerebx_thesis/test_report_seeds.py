@@ -79,3 +79,48 @@ def test_reaching_is_checked_for_its_spread_and_the_trials_it_needs(tmp_path):
     assert holds["reaching: higher std between trials at the final stage than circle and eight"]
     assert holds["reaching needs more trials to reach stability than circle and eight"]
     assert holds["reaching: SNN MAE of the final stage below the factory position controller's"] is None  # no run
+
+
+def _kernel_run(tmp: Path, peak: float, seed: int, slope: float, pathway_ms: float | None = None) -> Run:
+    """A kernel-sweep run: MAE = slope · peak + 0.004 (plus a little noise), pathway delay (peak - 50) / 2."""
+    d = (peak - 50) / 2 if pathway_ms is None else pathway_ms
+    cfg = {"init_from": None, "events": [], "controller": {"pathway_delay_ms": d, "network": {"projections": {
+        "pf_pc": {"plasticity": {"kind": "kernel_stdp", "ltp_nS": 0.002, "ltd_nS": -0.0008, "kernel_peak_ms": peak,
+                                 "kernel_onset_ms": peak - 30, "teacher": "cf_pc"}}}}}}
+    mae = slope * peak + 0.004 + 0.0002 * np.sin(np.arange(120) + peak)
+    summary = {"task": "circle", "controller": "snn", "delay": "none", "status": "completed", "seed": seed,
+               "trials_completed": 120, "mae_per_trial": list(mae), "sim_seconds": 240.0}
+    return Run(tmp / f"k{peak:g}s{seed}", summary, cfg)
+
+
+def test_fig3_6_fits_a_slope_per_seed_and_keeps_other_designs_out(tmp_path):
+    from cerebx_thesis.report.kernels import fig3_6, fig3_6_intervals, kernel_fit, kernel_runs
+
+    peaks = [90.0, 130.0, 170.0, 210.0, 250.0]
+    runs = RunSet(_kernel_run(tmp_path, p, k, 0.0001 * (1 + 0.1 * k)) for k in range(3) for p in peaks)
+    runs.append(_kernel_run(tmp_path, 100.0, 0, 0.01, pathway_ms=50.0))  # chapter 2's circle: not a sweep point
+    runs.append(_kernel_run(tmp_path, 90.0, 3, 0.0001))  # a seed that learned one kernel so far
+    by_peak = kernel_runs(runs.seeds()[0])
+    assert sorted(by_peak) == peaks
+    assert kernel_fit(by_peak)[0] == pytest.approx(0.0001, rel=0.02)
+    ivs = fig3_6_intervals(runs, peaks)
+    slope = ivs["slope (rad/ms)"]
+    assert slope.n == 3 and slope.mean == pytest.approx(0.00011, rel=0.02) and slope.paper == (0.000106, 0.000106)
+    assert ivs["intercept (rad)"].mean == pytest.approx(0.004, abs=3e-4)
+    fig = fig3_6(runs, tmp_path / "fig3_6")
+    assert fig.intervals["slope (rad/ms)"].n == 3
+    assert "; over seeds 0.000110 [" in next(r for r in fig.table if r[0] == "slope (rad/ms)")[2]
+
+
+def test_fig3_6_checks_the_thesis_line_on_the_seed_mean(tmp_path):
+    from cerebx_thesis.report.kernels import _fig3_6_shape, fig3_6_intervals, kernel_fit, kernel_runs
+
+    peaks = [90.0, 130.0, 170.0, 210.0, 250.0]
+    for slope, size in ((0.0001, True), (0.0004, False)):
+        runs = RunSet(_kernel_run(tmp_path / str(slope), p, k, slope) for k in range(2) for p in peaks)
+        by_peak = kernel_runs(runs.seeds()[0])
+        checks, _ = _fig3_6_shape(runs, by_peak, {}, kernel_fit(by_peak), fig3_6_intervals(runs, peaks))
+        holds = {c.claim.split(":")[0].split(" (")[0]: c.holds for c in checks}
+        assert holds["MAE rises with the kernel peak"] and holds["the MAE evolves linearly with the kernel peak"]
+        assert holds["the slope of the thesis's size"] is size
+        assert holds["the shortest kernel peak gives the lowest MAE"]
