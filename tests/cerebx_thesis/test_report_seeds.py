@@ -124,3 +124,44 @@ def test_fig3_6_checks_the_thesis_line_on_the_seed_mean(tmp_path):
         assert holds["MAE rises with the kernel peak"] and holds["the MAE evolves linearly with the kernel peak"]
         assert holds["the slope of the thesis's size"] is size
         assert holds["the shortest kernel peak gives the lowest MAE"]
+
+
+def _muscle_run(tmp: Path, k: float, seed: int, level: float) -> Run:
+    """An SNN run of the eight with the Table 4.1 muscle at cocontraction ``k``, evaluated from a learned state."""
+    from cerebx.schema.muscles import EkebergConfig
+
+    muscle = {**EkebergConfig().model_dump(mode="json"), "kind": "ekeberg", "cocontraction": k}
+    cfg = {"init_from": f"learn/{k:g}", "events": [], "muscle": muscle}
+    mae = level + 0.001 * np.sin(np.arange(100))
+    summary = {"task": "eight", "controller": "snn", "delay": "none", "status": "completed", "seed": seed,
+               "trials_completed": 100, "mae_per_trial": list(mae), "sim_seconds": 200.0}
+    return Run(tmp / f"m{k:g}s{seed}", summary, cfg)
+
+
+def test_fig4_6_gives_each_cocontractions_mae_over_seeds_and_checks_panel_a(tmp_path):
+    from cerebx_thesis.report.baxter_muscles import RATIO_ROW, fig4_6, fig4_6_intervals, mae_row
+
+    level = {0: 0.019, 1: 0.019, 5: 0.018, 9: 0.019, 10: 0.024, 12: 0.05}
+    runs = RunSet(_muscle_run(tmp_path, float(k), s, v + 0.0005 * s) for s in range(3) for k, v in level.items())
+    ivs = fig4_6_intervals(runs)
+    assert ivs[mae_row(12)].n == 3 and ivs[mae_row(12)].mean == pytest.approx(0.0505, abs=1e-4)
+    assert ivs[mae_row(0)].paper == (0.0189, 0.0189) and ivs[mae_row(0)].paper_in_ci == "yes"
+    assert ivs[RATIO_ROW].mean == pytest.approx(0.0505 / 0.01925, rel=0.01)
+    fig = fig4_6(runs, tmp_path / "fig4_6")
+    assert "; over seeds 0.0505 [" in next(r for r in fig.table if r[0] == mae_row(12))[2]
+    holds = {c.claim.split(":")[1].strip().split(" (")[0]: c.holds for c in fig.checks}
+    assert holds == {"MAE flat up to x9": True, "x10 starts to degrade": True, "x12 degraded significantly": True,
+                     "x12 the least accurate": True}
+    # x10 no worse than the flat range: it has not started to degrade
+    runs = RunSet(_muscle_run(tmp_path, float(k), 0, 0.019 if k == 10 else v) for k, v in level.items())
+    holds = {c.claim.split(":")[1].strip(): c.holds for c in fig4_6(runs, tmp_path / "f2").checks}
+    assert holds["x10 starts to degrade"] is False
+
+
+def test_fig4_6_b_sag_values_within_the_constructed_tolerance_of_the_thesis():
+    from cerebx_thesis.report.baxter_muscles import SAG_TOLERANCE, THESIS_SAG_CM, _sag_values
+
+    near = {float(k): v * (1 + 0.9 * SAG_TOLERANCE) for k, v in THESIS_SAG_CM.items()}
+    assert [c.holds for c in _sag_values(near)] == [True]
+    assert [c.holds for c in _sag_values({**near, 0.0: 9.9 * (1 + 1.1 * SAG_TOLERANCE)})] == [False]
+    assert _sag_values({}) == []
