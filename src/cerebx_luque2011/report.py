@@ -1,7 +1,9 @@
 """Figures of Luque et al. 2011 (the feed-forward corrective cerebellum on a 3-joint LWR): Fig. 7c (the learned
 PF-PC weights), Fig. 8 (LTD x LTP estimators), Fig. 9 (delays with the kernel matched), Fig. 10 (kernel
 mismatched with the delay) and Fig. 12 (objects of 0.5-2 kg). The MAE of a trial is the sum over the three
-joints (paper Section III-A); the estimators are Eq. 8-11 (``cerebx.metrics``)."""
+joints (paper Section III-A); the estimators are Eq. 8-11 (``cerebx.metrics``). The headline, Fig. 11's error
+reduction (and stability improvement) per object mass, is given over independently learned seeds with its
+95 % interval beside the paper's numbers."""
 
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from cerebx.report.convergence import Convergence, learning_convergence
 from cerebx.report.plot import fmt, panel_letter, save
 from cerebx.report.registry import Check, Figure, MissingRuns, figure, studies
 from cerebx.report.runs import Run, RunSet
+from cerebx.report.stats import Interval, interval
 from cerebx.report.studies import study_plateau
 from cerebx_luque2011.cerebellum.schema import Luque2011Cerebellum
 
@@ -23,10 +26,20 @@ studies(Path(__file__).with_name("studies.yaml"))
 HEADER = ["quantity", "paper", "cerebx"]
 N_JOINTS = 3
 FINAL_TRIALS = 30  # the paper's final error: the last 30 trials (Eq. 9)
-NEARLY_CONSTANT = 1.5  # Fig. 9: "nearly constant" final error, the largest at most this times the smallest
-UNSTABLE = 1.05  # Fig. 10: unstable, the final error this much above the lowest it had reached
+NEARLY_CONSTANT = 1.5  # Fig. 9 / 10: "nearly constant" final error, the largest at most this times the smallest
+# (constructed)
+UNSTABLE = 1.05  # Fig. 10: unstable, the final error this much above the lowest it had reached (constructed)
+LEARNS = 0.5  # Fig. 9 / 10: still learns, the final error below this fraction of the first 30 trials' (constructed)
+SIGNIFICANT = 30.0  # Fig. 12: "significantly reduce the error": by at least this % by trial 400 (constructed)
+EDGE = 3  # Fig. 7c: the outermost input cells at each side of a 20-cell column block (constructed)
 # Fig. 11 caption: error reduction after 200 / 400 trials, by object mass (kg)
 PAPER_IMPROVEMENT = {0.5: (40.4, 49.0), 1.0: (64.6, 64.5), 1.5: (72.5, 74.4), 2.0: (78.6, 79.3)}
+# Fig. 11 caption: "stability improvement", the std of the MAE over trials 170-200 / 370-400 below that of the
+# first 30 trials, in %, by object mass (kg)
+PAPER_STABILITY = {0.5: (82.0, 60.1), 1.0: (49.6, 42.1), 1.5: (46.1, 26.4), 2.0: (26.4, 25.1)}
+AT_TRIALS = (200, 400)
+# Fig. 8: "if our LTD choice is 0.075, our LTP must be lower than 0.015"
+BALANCED_LTD, BALANCED_LTP_BELOW = 0.075, 0.015
 
 
 def _cer(r: Run, dotted: str):
@@ -118,9 +131,7 @@ def fig8(runs: RunSet, stem: Path) -> Figure:
     best = min(cells, key=lambda k: _estimators(cells[k])["final error (rad)"])
     table = [HEADER, ["balanced point", "LTD 0.075 with LTP < 0.015", f"lowest final error at LTD {best[0]:g}, "
                       f"LTP {best[1]:g}"]]
-    checks = [Check("balanced point: the lowest final error at LTD 0.075 with LTP < 0.015",
-                    best[0] == 0.075 and best[1] < 0.015, f"lowest at LTD {best[0]:g}, LTP {best[1]:g} "
-                    f"({_estimators(cells[best])['final error (rad)']:.3f} rad)")]
+    checks = _fig8_checks({k: _estimators(r) for k, r in cells.items()})
     for (ltd, ltp), r in cells.items():
         e = _estimators(r)
         table.append([f"LTD {ltd:g}, LTP {ltp:g}", "–", f"final {e['final error (rad)']:.3f}, std "
@@ -131,6 +142,60 @@ def fig8(runs: RunSet, stem: Path) -> Figure:
                "estimate), LTD-dominated points reach low error but are unstable; LTD 0.075 needs LTP < 0.015.")
     conv = _learnt(runs, cells, lambda k: f"LTD {k[0]:g}, LTP {k[1]:g}", "luque2011_fig8")
     return Figure([png], caption, table, checks=checks, convergence=conv)
+
+
+def _fig8_checks(est: dict[tuple[float, float], dict[str, float]]) -> list[Check]:
+    """Fig. 8's claims on the LTD x LTP grid, against the balanced points (LTD 0.075 with LTP < 0.015): LTP
+    dominating LTD (the lowest LTD with the highest LTP) saturates, with a high final error, a low adaptation and
+    a "useless high stability"; LTD dominating LTP (the highest LTD with the lowest LTP) has a good final error
+    and accuracy gain but a very unstable output; LTD 0.075 needs LTP < 0.015; the balanced points are low and
+    stable."""
+    fe, st, gain = "final error (rad)", "final error stability (rad)", "accuracy gain (rad)"
+    ltds, ltps = sorted({k[0] for k in est}), sorted({k[1] for k in est})
+    balanced = {k: e for k, e in est.items() if k[0] == BALANCED_LTD and k[1] < BALANCED_LTP_BELOW}
+    if not balanced or len(ltds) < 2 or len(ltps) < 2:
+        return [Check(f"balanced points (LTD {BALANCED_LTD:g} with LTP < {BALANCED_LTP_BELOW:g}) on the grid", False,
+                      "grid LTD " + ", ".join(f"{v:g}" for v in ltds) + "; LTP " + ", ".join(f"{v:g}" for v in ltps))]
+    name = f"balanced points' (LTD {BALANCED_LTD:g}, LTP " + ", ".join(f"{k[1]:g}" for k in balanced) + ")"
+
+    def vs(e: dict[str, float], key: str) -> str:
+        return f"{e[key]:.4f} vs balanced " + ", ".join(f"{b[key]:.4f}" for b in balanced.values())
+
+    checks = []
+    ltp_dom, ltd_dom = est.get((ltds[0], ltps[-1])), est.get((ltds[-1], ltps[0]))
+    if ltp_dom is not None:
+        at = f"LTD {ltds[0]:g}, LTP {ltps[-1]:g}"
+        checks += [Check(f"LTP dominating LTD ({at}): a high final error, above every one of the {name}",
+                         all(ltp_dom[fe] > b[fe] for b in balanced.values()), vs(ltp_dom, fe) + " rad"),
+                   Check(f"LTP dominating LTD ({at}): saturated, a useless high stability (final error stability "
+                         f"below the {name})", all(ltp_dom[st] < b[st] for b in balanced.values()),
+                         vs(ltp_dom, st) + " rad"),
+                   Check(f"LTP dominating LTD ({at}): a low adaptation (accuracy gain below the {name})",
+                         all(ltp_dom[gain] < b[gain] for b in balanced.values()), vs(ltp_dom, gain) + " rad")]
+    if ltd_dom is not None:
+        at = f"LTD {ltds[-1]:g}, LTP {ltps[0]:g}"
+        checks.append(Check(f"LTD dominating LTP ({at}): a very unstable output (final error stability above the "
+                            f"{name})", all(ltd_dom[st] > b[st] for b in balanced.values()), vs(ltd_dom, st) + " rad"))
+        if ltp_dom is not None:
+            checks.append(Check(f"LTD dominating LTP ({at}): a good final error and accuracy gain (final error "
+                                "below, gain above the LTP-dominated point's)",
+                                ltd_dom[fe] < ltp_dom[fe] and ltd_dom[gain] > ltp_dom[gain],
+                                f"final {ltd_dom[fe]:.4f} vs {ltp_dom[fe]:.4f}, gain {ltd_dom[gain]:.4f} vs "
+                                f"{ltp_dom[gain]:.4f} rad"))
+    above = {k: e for k, e in est.items() if k[0] == BALANCED_LTD and k[1] >= BALANCED_LTP_BELOW}
+    if above:
+        best = min(b[fe] for b in balanced.values())
+        checks.append(Check(f"LTD {BALANCED_LTD:g} needs LTP < {BALANCED_LTP_BELOW:g}: with a larger LTP a higher "
+                            "final error than the best below it", all(e[fe] > best for e in above.values()),
+                            ", ".join(f"LTP {k[1]:g} {e[fe]:.4f}" for k, e in sorted(est.items())
+                                      if k[0] == BALANCED_LTD) + " rad"))
+    beaten = [k for k, e in est.items() if k not in balanced
+              and all(e[fe] < b[fe] and e[st] < b[st] for b in balanced.values())]
+    checks.append(Check("the balanced points give a low and stable final error (reading: no grid point has both a "
+                        "lower final error and a lower final error stability than all of them)", not beaten,
+                        "beaten by " + ", ".join(f"LTD {k[0]:g}, LTP {k[1]:g}" for k in beaten) if beaten
+                        else "none beats them on both"))
+    return checks
 
 
 # ---- Fig. 9 / 10 -------------------------------------------------------------------------------------------------
@@ -169,9 +234,10 @@ def fig9(runs: RunSet, stem: Path) -> Figure:
     finals = [float(r.split()[0]) for _, _, r in rows]
     table = [HEADER, ["final error across delays", "nearly constant", f"{min(finals):.3f} - {max(finals):.3f} rad"],
              *rows]
-    checks = [Check(f"final error nearly constant across delays (largest within {NEARLY_CONSTANT:g}× the smallest)",
-                    max(finals) <= NEARLY_CONSTANT * min(finals),
-                    ", ".join(f"{d:g} ms {f:.3f}" for d, f in zip(by_delay, finals)) + " rad")]
+    checks = [Check(f"final error nearly constant across delays (largest within {NEARLY_CONSTANT:g}× the smallest, "
+                    "constructed)", max(finals) <= NEARLY_CONSTANT * min(finals),
+                    ", ".join(f"{d:g} ms {f:.3f}" for d, f in zip(by_delay, finals)) + " rad"),
+              _learns("the cerebellum learns at every delay", {f"{d:g} ms": _mae_sum(r) for d, r in by_delay.items()})]
     conv = _learnt(runs, by_delay, lambda d: f"delay {d:g} ms", "luque2011_fig9")
     return Figure([png], "MAE per trial and final error for round-trip delays with the LTD kernel peak at the "
                   f"delay + the arm's own lag ({DEFAULT.arm_lag_ms:g} ms, constructed; 1 kg object). Paper: the "
@@ -196,22 +262,33 @@ def fig10(runs: RunSet, stem: Path) -> Figure:
                   convergence=conv)
 
 
+def _learns(claim: str, maes: dict[str, np.ndarray]) -> Check:
+    """Each curve learns: its final error below LEARNS times the mean of its first 30 trials."""
+    first = {k: (float(v[:FINAL_TRIALS].mean()), metrics.final_error(list(v))) for k, v in maes.items()}
+    return Check(f"{claim} (final error below {LEARNS:g}× the first 30 trials', constructed)",
+                 all(b < LEARNS * a for a, b in first.values()),
+                 ", ".join(f"{k} {a:.3f} → {b:.3f}" for k, (a, b) in first.items()) + " rad")
+
+
 def _fig10_checks(by_dev: dict[float, Run]) -> list[Check]:
-    """Fig. 10's shapes: the matched kernel learns best; 50-70 ms of mismatch still learns (the final error below
-    half the first trials'); beyond 70 ms learning is unstable (the error rises again after its lowest)."""
+    """Fig. 10's claims: up to 70 ms of mismatch (the paper tested 50-70 ms) the cerebellum still learns and the
+    final error keeps constant; beyond 70 ms learning is unstable (the error rises again after its lowest)."""
     m = {d: _mae_sum(r) for d, r in by_dev.items()}
     final = {d: metrics.final_error(list(v)) for d, v in m.items()}
-    checks = [Check("the matched kernel (mismatch 0) gives the lowest final error", min(final, key=final.get) == 0,
-                    ", ".join(f"{d:+g} ms {v:.3f}" for d, v in final.items()) + " rad")]
-    still = {d: (float(v[:FINAL_TRIALS].mean()), final[d]) for d, v in m.items() if 50 <= abs(d) <= 70}
+    checks = []
+    still = {d: v for d, v in m.items() if 50 <= abs(d) <= 70}
     if still:
-        checks.append(Check("50-70 ms of mismatch still learns (final error below half the first trials')",
-                            all(b < 0.5 * a for a, b in still.values()),
-                            ", ".join(f"{d:+g} ms {a:.3f} → {b:.3f}" for d, (a, b) in still.items()) + " rad"))
+        checks.append(_learns("50-70 ms of mismatch still learns", {f"{d:+g} ms": v for d, v in still.items()}))
+    within = {d: v for d, v in final.items() if abs(d) <= 70}
+    if len(within) > 1 and still:
+        checks.append(Check(f"the final error keeps constant up to 70 ms of mismatch (largest within "
+                            f"{NEARLY_CONSTANT:g}× the smallest, constructed)",
+                            max(within.values()) <= NEARLY_CONSTANT * min(within.values()),
+                            ", ".join(f"{d:+g} ms {v:.3f}" for d, v in within.items()) + " rad"))
     beyond = {d: (_lowest(v), final[d]) for d, v in m.items() if abs(d) > 70}
     if beyond:
         checks.append(Check(f"beyond 70 ms of mismatch learning is unstable (the final error over {UNSTABLE:g}× the "
-                            "lowest running mean)", all(b > UNSTABLE * a for a, b in beyond.values()),
+                            "lowest running mean, constructed)", all(b > UNSTABLE * a for a, b in beyond.values()),
                             ", ".join(f"{d:+g} ms lowest {a:.3f}, final {b:.3f}" for d, (a, b) in beyond.items())
                             + " rad"))
     return checks
@@ -224,26 +301,88 @@ def _lowest(mae: np.ndarray) -> float:
 
 
 # ---- Fig. 11 / 12 and Fig. 7c ---------------------------------------------------------------------------------------
-@figure("luque2011_fig12", "Luque 2011 Fig. 12: objects of 0.5-2 kg", studies=("luque2011_fig12",))
-def fig12(runs: RunSet, stem: Path) -> Figure:
+def _fig12_runs(runs: RunSet) -> dict[float, Run]:
+    """The run of each object mass (kg) at the 100 ms delay with the matched kernel and the preset's plasticity."""
     rs = _luque(runs).where(lambda r: r.delay_total_ms == 100.0 and _cer(r, "plasticity.kernel_peak_ms") == 100.0
                             and _default_plasticity(r))
-    by_mass = rs.by(lambda r: r.get("plant.object_mass_kg"))
+    return rs.by(lambda r: r.get("plant.object_mass_kg"))
+
+
+def reduction_row(mass: float, t: int) -> str:
+    return f"{mass:g} kg: error reduction by trial {t}"
+
+
+def stability_row(mass: float, t: int) -> str:
+    return f"{mass:g} kg: stability improvement, trials {t - FINAL_TRIALS}–{t} vs 0–{FINAL_TRIALS}"
+
+
+def stability_improvement_pct(mae: list[float], at_trial: int, n: int = FINAL_TRIALS) -> float:
+    """Fig. 11's stability improvement in %: 100 (1 - std of the MAE over the ``n`` trials before ``at_trial`` /
+    its std over the first ``n`` trials)."""
+    m = np.asarray(mae, float)
+    return float(100.0 * (1.0 - m[max(0, at_trial - n):at_trial].std() / m[:n].std()))
+
+
+def headline(r: Run) -> dict[str, float]:
+    """Fig. 11's numbers of one run (one mass, one seed): the error reduction and the stability improvement by
+    trials 200 and 400 (counted from the run's start), as far as the run goes."""
+    m, mass = list(_mae_sum(r)), float(r.get("plant.object_mass_kg"))
+    out = {}
+    for t in AT_TRIALS:
+        if t <= len(m) + r.warmup:
+            k = min(t, len(m))
+            out[reduction_row(mass, t)] = metrics.improvement_pct(m, k)
+            out[stability_row(mass, t)] = stability_improvement_pct(m, k)
+    return out
+
+
+def fig12_intervals(runs: RunSet) -> dict[str, Interval]:
+    """Fig. 11's error reduction and stability improvement per mass over every seed that learned it, with the
+    paper's numbers."""
+    paper = {}
+    for mass in PAPER_IMPROVEMENT:
+        for i, t in enumerate(AT_TRIALS):
+            paper[reduction_row(mass, t)] = PAPER_IMPROVEMENT[mass][i]
+            paper[stability_row(mass, t)] = PAPER_STABILITY[mass][i]
+    per_seed: dict[str, list[float]] = {}
+    for rs in runs.seeds().values():
+        for r in _fig12_runs(rs).values():
+            for q, v in headline(r).items():
+                per_seed.setdefault(q, []).append(v)
+    return {q: interval(v, paper.get(q)) for q, v in per_seed.items()}
+
+
+def _with_intervals(table: list[list[str]], intervals: dict[str, Interval], nd: int = 1) -> list[list[str]]:
+    """The cerebx cell of each row with an interval over several seeds, followed by it."""
+    return [row if row[0] not in intervals or not intervals[row[0]].has_interval
+            else [*row[:-1], f"{row[-1]}; over seeds {intervals[row[0]].text(nd)}"] for row in table]
+
+
+@figure("luque2011_fig12", "Luque 2011 Fig. 12: objects of 0.5-2 kg", studies=("luque2011_fig12",))
+def fig12(runs: RunSet, stem: Path) -> Figure:
+    by_mass = _fig12_runs(runs)
     if len(by_mass) < 2:
         raise MissingRuns("fewer than 2 object masses (study luque2011_fig12)")
+    intervals = fig12_intervals(runs)
     fig, (ax_a, ax_b) = plt.subplots(1, 2, figsize=(12, 4.4))
     table = [HEADER]
     gains = []
     for i, (mass, r) in enumerate(by_mass.items()):
         m = list(_mae_sum(r))
         ax_a.plot(m, lw=1, color=f"C{i}", label=f"{mass:g} kg")
-        at = [t for t in (200, 400) if t <= len(m) + r.warmup]  # trials counted from the run's start
-        ours = [metrics.improvement_pct(m, min(t, len(m))) for t in at]
+        ours = headline(r)
+        at = [t for t in AT_TRIALS if reduction_row(mass, t) in ours]
         paper = PAPER_IMPROVEMENT.get(float(mass))
-        gains.append((mass, metrics.accuracy_gain(m), ours))
-        for t, v in zip(at, ours):
-            p = "–" if paper is None else f"{paper[0 if t == 200 else 1]:.1f} %"
-            table.append([f"{mass:g} kg: error reduction by trial {t}", p, f"{v:.1f} %"])
+        stab = PAPER_STABILITY.get(float(mass))
+        gains.append((mass, metrics.accuracy_gain(m), [ours[reduction_row(mass, t)] for t in at]))
+        for t in at:
+            j = AT_TRIALS.index(t)
+            table.append([reduction_row(mass, t), "–" if paper is None else f"{paper[j]:.1f} %",
+                          f"{ours[reduction_row(mass, t)]:.1f} %"])
+        for t in at:
+            j = AT_TRIALS.index(t)
+            table.append([stability_row(mass, t), "–" if stab is None else f"{stab[j]:.1f} %",
+                          f"{ours[stability_row(mass, t)]:.1f} %"])
         table.append([f"{mass:g} kg: first-trial MAE / accuracy gain (rad)", "–",
                       f"{m[0]:.3f} / {metrics.accuracy_gain(m):.3f}"])
     ax_a.set_xlabel("trial")
@@ -265,10 +404,58 @@ def fig12(runs: RunSet, stem: Path) -> Figure:
     table.insert(1, ["accuracy gain grows with the mass", "yes", "yes" if ordered else "no"])
     checks = [Check("accuracy gain grows with the mass", ordered,
                     ", ".join(f"{g[0]:g} kg {g[1]:.3f}" for g in gains) + " rad")]
+    firsts = [(mass, float(_mae_sum(r)[0])) for mass, r in by_mass.items()]
+    checks.append(Check("heavier objects start with a higher error (first-trial MAE grows with the mass)",
+                        all(a[1] < b[1] for a, b in zip(firsts, firsts[1:])),
+                        ", ".join(f"{mass:g} kg {v:.3f}" for mass, v in firsts) + " rad"))
+    checks += _fig11_checks(list(by_mass), intervals)
+    n_seeds = max((iv.n for iv in intervals.values()), default=1)
+    caption = ("MAE per trial with objects of 0.5-2 kg held at the hand; the crude inverse dynamics ignores the "
+               "object. Paper: heavier objects start worse and gain more. Error reduction by trial t: 1 - mean MAE "
+               "of the 30 trials before t / MAE of the first trial; stability improvement: 1 - std of the MAE over "
+               "those 30 trials / its std over the first 30 (Fig. 11's caption)."
+               + (f" Both over {n_seeds} independently learned seeds: mean and 95 % interval in the table; the checks "
+                  "on them decide on the mean over seeds; the curves show the first seed." if n_seeds > 1 else ""))
     conv = _learnt(runs, by_mass, lambda m: f"{m:g} kg", "luque2011_fig12")
-    return Figure([png], "MAE per trial with objects of 0.5-2 kg held at the hand; the crude inverse dynamics "
-                  "ignores the object. Paper: heavier objects start worse and gain more.", table, checks=checks,
-                  convergence=conv)
+    return Figure([png], caption, _with_intervals(table, intervals), checks=checks, convergence=conv,
+                  intervals=intervals)
+
+
+def _fig11_checks(masses: list[float], intervals: dict[str, Interval]) -> list[Check]:
+    """Fig. 11's numbers, on the mean over seeds: the error significantly reduced for every mass and the more
+    the heavier the object (the paper: 40.4 → 78.6 % by trial 200, 49.0 → 79.3 % by 400); the MAE's spread
+    between trials lower than in the first 30 trials for every mass, and improved the less the heavier the
+    object (82 → 26.4 % at trials 170-200, 60.1 → 25.1 % at 370-400)."""
+    def mean(row, t: int) -> dict[float, float]:
+        return {m: intervals[row(m, t)].mean for m in masses if row(m, t) in intervals}
+
+    checks = []
+    t = AT_TRIALS[-1]
+    red = mean(reduction_row, t)
+    if red:
+        checks.append(Check(f"the error is significantly reduced for every mass: by at least {SIGNIFICANT:g} % by "
+                            f"trial {t} (constructed; paper: 49.0-79.3 %)", all(v >= SIGNIFICANT for v in red.values()),
+                            ", ".join(f"{m:g} kg {v:.1f} %" for m, v in red.items())))
+    for t in AT_TRIALS:
+        red, stab = mean(reduction_row, t), mean(stability_row, t)
+        paper_red = " → ".join(f"{PAPER_IMPROVEMENT[m][AT_TRIALS.index(t)]:g}" for m in PAPER_IMPROVEMENT)
+        paper_stab = " → ".join(f"{PAPER_STABILITY[m][AT_TRIALS.index(t)]:g}" for m in PAPER_STABILITY)
+        if len(red) > 1:
+            v = list(red.values())
+            checks.append(Check(f"the error reduction by trial {t} grows with the mass (paper: {paper_red} %)",
+                                all(a < b for a, b in zip(v, v[1:])),
+                                ", ".join(f"{m:g} kg {x:.1f} %" for m, x in red.items())))
+        if stab:
+            checks.append(Check(f"the MAE varies less between trials {t - FINAL_TRIALS}–{t} than in the first "
+                                f"{FINAL_TRIALS} for every mass (paper: {paper_stab} % lower)",
+                                all(x > 0 for x in stab.values()),
+                                ", ".join(f"{m:g} kg {x:.1f} %" for m, x in stab.items())))
+        if len(stab) > 1:
+            v = list(stab.values())
+            checks.append(Check(f"the stability improvement at trials {t - FINAL_TRIALS}–{t} falls with the mass "
+                                f"(paper: {paper_stab} %)", all(a > b for a, b in zip(v, v[1:])),
+                                ", ".join(f"{m:g} kg {x:.1f} %" for m, x in stab.items())))
+    return checks
 
 
 @figure("luque2011_fig7c", "Luque 2011 Fig. 7c: learned PF-PC weights", studies=("luque2011_fig12",))
@@ -291,5 +478,34 @@ def fig7c(runs: RunSet, stem: Path) -> Figure:
     table = [HEADER, ["weights after learning", "six column blocks x six row blocks, dark at the inputs' edges",
                       f"{fmt(float(w.min()), 2)} - {fmt(float(w.max()), 2)} nS after {r.trials} trials"]]
     return Figure([png], f"PF-PC weights after {r.trials} trials (1 kg object; dark = low weight = more DCN "
-                  "activity for that output group).", table, convergence=_learnt(runs, {1.0: r}, lambda m: "1 kg",
-                                                                                 "luque2011_fig12"))
+                  "activity for that output group; the paper shows them after 300).", table,
+                  checks=fig7c_checks(w), convergence=_learnt(runs, {1.0: r}, lambda m: "1 kg", "luque2011_fig12"))
+
+
+def fig7c_checks(w: np.ndarray, groups: int = 6) -> list[Check]:
+    """Fig. 7c's weight pattern (PCs x input cells; rows: + and - groups of joints 1-3, columns: desired q1-q3,
+    qd1-qd3): six well-defined rows; dark squares at both sides of the six weight columns (the inputs active where
+    the desired sines turn); the + and - rows of a joint alternating high / low there."""
+    n_pc, n_in = w.shape
+    per_row, per_col = n_pc // groups, n_in // groups
+    if per_row < 2 or per_col < 2 * EDGE + 1:
+        return []
+    rows = w[: groups * per_row, : groups * per_col].reshape(groups, per_row, groups * per_col)
+    means = rows.mean(1)
+    within, between = float(rows.std(1).mean()), float(means.std(0).mean())
+    blocks = [w[:, c * per_col:(c + 1) * per_col] for c in range(groups)]
+    sides = [(b[:, :EDGE].min(), b[:, EDGE:-EDGE].min(), b[:, -EDGE:].min()) for b in blocks]
+    diff = np.abs(means[0::2] - means[1::2]).reshape(groups // 2, groups, per_col)
+    edge = float(np.concatenate([diff[..., :EDGE], diff[..., -EDGE:]], axis=-1).mean())
+    middle = float(diff[..., EDGE:-EDGE].mean())
+    return [Check(f"six well-defined rows: the {per_row} PCs of an output group carry more alike weights than the "
+                  "groups differ (spread within groups below that between them)", within < between,
+                  f"within {within:.2f}, between {between:.2f} nS"),
+            Check(f"dark squares at both sides of the six weight columns: in every input block the lowest weight "
+                  f"lies among its {EDGE} outermost cells at each side (constructed)",
+                  all(left < mid and right < mid for left, mid, right in sides),
+                  "lowest left | middle | right: " + "; ".join(f"{a:.1f} | {b:.1f} | {c:.1f}" for a, b, c in sides)
+                  + " nS"),
+            Check(f"the + and - rows of a joint alternate high / low at the columns' sides: they differ more at the "
+                  f"{EDGE} outermost cells of each block than in its middle (constructed)", edge > middle,
+                  f"sides {edge:.2f}, middle {middle:.2f} nS")]
