@@ -5,15 +5,15 @@ and figures.
 Registered through the ``cerebx.plugins`` entry point ``capolei2020`` (see pyproject.toml).
 """
 
-from cerebx import registry
+from cerebx.schema.api import add_config_source, add_report, controllers, plants, tasks
 from cerebx_capolei2020.modules.schema import CapoleiForward, CapoleiInverse
 from cerebx_capolei2020.schema import ICubWristConfig, WristOscillationTask
 
 
 def register() -> None:
-    registry.tasks.register(WristOscillationTask, "cerebx_capolei2020.task:WristOscillation")
-    registry.plants.register(ICubWristConfig, "cerebx_capolei2020.wrist:ICubWrist")
-    registry.controllers.register(CapoleiForward, "cerebx_capolei2020.modules.controller:build_forward")
-    registry.controllers.register(CapoleiInverse, "cerebx_capolei2020.modules.controller:build_inverse")
-    registry.add_config_source("cerebx_capolei2020.conf")
-    registry.add_report("cerebx_capolei2020.report")
+    tasks.register(WristOscillationTask, "cerebx_capolei2020.task:WristOscillation")
+    plants.register(ICubWristConfig, "cerebx_capolei2020.wrist:ICubWrist")
+    controllers.register(CapoleiForward, "cerebx_capolei2020.modules.controller:build_forward")
+    controllers.register(CapoleiInverse, "cerebx_capolei2020.modules.controller:build_inverse")
+    add_config_source("cerebx_capolei2020.conf")
+    add_report("cerebx_capolei2020.report")

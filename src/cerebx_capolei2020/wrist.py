@@ -17,7 +17,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from cerebx.plants.base import Plant
+from cerebx.api import Plant
 from cerebx_capolei2020.schema import ICubWristConfig
 
 MJCF = Path(__file__).with_name("icub_wrist.xml")

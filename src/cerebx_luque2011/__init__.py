@@ -4,15 +4,15 @@ on three joints of a lightweight arm manipulating objects, with its presets, stu
 Registered through the ``cerebx.plugins`` entry point ``luque2011`` (see pyproject.toml).
 """
 
-from cerebx import registry
+from cerebx.schema.api import add_config_source, add_report, controllers, plants, tasks
 from cerebx_luque2011.cerebellum.schema import Luque2011Cerebellum
 from cerebx_luque2011.schema import CrudeInverseDynamics, LuqueEightTask, LWR3Config
 
 
 def register() -> None:
-    registry.tasks.register(LuqueEightTask, "cerebx_luque2011.task:LuqueEight")
-    registry.plants.register(LWR3Config, "cerebx_luque2011.arm:LWR3Arm")
-    registry.controllers.register(CrudeInverseDynamics, "cerebx_luque2011.inverse_dynamics:CrudeInverseDynamicsStage")
-    registry.controllers.register(Luque2011Cerebellum, "cerebx_luque2011.cerebellum.controller:Luque2011Stage")
-    registry.add_config_source("cerebx_luque2011.conf")
-    registry.add_report("cerebx_luque2011.report")
+    tasks.register(LuqueEightTask, "cerebx_luque2011.task:LuqueEight")
+    plants.register(LWR3Config, "cerebx_luque2011.arm:LWR3Arm")
+    controllers.register(CrudeInverseDynamics, "cerebx_luque2011.inverse_dynamics:CrudeInverseDynamicsStage")
+    controllers.register(Luque2011Cerebellum, "cerebx_luque2011.cerebellum.controller:Luque2011Stage")
+    add_config_source("cerebx_luque2011.conf")
+    add_report("cerebx_luque2011.report")

@@ -23,7 +23,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from cerebx.plants.mujoco_arm import MujocoArm
+from cerebx.api import MujocoArm
 from cerebx_luque2011.schema import LWR3Config
 
 MJCF = Path(__file__).with_name("lwr3.xml")

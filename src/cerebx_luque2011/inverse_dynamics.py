@@ -9,9 +9,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from cerebx.errors import ConfigError
-from cerebx.signals import Frame
-from cerebx.stages.base import Stage
+from cerebx.api import ConfigError, Frame, Stage
 from cerebx_luque2011.schema import CrudeInverseDynamics
 
 

@@ -10,9 +10,16 @@ from typing import ClassVar, Literal
 
 from pydantic import Field
 
-from cerebx.schema.base import NonNegFloat, PhysicsStepMs, PlantSchema, PositiveFloat, Strict
-from cerebx.schema.controller import ControllerConfig
-from cerebx.signals import Signal, StageIO
+from cerebx.schema.api import (
+    ControllerConfig,
+    NonNegFloat,
+    PhysicsStepMs,
+    PlantSchema,
+    PositiveFloat,
+    Signal,
+    StageIO,
+    Strict,
+)
 
 
 class LWR3Config(PlantSchema):

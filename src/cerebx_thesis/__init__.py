@@ -5,14 +5,14 @@ Registered through the ``cerebx.plugins`` entry point ``thesis`` (see pyproject.
 package would be.
 """
 
-from cerebx import registry
+from cerebx.schema.api import add_bench_run, add_config_source, add_report, controllers
 from cerebx_thesis.ann.schema import ANNController
 
 
 def register() -> None:
-    registry.controllers.register(ANNController, "cerebx_thesis.ann.controller:ANN")
-    registry.add_config_source("cerebx_thesis.conf")
-    registry.add_report("cerebx_thesis.report")
+    controllers.register(ANNController, "cerebx_thesis.ann.controller:ANN")
+    add_config_source("cerebx_thesis.conf")
+    add_report("cerebx_thesis.report")
     # learning runs as users make them, timed by `cerebx bench`: what `make run` runs, and chapter 3's
-    registry.add_bench_run("make_run", ["+experiment=default"])
-    registry.add_bench_run("learn_circle_ch3", ["+experiment=learn_circle_ch3"])
+    add_bench_run("make_run", ["+experiment=default"])
+    add_bench_run("learn_circle_ch3", ["+experiment=learn_circle_ch3"])

@@ -7,9 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
-from cerebx.controllers.state import load_state_npz, save_state_npz
-from cerebx.errors import StateMismatchError
+from cerebx.api import ControlInput, Controller, StateMismatchError, TorqueMsg, load_state_npz, save_state_npz
 from my_cerebellum.schema import AdaptiveFilterConfig
 
 STEP_S = 0.002

@@ -1,14 +1,14 @@
 """A lab's additions to cerebx as one plugin: a pendulum plant, a robot-side torque rate limiter, a swing task,
 their presets, and a report module with one figure and the study it needs."""
 
-from cerebx import registry
+from cerebx.schema.api import add_config_source, add_report, plants, stages, tasks
 from my_lab.schema import PendulumConfig, RateLimitConfig, SwingTask
 
 
 def register() -> None:
     # builders are named as "module:attr": their code (MuJoCo, numpy) is imported only when a run uses them
-    registry.plants.register(PendulumConfig, "my_lab.pendulum:Pendulum")
-    registry.stages.register(RateLimitConfig, "my_lab.rate_limit:RateLimiter")
-    registry.tasks.register(SwingTask, "my_lab.swing:Swing")
-    registry.add_config_source("my_lab.conf")  # conf/plant, conf/task, conf/controller, conf/experiment
-    registry.add_report("my_lab.report")  # its figure and the study the figure needs
+    plants.register(PendulumConfig, "my_lab.pendulum:Pendulum")
+    stages.register(RateLimitConfig, "my_lab.rate_limit:RateLimiter")
+    tasks.register(SwingTask, "my_lab.swing:Swing")
+    add_config_source("my_lab.conf")  # conf/plant, conf/task, conf/controller, conf/experiment
+    add_report("my_lab.report")  # its figure and the study the figure needs

@@ -16,7 +16,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from cerebx.plants.mujoco_arm import MujocoArm
+from cerebx.api import MujocoArm
 from my_lab.schema import PendulumConfig
 
 MJCF = Path(__file__).with_name("pendulum.xml")

@@ -6,8 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.signals import Frame
-from cerebx.stages.base import Stage
+from cerebx.api import Frame, Stage
 from my_lab.schema import RateLimitConfig
 
 

@@ -8,9 +8,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from cerebx.report.plot import panel_letter, save
-from cerebx.report.registry import Figure, MissingRuns, figure, studies
-from cerebx.report.runs import Run, RunSet
+from cerebx.report.api import Figure, MissingRuns, Run, RunSet, figure, panel_letter, save, studies
 
 studies(Path(__file__).with_name("studies.yaml"))
 

@@ -7,9 +7,16 @@ from typing import ClassVar, Literal
 
 from pydantic import Field, model_validator
 
-from cerebx.schema.base import NonNegFloat, PhysicsStepMs, PlantSchema, PositiveFloat, Strict
-from cerebx.schema.stages import StageConfig
-from cerebx.signals import Signal, StageIO
+from cerebx.schema.api import (
+    NonNegFloat,
+    PhysicsStepMs,
+    PlantSchema,
+    PositiveFloat,
+    Signal,
+    StageConfig,
+    StageIO,
+    Strict,
+)
 
 
 # --8<-- [start:plant]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cerebx.tasks.base import Task, TrialReference
+from cerebx.api import Task, TrialReference
 from my_lab.schema import SwingTask
 
 

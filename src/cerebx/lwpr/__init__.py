@@ -1,7 +1,19 @@
 """Locally Weighted Projection Regression, written for cerebx (e.g. as the granular layer of cerebellar
-modules whose input is continuous)."""
+modules whose input is continuous).
 
-from cerebx.lwpr.model import LWPR
+``LWPR`` (the model, numba kernels) is imported on first use, so that ``cerebx.lwpr.schema`` validates a
+config without loading numba."""
+
+from typing import Any
+
 from cerebx.lwpr.schema import LWPRParams
 
 __all__ = ["LWPR", "LWPRParams"]
+
+
+def __getattr__(name: str) -> Any:
+    if name == "LWPR":
+        from cerebx.lwpr.model import LWPR
+
+        return LWPR
+    raise AttributeError(f"module 'cerebx.lwpr' has no attribute {name!r}")

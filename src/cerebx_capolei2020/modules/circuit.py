@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cerebx.lwpr import LWPR
+from cerebx.api import LWPR
 from cerebx_capolei2020.modules.schema import CerebellarModule, SynapseKernel
 
 

@@ -14,12 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.controllers.pid import updates_every
-from cerebx.controllers.state import load_state_npz, save_state_npz
-from cerebx.errors import StateMismatchError
-from cerebx.schema.controller import VELOCITY_ERROR
-from cerebx.signals import Frame
-from cerebx.stages.base import Stage
+from cerebx.api import VELOCITY_ERROR, Frame, Stage, StateMismatchError, load_state_npz, save_state_npz, updates_every
 from cerebx_capolei2020.modules.circuit import ModularCerebellarCircuit
 from cerebx_capolei2020.modules.schema import QD_CORRECTION, CapoleiForward, CapoleiInverse
 

@@ -10,10 +10,16 @@ from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
-from cerebx.lwpr.schema import LWPRParams
-from cerebx.schema.base import PositiveFloat, Strict
-from cerebx.schema.controller import VELOCITY_ERROR, ControllerConfig, periodic_part_problems
-from cerebx.signals import Signal, StageIO
+from cerebx.schema.api import (
+    VELOCITY_ERROR,
+    ControllerConfig,
+    LWPRParams,
+    PositiveFloat,
+    Signal,
+    StageIO,
+    Strict,
+    periodic_part_problems,
+)
 
 QD_CORRECTION = "capolei.qd_correction"
 

@@ -17,10 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.controllers.state import load_state_npz, save_state_npz
-from cerebx.errors import StateMismatchError
-from cerebx.signals import Frame
-from cerebx.stages.base import Stage
+from cerebx.api import Frame, Stage, StateMismatchError, load_state_npz, save_state_npz
 from cerebx_luque2011.cerebellum import kernels as k
 from cerebx_luque2011.cerebellum.schema import ConductanceLIF, Luque2011Cerebellum
 

@@ -11,8 +11,7 @@ from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
-from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
-from cerebx.schema.controller import ControllerConfig, TaskRanges
+from cerebx.schema.api import ControllerConfig, NonNegFloat, PositiveFloat, Strict, TaskRanges
 
 
 class ConductanceLIF(Strict):

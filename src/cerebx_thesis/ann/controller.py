@@ -30,10 +30,15 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
-from cerebx.controllers.ranges import mf_ranges
-from cerebx.controllers.state import load_state_npz, save_state_npz
-from cerebx.errors import StateMismatchError
+from cerebx.api import (
+    ControlInput,
+    Controller,
+    StateMismatchError,
+    TorqueMsg,
+    load_state_npz,
+    mf_ranges,
+    save_state_npz,
+)
 from cerebx_thesis.ann.schema import ANNController
 
 STEP_S = 0.002
