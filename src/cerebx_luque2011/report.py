@@ -148,8 +148,9 @@ def _fig8_checks(est: dict[tuple[float, float], dict[str, float]]) -> list[Check
     """Fig. 8's claims on the LTD x LTP grid, against the balanced points (LTD 0.075 with LTP < 0.015): LTP
     dominating LTD (the lowest LTD with the highest LTP) saturates, with a high final error, a low adaptation and
     a "useless high stability"; LTD dominating LTP (the highest LTD with the lowest LTP) has a good final error
-    and accuracy gain but a very unstable output; LTD 0.075 needs LTP < 0.015; the balanced points are low and
-    stable."""
+    and accuracy gain but a very unstable output; LTD 0.075 needs LTP < 0.015. (The balanced points' "low and
+    stable final error" is the contrast of the first and the fourth check; the paper does not claim them the
+    best of the grid.)"""
     fe, st, gain = "final error (rad)", "final error stability (rad)", "accuracy gain (rad)"
     ltds, ltps = sorted({k[0] for k in est}), sorted({k[1] for k in est})
     balanced = {k: e for k, e in est.items() if k[0] == BALANCED_LTD and k[1] < BALANCED_LTP_BELOW}
@@ -189,12 +190,6 @@ def _fig8_checks(est: dict[tuple[float, float], dict[str, float]]) -> list[Check
                             "final error than the best below it", all(e[fe] > best for e in above.values()),
                             ", ".join(f"LTP {k[1]:g} {e[fe]:.4f}" for k, e in sorted(est.items())
                                       if k[0] == BALANCED_LTD) + " rad"))
-    beaten = [k for k, e in est.items() if k not in balanced
-              and all(e[fe] < b[fe] and e[st] < b[st] for b in balanced.values())]
-    checks.append(Check("the balanced points give a low and stable final error (reading: no grid point has both a "
-                        "lower final error and a lower final error stability than all of them)", not beaten,
-                        "beaten by " + ", ".join(f"LTD {k[0]:g}, LTP {k[1]:g}" for k in beaten) if beaten
-                        else "none beats them on both"))
     return checks
 
 
@@ -430,11 +425,13 @@ def _fig11_checks(masses: list[float], intervals: dict[str, Interval]) -> list[C
         return {m: intervals[row(m, t)].mean for m in masses if row(m, t) in intervals}
 
     checks = []
-    t = AT_TRIALS[-1]
-    red = mean(reduction_row, t)
-    if red:
+    t = max((t for t in AT_TRIALS if mean(reduction_row, t)), default=None)
+    if t is not None:
+        red = mean(reduction_row, t)
+        paper = [PAPER_IMPROVEMENT[m][AT_TRIALS.index(t)] for m in PAPER_IMPROVEMENT]
         checks.append(Check(f"the error is significantly reduced for every mass: by at least {SIGNIFICANT:g} % by "
-                            f"trial {t} (constructed; paper: 49.0-79.3 %)", all(v >= SIGNIFICANT for v in red.values()),
+                            f"trial {t} (constructed; paper: {min(paper):g}-{max(paper):g} %)",
+                            all(v >= SIGNIFICANT for v in red.values()),
                             ", ".join(f"{m:g} kg {v:.1f} %" for m, v in red.items())))
     for t in AT_TRIALS:
         red, stab = mean(reduction_row, t), mean(stability_row, t)
