@@ -332,6 +332,8 @@ def main(argv: list[str]) -> int:
     ap.add_argument("-o", "--override", action="append", default=[], metavar="OVERRIDE",
                     help="Hydra override for every study's multirun, e.g. -o hydra/launcher=slurm "
                     "(repeatable; see docs/guide/sweeps.md)")
+    ap.add_argument("--seeds", type=int, metavar="N", help="with --profile: at most N seeds of each study "
+                    "learned from several (their first; default: as many as the profile asks)")
     ap.add_argument("--dry-run", action="store_true", help="with --profile: list the jobs, run nothing")
     ap.add_argument("--out", type=Path, default=Path("reports"), help="output folder (default reports/)")
     ap.add_argument("--list", action="store_true", help="list the figures and the studies they need")
@@ -346,7 +348,9 @@ def main(argv: list[str]) -> int:
         failed: list[str] = []
         if a.profile:
             root = Path("runs") / "report"
-            jobs = plan(a.profile, root, needed_studies(names))
+            if a.seeds is not None and a.seeds < 1:
+                raise CerebxError(f"--seeds: {a.seeds} is not a number of seeds (at least 1)")
+            jobs = plan(a.profile, root, needed_studies(names), max_seeds=a.seeds)
             if a.dry_run:
                 for j in jobs:
                     print(f"{'reuse' if j.done() else 'run  '} {j.run_dir}  cerebx run {' '.join(j.overrides())}")

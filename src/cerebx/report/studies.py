@@ -118,13 +118,14 @@ def load_studies(*paths: Path) -> dict[str, StudySpec]:
 REPLICA = "~seed"  # <study>~seed<k>: seed k of a study learned from several seeds
 
 
-def with_replicas(studies: dict[str, StudySpec], profile: str) -> dict[str, StudySpec]:
+def with_replicas(studies: dict[str, StudySpec], profile: str, max_seeds: int | None = None) -> dict[str, StudySpec]:
     """``studies`` and, after each whose ``profile`` asks for several seeds, one study per further seed (the
-    same arguments and ``seed=k``, starting from seed k of the study it starts from when that has one)."""
+    same arguments and ``seed=k``, starting from seed k of the study it starts from when that has one);
+    ``max_seeds``: at most that many seeds of any study (its first seeds)."""
     out: dict[str, StudySpec] = {}
     for name, s in studies.items():
         out[name] = s
-        for k in range(1, getattr(s, profile).seeds):
+        for k in range(1, min(getattr(s, profile).seeds, max_seeds or 10**6)):
             src = _init_from(s, profile)
             if src is not None and src in studies and getattr(studies[src], profile).seeds > k:
                 src = f"{src}{REPLICA}{k}"
@@ -270,11 +271,12 @@ class Job:
 
 
 def plan(profile: str, root: Path, names: list[str] | None = None,
-         studies: dict[str, StudySpec] | None = None) -> list[Job]:
-    """Every job of the named studies (all by default) and of the studies they start from, in order."""
+         studies: dict[str, StudySpec] | None = None, max_seeds: int | None = None) -> list[Job]:
+    """Every job of the named studies (all by default) and of the studies they start from, in order;
+    ``max_seeds``: only the first seeds of studies learned from more (e.g. 1: every study's first seed)."""
     if profile not in PROFILES:
         raise ConfigError(f"--profile: {profile!r} is not one of {', '.join(PROFILES)}")
-    studies = with_replicas(load_studies() if studies is None else studies, profile)
+    studies = with_replicas(load_studies() if studies is None else studies, profile, max_seeds)
     wanted: list[str] = []
 
     def want(n: str) -> None:
@@ -286,7 +288,8 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
         if n not in wanted:
             wanted.append(n)
         for k in range(1, getattr(studies[n], profile).seeds):
-            want(f"{n}{REPLICA}{k}")
+            if f"{n}{REPLICA}{k}" in studies:
+                want(f"{n}{REPLICA}{k}")
 
     for n in names if names is not None else list(studies):
         want(n)

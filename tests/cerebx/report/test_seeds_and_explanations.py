@@ -147,3 +147,12 @@ def test_figures_json_and_shapes_csv_carry_explained_at_and_intervals(tmp_path, 
     with open(tmp_path / "out" / "shapes.csv") as fh:
         shapes = list(csv.reader(fh))
     assert shapes[0][-1] == "explained_at" and shapes[1][-1] == "docs/reproductions/x.md#why"
+
+
+def test_a_plan_can_run_only_the_first_seeds(tmp_path):
+    studies = _studies(tmp_path, "studies:\n"
+                       "  learn:\n    args: [+experiment=learn_circle_ch3]\n"
+                       "    quick: {trials: 1}\n    full: {trials: 2, seeds: 3}\n")
+    assert [j.study for j in plan("full", tmp_path, studies=studies, max_seeds=1)] == ["learn"]
+    assert [j.study for j in plan("full", tmp_path, studies=studies, max_seeds=2)] == ["learn", f"learn{REPLICA}1"]
+    assert len(plan("full", tmp_path, studies=studies)) == 3
