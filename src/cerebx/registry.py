@@ -28,6 +28,8 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, WrapValidator
 
+from cerebx.errors import CerebxError
+
 ENTRY_POINTS = "cerebx.plugins"
 ONLY_ENV = "CEREBX_PLUGINS"
 
@@ -158,6 +160,7 @@ def add_bench_run(name: str, overrides: list[str]) -> None:
 _loaded: list[str] = []
 _loading: str | None = None
 _done = False
+_broken: CerebxError | None = None
 
 
 def _load_order(ep: Any) -> tuple[bool, str]:
@@ -169,22 +172,35 @@ def _load_order(ep: Any) -> tuple[bool, str]:
 
 def load_plugins() -> None:
     """Call every ``cerebx.plugins`` entry point once (those named in ``CEREBX_PLUGINS`` when it is set), in
-    :func:`_load_order`."""
-    global _done, _loading
+    :func:`_load_order`. A plugin whose import or ``register()`` raises is a :class:`CerebxError` naming it and
+    its error (one line), raised again by every later call."""
+    global _done, _loading, _broken
     if _done:
+        if _broken is not None:
+            raise _broken
         return
     _done = True
     only = os.environ.get(ONLY_ENV)
     wanted = None if only is None else {n.strip() for n in only.split(",") if n.strip()}
-    for ep in sorted(entry_points(group=ENTRY_POINTS), key=_load_order):
-        if wanted is not None and ep.name not in wanted:
-            continue
+    chosen = [ep for ep in sorted(entry_points(group=ENTRY_POINTS), key=_load_order)
+              if wanted is None or ep.name in wanted]
+    for ep in chosen:
         _loading = ep.name
         try:
             ep.load()()
+        except Exception as err:  # whatever a third party's code raises: the command stops with one line
+            _broken = _broken_plugin(ep, err, [e.name for e in chosen if e.name != ep.name])
+            raise _broken from err
         finally:
             _loading = None
         _loaded.append(ep.name)
+
+
+def _broken_plugin(ep: Any, err: Exception, others: list[str]) -> CerebxError:
+    """The one line saying which plugin failed to load, why, and how to run without it."""
+    first = next(iter(str(err).splitlines()), "")
+    return CerebxError(f"plugin {ep.name} ({ep.value}): {type(err).__name__}: {first} (uninstall it, or load "
+                       f"only the others: {ONLY_ENV}={','.join(others)})")
 
 
 def loaded_plugins() -> list[str]:

@@ -71,3 +71,43 @@ def test_no_platform_module_names_a_paper_package():
                  for i, line in enumerate(p.read_text().splitlines(), 1)
                  if any(pkg in line for pkg in PAPERS.values())]
     assert offenders == []
+
+
+def test_a_plugin_that_fails_to_load_is_one_line_naming_it(monkeypatch):
+    from importlib.metadata import EntryPoint
+
+    from cerebx.errors import CerebxError
+
+    broken = EntryPoint(name="broken_lab", value="broken_lab_not_installed:register", group=registry.ENTRY_POINTS)
+    monkeypatch.setattr(registry, "entry_points", lambda group: [broken])
+    monkeypatch.setattr(registry, "_done", False)
+    monkeypatch.setattr(registry, "_broken", None)
+    monkeypatch.setattr(registry, "_loaded", [])
+    expected = ("plugin broken_lab (broken_lab_not_installed:register): ModuleNotFoundError: No module named "
+                "'broken_lab_not_installed' (uninstall it, or load only the others: CEREBX_PLUGINS=)")
+    for _ in range(2):  # every later use says it again
+        with pytest.raises(CerebxError) as err:
+            registry.load_plugins()
+        assert str(err.value) == expected
+
+
+BROKEN = "def register():\n    raise RuntimeError('the lab key\\nis missing')\n"
+
+
+@pytest.mark.integration
+@pytest.mark.parametrize("command", [["validate", "+task=circle"], ["run", "+experiment=demo", "trials=1"],
+                                     ["report", "--list"], ["run", "--help"]])
+def test_every_command_says_which_plugin_is_broken_in_one_line(command, tmp_path):
+    info = tmp_path / "broken_lab-0.1.0.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: broken-lab\nVersion: 0.1.0\n")
+    (info / "entry_points.txt").write_text("[cerebx.plugins]\nbroken_lab = broken_lab:register\n")
+    (tmp_path / "broken_lab.py").write_text(BROKEN)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(tmp_path), os.environ.get("PYTHONPATH")]))}
+    done = subprocess.run([sys.executable, "-m", "cerebx", *command], capture_output=True, text=True, env=env,
+                          cwd=tmp_path, timeout=600)
+    assert done.returncode == 2
+    assert done.stderr.strip().splitlines() == [
+        "plugin broken_lab (broken_lab:register): RuntimeError: the lab key (uninstall it, or load only the others: "
+        "CEREBX_PLUGINS=core,capolei2020,luque2011,thesis)"]
+    assert not (tmp_path / "runs").exists()
