@@ -1,4 +1,4 @@
-"""``cerebx`` command: run | validate | inspect | bench | report | summarize | tune.
+"""``cerebx`` command: run | validate | inspect | bench | report | summarize | tune | robot | relay | delays.
 
 ``run`` is a Hydra application (multirun, launchers, --cfg, completion); the other commands
 compose the same config with Hydra's compose API. Input problems print one ``path: message``
@@ -22,7 +22,7 @@ USAGE = """usage: cerebx COMMAND [args]
 
 commands:
   run +task=NAME [group=option ...] [key=value ...]   run one experiment (-m for a sweep)
-  validate +task=NAME [...]                            check a config without running; print it
+  validate +task=NAME [...]                            check a config without running; print it (-m: a sweep)
   inspect RUN_DIR|FILE.mcap                            a run's summary and its MCAP channels
   bench [--seconds S] [--networks a,b]                 speed of plant, network and closed loop (JSON)
   bench --lwpr                                         LWPR updates per second (the reference's examples)
@@ -35,6 +35,7 @@ commands:
 
 groups: task (required, +task=), controller (snn), plant (baxter), delay (none),
         experiment (presets: +experiment=NAME); network (full), with controller=snn
+every command: cerebx COMMAND --help
 """
 
 COMMANDS = {**{name: f"cerebx.commands.{name}" for name in

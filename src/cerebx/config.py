@@ -3,28 +3,36 @@ expand sweeps, and turn Hydra's composition errors into one ``path: message`` li
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import itertools
 import math
 import os
 import re
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import yaml
 from hydra import compose as hydra_compose
-from hydra import initialize_config_module
+from hydra import initialize_config_module, version
+from hydra._internal.hydra import Hydra
+from hydra._internal.utils import create_automatic_config_search_path
+from hydra.core.config_search_path import SearchPathQuery
 from hydra.core.global_hydra import GlobalHydra
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.errors import HydraException
 from omegaconf import DictConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 
+from cerebx import runfiles
 from cerebx.errors import ConfigError
 from cerebx.estimate import Estimate, estimate, total
 from cerebx.guard import check_args, conf_roots
-from cerebx.schema.experiment import validate
+from cerebx.jobenv import source_checkout
+from cerebx.schema.base import closest
+from cerebx.schema.experiment import experiment_model, validate
 
 MAX_SWEEP_JOBS = 1000
 """The largest command-line sweep cerebx accepts (every job is validated before the first starts)."""
@@ -42,7 +50,7 @@ def to_plain(cfg: DictConfig) -> dict[str, Any]:
     return data
 
 
-def _hydra_lines(err: Exception) -> list[str]:
+def _hydra_lines(err: Exception, overrides: list[str] | None = None, config_dir: str | None = None) -> list[str]:
     text = str(err)
     m = re.search(r"Could not find '([^']+)/([^']+)'", text)
     if m:
@@ -52,13 +60,12 @@ def _hydra_lines(err: Exception) -> list[str]:
         return [f"{group}: unknown option '{option}'{tail}"]
     m = re.search(r"Could not override '([^']+)'", text)
     if m:
-        key = m.group(1)
-        if "." in key:
-            return [f"{key}: not in the composed config (schema defaults are not); set it with +{key}=VALUE"]
-        if "No match in the defaults list" in text and _is_group(key):
-            return [f"{key}: none of the chosen options takes a {key} (it is chosen inside another option, "
-                    f"e.g. network inside controller=snn)"]
-        return [f"{key}: '{key}' has no default to override; add it with +{key}=NAME"]
+        fix = re.search(r"use (\+\S+)", text)
+        fix_text = fix.group(1) if fix else f"+{m.group(1)}=VALUE"
+        return [_not_overridable(m.group(1), fix_text, overrides or [], config_dir)]
+    m = re.search(r"Ambiguous value for argument '([^=']+)=([^']*)'", text)
+    if m:
+        return [f"{m.group(1)}: several values ({m.group(2)}): add -m to sweep them"]
     m = re.search(r"Could not append to config. An item is already at '([^']+)'", text)
     if m:
         return [f"{m.group(1)}: already set; drop the leading '+' to override it"]
@@ -69,6 +76,59 @@ def _hydra_lines(err: Exception) -> list[str]:
     return [f"overrides: {first}"]
 
 
+def _not_overridable(key: str, fix: str, overrides: list[str], config_dir: str | None) -> str:
+    """Why ``key=...`` matched nothing in the composed config (``fix``: the same override with a '+')."""
+    if "." in key:
+        return (_schema_problem(key, overrides, config_dir)
+                or f"{key}: not in the composed config (schema defaults are not); set it with {fix}")
+    if _is_group(key):
+        owners = _group_owners(key)
+        if owners:
+            return f"{key}: none of the chosen options takes a {key}; it comes with {' or '.join(owners)}"
+        return f"{key}: not in the defaults list; add it with {fix}"
+    fields = experiment_model().model_fields
+    if key in fields:
+        return f"{key}: not in the composed config (the schema's default applies); set it with {fix}"
+    close = closest(key, dict.fromkeys([*_groups(), *fields]))
+    return f"{key}: no config group or key of that name" + (f"; did you mean {' or '.join(close)}?" if close else "")
+
+
+def _schema_problem(key: str, overrides: list[str], config_dir: str | None) -> str | None:
+    """What the schema says of a dotted ``key`` Hydra could not override, found by composing it with a '+': the
+    problem at that key or above it (an unknown key names the closest known ones), or None if it is valid."""
+    added = [f"+{o}" if o.split("=", 1)[0] == key else o for o in overrides]
+    try:
+        load(added, config_dir)
+    except ConfigError as err:
+        return next((p for p in err.problems if (key + ".").startswith(p.split(":", 1)[0] + ".")), None)
+    return None
+
+
+def _groups() -> list[str]:
+    """Config groups of cerebx and its plugins (Hydra's own left out)."""
+    return sorted({d.name for root in conf_roots() for d in root.iterdir() if d.is_dir() and d.name[0] not in "_."}
+                  - {"hydra"})
+
+
+@functools.cache
+def _group_owners(group: str) -> tuple[str, ...]:
+    """The options that choose ``group`` in their own defaults list (``controller=snn`` chooses a network);
+    experiment presets, which choose any group, are left out."""
+    owners = []
+    for root in conf_roots():
+        for f in sorted(root.glob("*/*.yaml")):
+            if f.parent.name in ("experiment", "hydra"):
+                continue
+            try:
+                doc = yaml.safe_load(f.read_text()) or {}
+            except (OSError, yaml.YAMLError):
+                continue
+            entries = doc.get("defaults") or [] if isinstance(doc, dict) else []
+            if any(isinstance(e, dict) and f"/{group}" in e for e in entries):
+                owners.append(f"{f.parent.name}={f.stem}")
+    return tuple(owners)
+
+
 def _is_group(name: str) -> bool:
     """``name`` is a config group of cerebx or of a plugin."""
     return any((root / name).is_dir() for root in conf_roots())
@@ -77,28 +137,63 @@ def _is_group(name: str) -> bool:
 _COMPOSING = threading.RLock()  # Hydra's global state and the lazily built schema: one thread at a time
 
 
-def compose(overrides: list[str]) -> DictConfig:
+def compose(overrides: list[str], config_dir: str | None = None) -> DictConfig:
     """Compose ``conf/config.yaml`` with command-line style overrides (no output folders)."""
-    return compose_with_choices(overrides)[0]
+    return compose_with_choices(overrides, config_dir)[0]
 
 
-def compose_with_choices(overrides: list[str]) -> tuple[DictConfig, dict[str, str]]:
-    """Compose, and return the option chosen in each config group (what ``cerebx run`` records as presets)."""
-    problems = check_args(overrides) + _group_lists(overrides)
+def compose_with_choices(overrides: list[str], config_dir: str | None = None) -> tuple[DictConfig, dict[str, str]]:
+    """Compose, and return the option chosen in each config group (what ``cerebx run`` records as presets);
+    ``config_dir`` is a ``--config-dir`` folder of presets."""
+    flags = ["--config-dir", config_dir] if config_dir is not None else []
+    problems = check_args([*flags, *overrides]) + _group_lists(overrides)
     if problems:
         raise ConfigError(problems)
     try:
-        with _COMPOSING:
-            GlobalHydra.instance().clear()
-            with initialize_config_module(config_module="cerebx.conf", version_base="1.3"):
-                cfg = hydra_compose(config_name="config", overrides=[o for o in overrides if not _is_hydra(o)],
-                                    return_hydra_config=True)
+        with _COMPOSING, _hydra(config_dir):
+            cfg = hydra_compose(config_name="config", overrides=[o for o in overrides if not _is_hydra(o)],
+                                return_hydra_config=True)
     except (HydraException, OmegaConfBaseException, ValueError) as err:
-        raise ConfigError(_hydra_lines(err)) from None
+        raise ConfigError(_hydra_lines(err, overrides, config_dir)) from None
     choices = user_choices(cfg.hydra.runtime.choices)
     with open_dict(cfg):
         del cfg["hydra"]
     return cfg, choices
+
+
+@contextlib.contextmanager
+def _hydra(config_dir: str | None) -> Iterator[None]:
+    """Hydra set up on cerebx's presets; a ``--config-dir`` folder is searched first, as ``cerebx run`` does."""
+    GlobalHydra.instance().clear()
+    if config_dir is None:
+        with initialize_config_module(config_module="cerebx.conf", version_base="1.3"):
+            yield
+        return
+    version.setbase("1.3")
+    path = create_automatic_config_search_path(None, "cerebx.conf.app", None)
+    path.prepend(provider="command-line", path=f"file://{os.path.abspath(config_dir)}",
+                 anchor=SearchPathQuery(provider="schema"))
+    Hydra.create_main_hydra2("app", path)
+    try:
+        yield
+    finally:
+        GlobalHydra.instance().clear()
+
+
+def split_args(args: list[str]) -> tuple[list[str], str | None]:
+    """The overrides of a ``cerebx run``/``validate`` command line and its ``--config-dir`` (flags dropped)."""
+    overrides: list[str] = []
+    config_dir = None
+    i = 0
+    while i < len(args):
+        flag, eq, value = args[i].partition("=")
+        if flag in ("--config-dir", "-cd"):
+            config_dir, i = (value, i + 1) if eq else (args[i + 1] if i + 1 < len(args) else None, i + 2)
+            continue
+        if not args[i].startswith("-"):
+            overrides.append(args[i])
+        i += 1
+    return overrides, config_dir
 
 
 def _group_lists(overrides: list[str]) -> list[str]:
@@ -130,10 +225,10 @@ def _is_hydra(override: str) -> bool:
     return key == "hydra" or key.startswith(("hydra.", "hydra/"))
 
 
-def load(overrides: list[str]) -> tuple[Any, dict[str, Any]]:
+def load(overrides: list[str], config_dir: str | None = None) -> tuple[Any, dict[str, Any]]:
     """Compose and validate; returns (validated experiment, plain resolved dict)."""
     with _COMPOSING:  # the report composes jobs in threads
-        plain = to_plain(compose(overrides))
+        plain = to_plain(compose(overrides, config_dir))
         try:
             return validate(plain), plain
         except ConfigError as err:
@@ -191,9 +286,11 @@ def expand_sweep(overrides: list[str]) -> list[list[str]]:
     return [list(c) for c in itertools.product(*choices)]
 
 
-def check(overrides: list[str], multirun: bool = False, estimates: list | None = None) -> list[str]:
+def check(overrides: list[str], multirun: bool = False, estimates: list | None = None,
+          config_dir: str | None = None, valid: list | None = None) -> list[str]:
     """Every problem of every job the command would run, one line each (empty when all is well);
-    the disk and time estimate of each valid job is appended to ``estimates``."""
+    the disk and time estimate of each valid job is appended to ``estimates``, and (its overrides, the
+    validated experiment, its plain config) to ``valid``; ``config_dir`` is a ``--config-dir`` folder of presets."""
     try:
         jobs = expand_sweep(overrides) if multirun else [overrides]
     except ConfigError as err:
@@ -201,9 +298,11 @@ def check(overrides: list[str], multirun: bool = False, estimates: list | None =
     seen: list[str] = []
     for job in jobs:
         try:
-            exp, _ = load(job)
+            exp, plain = load(job, config_dir)
             if estimates is not None:
                 estimates.append(estimate(exp))
+            if valid is not None:
+                valid.append((job, exp, plain))
         except ConfigError as err:
             prefix = f"[{' '.join(job)}] " if multirun and len(jobs) > 1 else ""
             for line in err.problems:
@@ -281,8 +380,46 @@ def output_root(overrides: list[str], multirun: bool) -> Path:
     return _literal_prefix(_output_dir(overrides, multirun)[1])
 
 
-def check_output_dir(overrides: list[str], multirun: bool) -> list[str]:
-    """The run (or sweep) folder of a ``cerebx run`` command can be made; one line if not."""
+def check_output_dir(overrides: list[str], multirun: bool, probe: bool = True) -> list[str]:
+    """The run (or sweep) folder of a ``cerebx run`` command is a new folder, or one of runs, and can be made
+    (``probe``: try it; ``cerebx validate`` does not); one line if not."""
     key, value = _output_dir(overrides, multirun)
-    why = _can_make(_literal_prefix(value))
-    return [f"{key}: {value}: {why}"] if why else []
+    if not value.isprintable():
+        return [f"{key}: {value!r}: not a folder name (it holds control characters)"]
+    why = _refused_folder(value) or (_can_make(_literal_prefix(value)) if probe else None)
+    return [f"{key}: {value}: {why}" if value.strip() else f"{key}: {why}"] if why else []
+
+
+RUN_MARKERS = (runfiles.SUMMARY, runfiles.MCAP, runfiles.HYDRA, runfiles.CHECKPOINT, runfiles.ERROR, "multirun.yaml")
+"""What marks a folder as a run's or a sweep's: cerebx writes into such a folder again (resume, reuse)."""
+
+
+def _refused_folder(value: str) -> str | None:
+    """Why ``value`` cannot be a run or sweep folder whatever the disk allows: empty, the working directory, the
+    source checkout, or an existing folder that holds other things than runs and logs (``src``)."""
+    new = "give a new folder, e.g. runs/mine"
+    if not value.strip():
+        return f"empty; {new}"
+    if "${" in value:
+        return None  # resolved per run (a time stamp, a chosen option): a folder of its own
+    try:
+        folder = Path(value).resolve()
+        if folder == Path.cwd().resolve():
+            return f"is the working directory; {new}"
+        if folder == source_checkout():
+            return f"is the cerebx source checkout; {new}"
+        if folder.is_dir() and not _holds_runs(folder):
+            return f"is an existing folder that holds no run; {new} (or an empty one)"
+    except (OSError, RuntimeError):  # unreadable, a symlink loop: for the creation probe to say
+        return None
+    return None
+
+
+def _holds_runs(folder: Path) -> bool:
+    """``folder`` is empty, a run's or a sweep's, or holds only logs (the report writes a job's log first)."""
+    try:
+        entries = list(folder.iterdir())
+    except OSError:
+        return True  # not readable: whether a run can go there is for the creation probe to say
+    return (any(e.name in RUN_MARKERS for e in entries)
+            or all(e.is_file() and e.suffix == ".log" for e in entries))

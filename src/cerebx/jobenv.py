@@ -38,12 +38,18 @@ def job_cpus(environ: dict[str, str] | None = None) -> int:
     return max(1, available)
 
 
+def source_checkout() -> Path | None:
+    """The source checkout cerebx runs from (the folder of its ``pyproject.toml``), or None when installed."""
+    checkout = Path(__file__).resolve().parents[2]
+    return checkout if (checkout / "pyproject.toml").is_file() else None
+
+
 def numba_cache_dir(environ: dict[str, str] | None = None) -> Path:
     env = os.environ if environ is None else environ
     if env.get("CEREBX_CACHE"):
         return Path(env["CEREBX_CACHE"]) / "numba"
-    checkout = Path(__file__).resolve().parents[2]
-    if (checkout / "pyproject.toml").is_file():
+    checkout = source_checkout()
+    if checkout is not None:
         return checkout / ".cache" / "numba"
     return Path.home() / ".cache" / "cerebx" / "numba"
 

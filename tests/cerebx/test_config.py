@@ -94,7 +94,7 @@ INVALID = [
      "controller.network.projections.pf_pc: weight_range_nS min (5.0) is greater than max (0.0)"),
     (["+task=circle", "plant.physics_dt_ms=0.3"],
      "plant.physics_dt_ms: 0.3 ms does not divide the 2.0 ms control step"),
-    (["+task=circle", "+plant.colour=red"], "plant.colour: Extra inputs are not permitted"),
+    (["+task=circle", "+plant.colour=red"], "plant.colour: unknown key"),
     (["+task=circle", "controller.network.projections.pf_pc.plasticity.kernel_peak_ms=100"],
      "controller.network.projections.pf_pc.plasticity: kernel_peak_ms (100.0) must be greater than "
      "kernel_onset_ms (120.0)"),
@@ -102,7 +102,7 @@ INVALID = [
      "controller.network.populations.pc: microcomplexes (7) must divide the population size (600)"),
     (["+task=square"], "task: unknown option 'square'"),
     (["+task=circle", "init_from=/nonexistent/run"], "init_from: /nonexistent/run/controller_state.npz does not exist"),
-    (["+task=circle", "plant.colour=red"], "plant.colour: not in the composed config"),
+    (["+task=circle", "plant.colour=red"], "plant.colour: unknown key"),
     (["+task=circle", "controller.decoder.alpha_Nm_per_spike=[1,2]"],
      "controller.decoder.alpha_Nm_per_spike: 2 values given but the plant has 6 joints"),
     (["+task=circle", "~controller.mf.ranges",

@@ -6,17 +6,22 @@ from __future__ import annotations
 from pathlib import Path
 
 from cerebx import runfiles
-from cerebx.commands.common import fail
+from cerebx.commands.common import Parser, fail
 from cerebx.errors import CerebxError
 from cerebx.recording.console import format_summary
 from cerebx.recording.reader import channel_counts, has_summary, read_summary
 from cerebx.recording.segments import segments
 
 
+def parser() -> Parser:
+    """The command's one argument: a run folder or an MCAP file."""
+    ap = Parser("cerebx inspect", "a run's summary and its MCAP channels")
+    ap.add_argument("path", help="a run folder (RUN_DIR) or one of its .mcap files")
+    return ap
+
+
 def main(args: list[str]) -> int:
-    if len(args) != 1:
-        return fail(["inspect: give one run folder or .mcap file"])
-    p = Path(args[0])
+    p = Path(parser().parse_args(args).path)
     if not p.exists():
         return fail([f"{p}: no such file or folder"])
     run_dir = p if p.is_dir() else p.parent

@@ -14,13 +14,13 @@ import sys
 from cerebx import cli, sweep
 from cerebx.app import run_app
 from cerebx.commands.common import fail
-from cerebx.config import check, check_output_dir, output_root
+from cerebx.config import check, check_output_dir, output_root, split_args
 from cerebx.estimate import disk_problem, total
 from cerebx.guard import check_args
 from cerebx.loop.resume import expand_args
 
 PASS_THROUGH = ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i", "--resolve",
-                "--package", "-p", "-sc", "--shell-completion", "--config-dir", "-cd",
+                "--package", "-p", "-sc", "--shell-completion",
                 "--config-name", "-cn", "--config-path", "-cp", "--experimental-rerun")
 INFO = ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i", "-sc", "--shell-completion")
 NOT_WITH_MULTIRUN = ("--cfg", "-c", "--info", "-i", "-sc", "--shell-completion")  # Hydra does one of these or -m
@@ -44,7 +44,8 @@ def main(args: list[str]) -> int:
             return fail(problems)
     if not any(a.split("=")[0] in PASS_THROUGH for a in args):
         estimates: list = []
-        problems = check([a for a in args if not a.startswith("-")], multirun=multirun, estimates=estimates)
+        overrides, config_dir = split_args(args)
+        problems = check(overrides, multirun=multirun, estimates=estimates, config_dir=config_dir)
         problems += size_problems(estimates, args, multirun)
         if problems:
             return fail(problems)
