@@ -130,7 +130,7 @@ def gamma_delay(cfg: schema.GammaDelay, ctx: Any) -> DelayModel:
 
 
 def trace_delay(cfg: schema.TraceDelay, ctx: Any) -> DelayModel:
-    data = load_trace(cfg.path)
+    data = load_trace(str(cfg.file()))
     r2c = data[:, 0]
     c2r = data[:, 1] if data.shape[1] > 1 else data[:, 0]
     return DelayModel(Trace(r2c, cfg.loop), Trace(c2r, cfg.loop))

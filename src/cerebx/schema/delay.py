@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Literal
 
 from pydantic import Field, model_validator
@@ -67,12 +68,31 @@ class GammaDelay(Strict):
         return self
 
 
+SHIPPED_TRACES = Path(__file__).resolve().parents[1] / "data"
+"""Where the delay traces that ship with cerebx are (``delays/example_trace.csv``)."""
+
+
 class TraceDelay(Strict):
     """Replay a recorded series of per-step delays (ms) from a text/CSV file (one or two columns)."""
 
     kind: Literal["trace"] = "trace"
-    path: str
+    path: str = Field(description="the trace file: absolute, or relative to the working directory, else to the "
+                      "traces shipped with cerebx (delays/example_trace.csv)")
     loop: bool = True
+
+    @model_validator(mode="after")
+    def _file_exists(self) -> TraceDelay:
+        self.file()
+        return self
+
+    def file(self) -> Path:
+        """The trace file this path names (where the run reads it, from any working directory)."""
+        given = Path(self.path)
+        for candidate in (given, SHIPPED_TRACES / given):
+            if candidate.is_file():
+                return candidate
+        raise ValueError(f"path: no such file {self.path!r} (looked in {Path.cwd()} and in cerebx's shipped "
+                         f"traces, {SHIPPED_TRACES})")
 
 
 class PercentileDelay(Strict):

@@ -214,14 +214,7 @@ class NetworkConfig(Strict):
             if abs(p.delay_ms / self.dt_ms - round(p.delay_ms / self.dt_ms)) > 1e-9:
                 problems.append(f"{where}.delay_ms: {p.delay_ms} is not a multiple of dt_ms {self.dt_ms}")
             if p.plasticity is not None:
-                teacher = self.projections.get(p.plasticity.teacher)
-                if teacher is None:
-                    problems.append(f"{where}.plasticity.teacher: unknown projection {p.plasticity.teacher!r}")
-                elif teacher.post != p.post:
-                    problems.append(
-                        f"{where}.plasticity.teacher: {p.plasticity.teacher!r} targets {teacher.post!r}, "
-                        f"not {p.post!r}"
-                    )
+                problems += _plasticity_problems(where, p, self.projections)
         io = self.io
         for field, name in [("mossy", io.mossy), ("climbing", io.climbing), ("output", io.output),
                             ("granule", io.granule), *[("purkinje", n) for n in io.purkinje]]:
@@ -257,6 +250,26 @@ class NetworkConfig(Strict):
     @property
     def n_plastic(self) -> int:
         return sum(p.synapses for p in self.projections.values() if p.plasticity is not None)
+
+
+def _plasticity_problems(where: str, p: Projection, projections: dict[str, Projection]) -> list[str]:
+    """What the network engine refuses of a plastic projection (``snn/topology.py``): it learns on a dense
+    (all_to_all, current-carrying) projection, taught by a sparse one that targets the same population."""
+    out = []
+    if not isinstance(p.rule, AllToAll):
+        out.append(f"{where}: plasticity is supported on all_to_all projections only")
+    elif p.teaching:
+        out.append(f"{where}: plasticity is supported on all_to_all projections only, not on a teaching one")
+    name = p.plasticity.teacher  # type: ignore[union-attr]
+    teacher = projections.get(name)
+    if teacher is None:
+        out.append(f"{where}.plasticity.teacher: unknown projection {name!r}")
+    elif teacher.post != p.post:
+        out.append(f"{where}.plasticity.teacher: {name!r} targets {teacher.post!r}, not {p.post!r}")
+    elif isinstance(teacher.rule, AllToAll) and not teacher.teaching:
+        out.append(f"{where}.plasticity.teacher: {name!r} must be a one_to_one or joint_combinations projection "
+                   "(or a teaching one)")
+    return out
 
 
 def _rule_count(rule, n_pre: int, n_post: int, where: str, problems: list[str]) -> int | None:

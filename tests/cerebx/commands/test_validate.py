@@ -4,12 +4,18 @@ accepts what run accepts (``-m``, ``--config-dir``), and says the real cause of 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import ClassVar, Literal
 
 import pytest
 
+from cerebx import registry
 from cerebx.cli import main
+from cerebx.registry import Entry
+from cerebx.schema.base import Strict
 
 DEMO = ["+experiment=demo"]
+PLASTIC_ONE_TO_ONE = ["+task=circle", "+controller.network.projections.pc_dcn.plasticity={kind: kernel_stdp, "
+                      "teacher: cf_dcn_ampa}", "+controller.network.projections.pc_dcn.weight_range_nS=[0,5]"]
 
 REFUSED = [
     # a group that is not in the defaults list needs a '+' (not: "chosen inside another option")
@@ -26,6 +32,10 @@ REFUSED = [
     (["+task=circle", "contoller.kp=5"], "contoller: unknown key; did you mean controller?"),
     (["+task=circle", "+trails=3"], "trails: unknown key; did you mean trials?"),
     (DEMO + ["seed=1,2"], "seed: several values (1,2): add -m to sweep them"),
+    # accepted by validate, then failed in run, before
+    (DEMO + ["delay=trace", "delay.path=nowhere.csv"], "delay.path: no such file 'nowhere.csv' (looked in "),
+    (PLASTIC_ONE_TO_ONE, "controller.network.projections.pc_dcn: plasticity is supported on all_to_all "
+                         "projections only"),
     # an output folder that is no new or run folder
     (DEMO + ["hydra.run.dir="], "hydra.run.dir: empty; give a new folder, e.g. runs/mine"),
     (DEMO + ["hydra.run.dir=."], "hydra.run.dir: .: is the working directory; give a new folder"),
@@ -96,3 +106,42 @@ def test_a_config_dir_is_searched_as_run_searches_it(in_tmp, capsys):
 def test_a_wrong_flag_is_one_line(capsys):
     assert main(["validate", *DEMO, "--bogus"]) == 2
     assert capsys.readouterr().err.strip() == "cerebx validate: unrecognized arguments: --bogus"
+
+
+class NoRangesEncoder(Strict):
+    """A plugin's mossy encoder that forgot the ``ranges`` field the spiking controller reads."""
+
+    role: ClassVar[str] = "mossy"
+    kind: Literal["no_ranges"] = "no_ranges"
+    fibers_per_signal: int = 10
+
+
+def test_a_mossy_encoder_without_ranges_is_refused(monkeypatch, in_tmp, capsys):
+    monkeypatch.setitem(registry.encoders._entries, "no_ranges",
+                        Entry("no_ranges", NoRangesEncoder, "cerebx.snn.encoders:MossyEncoder", "test"))
+    line = _refused_alike(["+task=circle", "~controller.mf", "+controller.mf={kind: no_ranges}"], in_tmp, capsys)
+    assert line.startswith("controller.mf: encoder kind 'no_ranges' has no 'ranges' field")
+
+
+def test_the_plasticity_check_is_the_network_engines(load):
+    """validate refuses with the very line the network engine would stop the run with."""
+    from cerebx.snn.topology import build_topology
+
+    net = load(["+task=circle", "+experiment=small_snn"]).controller.network
+    pc_dcn = net.projections["pc_dcn"].model_copy(update={
+        "plasticity": net.projections["pf_pc"].plasticity.model_copy(update={"teacher": "cf_dcn_ampa"}),
+        "weight_range_nS": (0.0, 5.0)})
+    unchecked = net.model_copy(update={"projections": {**net.projections, "pc_dcn": pc_dcn}})
+    with pytest.raises(ValueError, match="^projections.pc_dcn: plasticity is supported on all_to_all projections "
+                                         "only$"):
+        build_topology(unchecked, fill=False)
+
+
+@pytest.mark.integration
+def test_the_shipped_delay_trace_runs_from_any_folder(in_tmp, capsys):
+    import json
+
+    assert main(["validate", *DEMO, "delay=trace"]) == 0
+    assert main(["run", *DEMO, "delay=trace", "trials=1", "hydra.run.dir=r", "recording.progress=off"]) == 0
+    summary = json.loads((in_tmp / "r" / "summary.json").read_text())
+    assert (summary["status"], summary["delay"]) == ("completed", "trace")

@@ -183,7 +183,7 @@ class SNNControllerImpl(Controller):
         if self.mf.n_fibers != self.sl_mf.stop - self.sl_mf.start:
             raise ValueError(f"network: {io.mossy} has {self.sl_mf.stop - self.sl_mf.start} fibres, the "
                              f"encoder needs {self.mf.n_fibers} ({nj} joints x 4 signals x "
-                             f"{cfg.mf.fibers_per_signal})")
+                             f"{getattr(cfg.mf, 'fibers_per_signal', '?')})")
         self._rng_seed = ctx.rng("controller.snn.cf")
         self.cf = registry.encoders.build(cfg.cf, nj, n_cf // nj, cfg.error.kpos, cfg.error.kvel, self._rng_seed)
         self.decoder = DCNDecoder(cfg.decoder.alpha_Nm_per_spike, nj, n_dcn // nj)

@@ -135,6 +135,10 @@ class SNNController(ControllerConfig):
             got = getattr(getattr(self, field), "role", None)
             if got != role:
                 raise ValueError(f"{field}: kind {getattr(self, field).kind!r} is a {got} encoder, not a {role} one")
+        if not hasattr(self.mf, "ranges"):
+            raise ValueError(f"mf: encoder kind {self.mf.kind!r} has no 'ranges' field, from which the spiking "
+                             "controller gives a mossy encoder the ranges of its signals (add one typed like "
+                             "BoxEncoder.ranges)")
         return self
 
     @property
