@@ -26,7 +26,7 @@ time uses the real-time factors of runs with their default recording on a quiet 
 from __future__ import annotations
 
 import shutil
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -47,11 +47,18 @@ class Estimate:
     mcap_bytes: float
     state_bytes: float
     wall_s: float
+    compile_s: float = 0.0
+    """Of ``wall_s``: compiling numba kernels not in the cache yet (``numba_cache``; once, not per job)."""
 
     def line(self) -> str:
         state = f", learned state <= {_size(self.state_bytes)} before compression" if self.state_bytes else ""
+        compiling = f" (~{_duration(self.compile_s)} of it compiling numba kernels, once)" if self.compile_s else ""
         return (f"estimate: {self.sim_s:,.0f} s simulated, run.mcap ~{_size(self.mcap_bytes)}{state}, "
-                f"~{_duration(self.wall_s)} on a quiet 2-core machine")
+                f"~{_duration(self.wall_s)} on a quiet 2-core machine{compiling}")
+
+    def with_compiling(self, seconds: float) -> Estimate:
+        """This estimate with ``seconds`` of compiling added to its wall time."""
+        return replace(self, wall_s=self.wall_s + seconds, compile_s=self.compile_s + seconds)
 
 
 def _size(b: float) -> str:

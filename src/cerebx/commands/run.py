@@ -14,10 +14,12 @@ import sys
 from cerebx import cli, sweep
 from cerebx.app import run_app
 from cerebx.commands.common import fail
+from cerebx.compile_progress import show_progress
 from cerebx.config import check, check_output_dir, output_root, split_args
 from cerebx.estimate import disk_problem, total
 from cerebx.guard import check_args
 from cerebx.loop.resume import expand_args
+from cerebx.numba_cache import ColdKernels, cold_kernels
 
 PASS_THROUGH = ("--cfg", "-c", "--help", "-h", "--hydra-help", "--info", "-i", "--resolve",
                 "--package", "-p", "-sc", "--shell-completion",
@@ -44,11 +46,15 @@ def main(args: list[str]) -> int:
             return fail(problems)
     if not any(a.split("=")[0] in PASS_THROUGH for a in args):
         estimates: list = []
+        valid: list = []
         overrides, config_dir = split_args(args)
-        problems = check(overrides, multirun=multirun, estimates=estimates, config_dir=config_dir)
-        problems += size_problems(estimates, args, multirun)
+        problems = check(overrides, multirun=multirun, estimates=estimates, config_dir=config_dir, valid=valid)
+        cold = cold_kernels([exp for _, exp, _ in valid])
+        problems += size_problems(estimates, args, multirun, cold)
         if problems:
             return fail(problems)
+        if cold.reported:
+            show_progress(cold.kernels)
     root = None
     if multirun and runs:
         root, args = sweep.sweep_dir(args)
@@ -59,12 +65,16 @@ def main(args: list[str]) -> int:
     return cli.run_command("summarize", [str(root), "--end-of-sweep"])
 
 
-def size_problems(estimates: list, args: list[str], multirun: bool) -> list[str]:
-    """Print the disk and time estimate of the command; one line if it does not fit on the disk."""
+def size_problems(estimates: list, args: list[str], multirun: bool, cold: ColdKernels | None = None) -> list[str]:
+    """Print the disk and time estimate of the command (with the compiling of numba kernels not in the cache
+    yet, ``cold``, and a line saying so); one line if it does not fit on the disk."""
     if not estimates:
         return []
     both = total(estimates)
     what = f"sweep of {len(estimates)} jobs" if multirun else "run"
+    if cold is not None and cold.reported:
+        print(cold.line(), file=sys.stderr)
+        both = both.with_compiling(cold.seconds)
     print(f"{what}: {both.line()}", file=sys.stderr)
     why = disk_problem(both.mcap_bytes + both.state_bytes, output_root(args, multirun), what)
     return [why] if why else []

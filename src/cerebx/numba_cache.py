@@ -1,0 +1,165 @@
+"""Whether the numba kernels a run will use are compiled already, and about how long compiling them takes.
+
+numba compiles a ``cache=True`` kernel on its first call and keeps it in ``NUMBA_CACHE_DIR``: one folder per
+source folder (``<folder name>_<sha1 of its absolute path>``), one index ``<module>.<function>-<line>.pyXY.nbi``
+per kernel, valid while the source file is unchanged. A run's kernels are those of the modules it imports: the
+closed loop's and those of the builders of its chosen kinds, followed through their imports within cerebx and
+its plugins (read from the source, nothing is imported). A module counts as compiled when one of its kernels has
+an index newer than its source. A run compiles only the kernels it calls: a module whose kernels no run has
+called yet (the checkpoint writer's, in runs shorter than ``checkpoint_every``) stays counted as cold, so less than
+``MIN_REPORTED_S`` of compiling is not reported.
+
+The cost is measured, not derived: the first small spiking run (``+task=circle +experiment=small_snn
+trials=1``) compiled its 29 kernels in 25.5 s (28.2 s cold, 2.7 s warm) on the 2-core development machine while
+it ran two other jobs (2026-11-27); the three largest (the network's step and chunk, the controller's chunk
+outputs) take most of it. Hence about 0.9 s per kernel.
+"""
+
+from __future__ import annotations
+
+import ast
+import functools
+import hashlib
+import importlib.util
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from cerebx import registry
+
+COMPILE_S_PER_KERNEL = 0.9
+MIN_REPORTED_S = 5.0
+"""Less compiling than this is left out of the estimate (it is within its noise, and partly kernels of modules a
+run imports without calling them)."""
+LOOP_MODULE = "cerebx.loop.runner"
+"""Where the closed loop of every run starts (its imports bring the loop's own kernels)."""
+
+
+@dataclass(frozen=True)
+class ColdKernels:
+    """The kernels a run has to compile first: how many, in which modules, and about how long it takes."""
+
+    modules: tuple[str, ...]
+    kernels: int
+    cache_dir: Path
+
+    @property
+    def seconds(self) -> float:
+        return self.kernels * COMPILE_S_PER_KERNEL
+
+    @property
+    def reported(self) -> bool:
+        """Enough compiling to tell the user and to count in the estimate."""
+        return self.seconds >= MIN_REPORTED_S
+
+    def line(self) -> str:
+        return (f"numba: {self.kernels} kernels of this run are not compiled yet (first run since an install or a "
+                f"change): compiling them first, ~{self.seconds:.0f} s, once (cached in {self.cache_dir})")
+
+
+def cold_kernels(exps: list[Any], cache_dir: Path | None = None) -> ColdKernels:
+    """The not yet compiled kernels of the runs of experiments ``exps`` (a sweep's jobs compile each kernel once;
+    ``cache_dir``: numba's cache folder, by default ``NUMBA_CACHE_DIR``)."""
+    folder = Path(cache_dir or os.environ.get("NUMBA_CACHE_DIR") or ".")
+    roots = tuple(sorted(set().union(*(builder_modules(e) for e in exps)))) if exps else ()
+    cold = [(m, n) for m in sorted(_closure(roots)) if (n := _kernel_count(m)) and not _compiled(m, folder)]
+    return ColdKernels(tuple(m for m, _ in cold), sum(n for _, n in cold), folder)
+
+
+def builder_modules(exp: Any) -> set[str]:
+    """The closed loop's module and those of the builders of every kind ``exp`` chooses (its components, stages,
+    link and, nested in them, e.g. a spiking controller's encoders)."""
+    out = {LOOP_MODULE}
+    for node in _kinds(exp):
+        for reg in registry.GROUPS.values():
+            entry = reg._entries.get(node.kind)
+            if entry is not None and entry.schema is type(node):
+                builder = entry.builder
+                out.add(builder.partition(":")[0] if isinstance(builder, str) else builder.__module__)
+    return out
+
+
+def _kinds(node: Any) -> list[Any]:
+    """Every config model with a ``kind`` inside ``node`` (itself included)."""
+    out = [node] if isinstance(getattr(node, "kind", None), str) else []
+    children = node if isinstance(node, (list, tuple)) else (
+        [getattr(node, f) for f in type(node).model_fields] if hasattr(type(node), "model_fields") else [])
+    for child in children:
+        if hasattr(type(child), "model_fields") or isinstance(child, (list, tuple)):
+            out += _kinds(child)
+    return out
+
+
+@functools.cache
+def _closure(roots: tuple[str, ...]) -> frozenset[str]:
+    """``roots`` and every module of cerebx or a plugin they import, directly or not (imports in functions too)."""
+    seen: set[str] = set()
+    todo = list(roots)
+    while todo:
+        name = todo.pop()
+        if name in seen or _source(name) is None:
+            continue
+        seen.add(name)
+        todo += _imports(name)
+    return frozenset(seen)
+
+
+def _is_ours(name: str) -> bool:
+    return name.split(".")[0].startswith("cerebx")
+
+
+@functools.cache
+def _source(name: str) -> Path | None:
+    """The source file of module ``name`` of cerebx or a plugin, found without importing it."""
+    if not _is_ours(name):
+        return None
+    top, *rest = name.split(".")
+    spec = importlib.util.find_spec(top)
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    base = Path(next(iter(spec.submodule_search_locations))).joinpath(*rest)
+    return next((p for p in (base.with_suffix(".py"), base / "__init__.py") if p.is_file()), None)
+
+
+@functools.cache
+def _tree(name: str) -> ast.Module:
+    return ast.parse(_source(name).read_text())  # type: ignore[union-attr]
+
+
+def _imports(name: str) -> list[str]:
+    """Modules of cerebx or a plugin that module ``name`` imports (``from a import b`` may name module a.b)."""
+    package = name if _source(name).name == "__init__.py" else name.rpartition(".")[0]  # type: ignore[union-attr]
+    out = []
+    for node in ast.walk(_tree(name)):
+        if isinstance(node, ast.Import):
+            out += [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parent = package.rsplit(".", node.level - 1)[0] if node.level > 1 else package
+                base = f"{parent}.{base}" if base else parent
+            out += [base, *(f"{base}.{a.name}" for a in node.names)]
+    return [m for m in out if _is_ours(m)]
+
+
+@functools.cache
+def _kernel_count(name: str) -> int:
+    """The ``cache=True`` kernels defined in module ``name``."""
+    return sum(1 for node in ast.walk(_tree(name)) if isinstance(node, ast.FunctionDef)
+               and any(_caches(d) for d in node.decorator_list))
+
+
+def _caches(decorator: ast.expr) -> bool:
+    return isinstance(decorator, ast.Call) and any(
+        k.arg == "cache" and isinstance(k.value, ast.Constant) and k.value.value is True for k in decorator.keywords)
+
+
+def _compiled(name: str, cache_dir: Path) -> bool:
+    """One kernel of module ``name`` has a cache index newer than its source."""
+    src = _source(name)
+    assert src is not None
+    parent = os.path.dirname(os.path.abspath(src))
+    folder = cache_dir / f"{os.path.basename(parent)}_{hashlib.sha1(parent.encode()).hexdigest()}"
+    changed = src.stat().st_mtime
+    return any(i.stat().st_mtime >= changed for i in folder.glob(f"{src.stem}.*.nbi"))

@@ -1,0 +1,80 @@
+"""A run whose numba kernels are not in the cache says it compiles them first and counts it in its estimate."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from cerebx import numba_cache
+from cerebx.cli import main
+from cerebx.compile_progress import CompileProgress
+from cerebx.numba_cache import MIN_REPORTED_S, cold_kernels
+
+SNN = ["+task=circle", "+experiment=small_snn", "trials=1"]
+
+
+def _warm(cache, modules) -> None:
+    """Fake compiled kernels: one cache index per module, newer than its source."""
+    for name in modules:
+        src = numba_cache._source(name)
+        parent = os.path.dirname(os.path.abspath(src))
+        folder = cache / f"{os.path.basename(parent)}_{numba_cache.hashlib.sha1(parent.encode()).hexdigest()}"
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / f"{src.stem}.kernel-1.py311.nbi").write_bytes(b"")
+
+
+def test_a_cold_cache_is_found_and_a_warm_one_is_not(load, tmp_path):
+    exp = load(SNN)
+    cold = cold_kernels([exp], tmp_path)
+    assert {"cerebx.snn.kernels", "cerebx.snn.encoders", "cerebx.loop.phases"} <= set(cold.modules)
+    assert cold.kernels >= 30 and cold.reported
+    _warm(tmp_path, cold.modules)
+    assert cold_kernels([exp], tmp_path).kernels == 0
+    edited = numba_cache._source("cerebx.snn.kernels").stat().st_mtime
+    for index in tmp_path.glob("snn_*/kernels.*.nbi"):  # compiled before its source last changed: stale
+        os.utime(index, (edited - 60, edited - 60))
+    assert cold_kernels([exp], tmp_path).modules == ("cerebx.snn.kernels",)
+
+
+def test_a_pd_run_has_too_few_kernels_to_report(load, tmp_path):
+    assert cold_kernels([load(["+experiment=demo"])], tmp_path).seconds < MIN_REPORTED_S
+
+
+def test_a_run_with_a_cold_cache_says_it_compiles(in_tmp, monkeypatch, capsys):
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(in_tmp / "cold"))
+    started = []
+    monkeypatch.setattr("cerebx.commands.run.run_app", lambda: started.append(True))
+    monkeypatch.setattr("cerebx.commands.run.show_progress", lambda n: started.append(n))
+    assert main(["run", *SNN]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    n = started[0]
+    assert err[0] == (f"numba: {n} kernels of this run are not compiled yet (first run since an install or a change): "
+                      f"compiling them first, ~{n * 0.9:.0f} s, once (cached in {in_tmp / 'cold'})")
+    assert err[1].startswith("run: estimate: 2 s simulated") and err[1].endswith(
+        f"~{n * 0.9:.0f} s on a quiet 2-core machine (~{n * 0.9:.0f} s of it compiling numba kernels, once)")
+    assert started == [n, True]
+
+
+def test_progress_counts_cerebx_kernels_only(capsys):
+    from numba.core.event import Event
+
+    from cerebx.loop.phases import all_finite
+
+    class Dispatcher:
+        def __init__(self, func):
+            self.py_func = func
+
+    progress = CompileProgress(expected=3, every_s=0.0)
+    for func in (all_finite.py_func, os.path.join, all_finite.py_func):
+        ev = Event("numba:compile", "start", data={"dispatcher": Dispatcher(func)})
+        progress.on_start(ev)
+        progress.on_end(Event("numba:compile", "end", data=ev.data))
+    assert progress.done == 2
+    assert capsys.readouterr().err.splitlines()[-1].startswith("numba: 2 of ~3 kernels compiled (")
+
+
+@pytest.fixture(autouse=True)
+def _fresh_parse():
+    """Each test reads the sources as they are now."""
+    numba_cache._closure.cache_clear()
