@@ -1,4 +1,4 @@
-"""``cerebx`` command: run | validate | inspect | bench | report | summarize | tune | robot | relay | delays.
+"""``cerebx`` command: run | validate | inspect | plot | bench | report | summarize | tune | robot | relay | delays.
 
 ``run`` is a Hydra application (multirun, launchers, --cfg, completion); the other commands
 compose the same config with Hydra's compose API. Input problems print one ``path: message``
@@ -24,6 +24,7 @@ commands:
   run +task=NAME [group=option ...] [key=value ...]   run one experiment (-m for a sweep)
   validate +task=NAME [...]                            check a config without running; print it (-m: a sweep)
   inspect RUN_DIR|FILE.mcap                            a run's summary and its MCAP channels
+  plot RUN_DIR [--out FILE.png]                        a run's learning curve and per-joint errors
   bench [--seconds S] [--networks a,b]                 speed of plant, network and closed loop (JSON)
   bench --lwpr                                         LWPR updates per second (the reference's examples)
   report [RUN_DIR ...]                                 build reports/ from run logs
@@ -39,7 +40,7 @@ every command: cerebx COMMAND --help
 """
 
 COMMANDS = {**{name: f"cerebx.commands.{name}" for name in
-               ("run", "validate", "inspect", "bench", "report", "tune", "summarize")},
+               ("run", "validate", "inspect", "plot", "bench", "report", "tune", "summarize")},
             "robot": "cerebx.loop.robot_side", "relay": "cerebx.link.relay", "delays": "cerebx.link.trace"}
 """Command name -> the module whose ``main(args)`` runs it."""
 
