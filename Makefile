@@ -65,7 +65,7 @@ report: $(STAMP) ## run missing studies (PROFILE=quick|full), then build reports
 
 lint: $(STAMP) ## ruff, and the import contracts of pyproject.toml (the layering: core, schema, papers)
 	$(BIN)/ruff check src tests
-	$(BIN)/lint-imports --no-cache
+	PYTHONPATH=examples/my_lab:examples/my_cerebellum $(BIN)/lint-imports --no-cache
 
 docs: $(DOCS_STAMP) ## build the docs site into site/ (strict: a broken link or reference fails the build)
 	DISABLE_MKDOCS_2_WARNING=true NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir site

@@ -365,14 +365,15 @@ def _can_make(folder: Path) -> str | None:
 
 
 def _output_dir(overrides: list[str], multirun: bool) -> tuple[str, str]:
-    """(key, value) of the run or sweep folder a ``cerebx run`` command would use."""
+    """(key, value) of the run or sweep folder a ``cerebx run`` command would use (the default: the literal
+    part of conf/config.yaml's, below which each run makes a folder of its own)."""
     key = "hydra.sweep.dir" if multirun else "hydra.run.dir"
-    value = RUN_DIR_DEFAULTS["sweep" if multirun else "run"]
+    value, given = RUN_DIR_DEFAULTS["sweep" if multirun else "run"], False
     for o in overrides:
         k, _, v = o.lstrip("+").partition("=")
         if k == key:
-            value = v.strip("'\"")
-    return key, value
+            value, given = v.strip("'\""), True
+    return key, value if given else value + "/${now}"
 
 
 def output_root(overrides: list[str], multirun: bool) -> Path:

@@ -18,12 +18,21 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from cerebx.report.convergence import Convergence, plateau  # noqa: E402
-from cerebx.report.plot import save  # noqa: E402
-from cerebx.report.registry import Check, Figure, MissingRuns, figure, studies  # noqa: E402
-from cerebx.report.runs import Run, RunSet  # noqa: E402
-from cerebx.report.stats import Interval, interval  # noqa: E402
-from cerebx.report.studies import study_plateau  # noqa: E402
+from cerebx.report.api import (  # noqa: E402
+    Check,
+    Convergence,
+    Figure,
+    Interval,
+    MissingRuns,
+    Run,
+    RunSet,
+    figure,
+    interval,
+    plateau,
+    save,  # noqa: E402
+    studies,
+    study_plateau,  # noqa: E402
+)
 
 studies(Path(__file__).with_name("studies.yaml"))
 

@@ -12,13 +12,28 @@ from pathlib import Path
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np
 
-from cerebx import metrics
-from cerebx.report.convergence import Convergence, learning_convergence
-from cerebx.report.plot import fmt, panel_letter, save
-from cerebx.report.registry import Check, Figure, MissingRuns, figure, studies
-from cerebx.report.runs import Run, RunSet
-from cerebx.report.stats import Interval, interval
-from cerebx.report.studies import study_plateau
+from cerebx.report.api import (
+    Check,
+    Convergence,
+    Figure,
+    Interval,
+    MissingRuns,
+    Run,
+    RunSet,
+    accuracy_gain,
+    convergence_speed,
+    figure,
+    final_error,
+    final_error_stability,
+    fmt,
+    improvement_pct,
+    interval,
+    learning_convergence,
+    panel_letter,
+    save,
+    studies,
+    study_plateau,
+)
 from cerebx_luque2011.cerebellum.schema import Luque2011Cerebellum
 
 studies(Path(__file__).with_name("studies.yaml"))
@@ -84,9 +99,9 @@ def _mae_sum(r: Run) -> np.ndarray:
 
 def _estimators(r: Run) -> dict[str, float]:
     m = list(_mae_sum(r))
-    return {"accuracy gain (rad)": metrics.accuracy_gain(m), "final error (rad)": metrics.final_error(m),
-            "final error stability (rad)": metrics.final_error_stability(m),
-            "convergence (trials)": float(metrics.convergence_speed(m))}
+    return {"accuracy gain (rad)": accuracy_gain(m), "final error (rad)": final_error(m),
+            "final error stability (rad)": final_error_stability(m),
+            "convergence (trials)": float(convergence_speed(m))}
 
 
 def _finish(fig, stem: Path, axes: list) -> Path:
@@ -202,8 +217,8 @@ def _curves_and_final(rs: dict, stem: Path, xlabel: str, label) -> tuple[Path, l
         m = _mae_sum(r)
         ax_a.plot(m, color=cmap(i / max(1, len(rs) - 1)), lw=1, label=label(x))
         xs.append(x)
-        finals.append(metrics.final_error(list(m)))
-        stds.append(metrics.final_error_stability(list(m)))
+        finals.append(final_error(list(m)))
+        stds.append(final_error_stability(list(m)))
     ax_a.set_xlabel("trial")
     ax_a.set_ylabel("MAE, sum over joints (rad)")
     ax_a.legend(fontsize=8)
@@ -259,7 +274,7 @@ def fig10(runs: RunSet, stem: Path) -> Figure:
 
 def _learns(claim: str, maes: dict[str, np.ndarray]) -> Check:
     """Each curve learns: its final error below LEARNS times the mean of its first 30 trials."""
-    first = {k: (float(v[:FINAL_TRIALS].mean()), metrics.final_error(list(v))) for k, v in maes.items()}
+    first = {k: (float(v[:FINAL_TRIALS].mean()), final_error(list(v))) for k, v in maes.items()}
     return Check(f"{claim} (final error below {LEARNS:g}× the first 30 trials', constructed)",
                  all(b < LEARNS * a for a, b in first.values()),
                  ", ".join(f"{k} {a:.3f} → {b:.3f}" for k, (a, b) in first.items()) + " rad")
@@ -269,7 +284,7 @@ def _fig10_checks(by_dev: dict[float, Run]) -> list[Check]:
     """Fig. 10's claims: up to 70 ms of mismatch (the paper tested 50-70 ms) the cerebellum still learns and the
     final error keeps constant; beyond 70 ms learning is unstable (the error rises again after its lowest)."""
     m = {d: _mae_sum(r) for d, r in by_dev.items()}
-    final = {d: metrics.final_error(list(v)) for d, v in m.items()}
+    final = {d: final_error(list(v)) for d, v in m.items()}
     checks = []
     still = {d: v for d, v in m.items() if 50 <= abs(d) <= 70}
     if still:
@@ -326,7 +341,7 @@ def headline(r: Run) -> dict[str, float]:
     for t in AT_TRIALS:
         if t <= len(m) + r.warmup:
             k = min(t, len(m))
-            out[reduction_row(mass, t)] = metrics.improvement_pct(m, k)
+            out[reduction_row(mass, t)] = improvement_pct(m, k)
             out[stability_row(mass, t)] = stability_improvement_pct(m, k)
     return out
 
@@ -369,7 +384,7 @@ def fig12(runs: RunSet, stem: Path) -> Figure:
         at = [t for t in AT_TRIALS if reduction_row(mass, t) in ours]
         paper = PAPER_IMPROVEMENT.get(float(mass))
         stab = PAPER_STABILITY.get(float(mass))
-        gains.append((mass, metrics.accuracy_gain(m), [ours[reduction_row(mass, t)] for t in at]))
+        gains.append((mass, accuracy_gain(m), [ours[reduction_row(mass, t)] for t in at]))
         for t in at:
             j = AT_TRIALS.index(t)
             table.append([reduction_row(mass, t), "–" if paper is None else f"{paper[j]:.1f} %",
@@ -379,7 +394,7 @@ def fig12(runs: RunSet, stem: Path) -> Figure:
             table.append([stability_row(mass, t), "–" if stab is None else f"{stab[j]:.1f} %",
                           f"{ours[stability_row(mass, t)]:.1f} %"])
         table.append([f"{mass:g} kg: first-trial MAE / accuracy gain (rad)", "–",
-                      f"{m[0]:.3f} / {metrics.accuracy_gain(m):.3f}"])
+                      f"{m[0]:.3f} / {accuracy_gain(m):.3f}"])
     ax_a.set_xlabel("trial")
     ax_a.set_ylabel("MAE, sum over joints (rad)")
     ax_a.legend(fontsize=8)

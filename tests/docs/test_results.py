@@ -169,7 +169,7 @@ def _entry(name: str, checks: list[dict], intervals: dict | None = None, table: 
 def test_checks_pages_and_hero_are_made_from_figures_json(tmp_path):
     ok = {"claim": "SNN below PD", "holds": True, "numbers": "", "explained_at": None}
     why = {"claim": "ANN above SNN", "holds": False, "numbers": "1 vs 2",
-           "explained_at": "docs/reproductions/thesis-ch3.md#the-ann"}
+           "explained_at": "docs/reproductions/thesis-ch3.md#fig3_4"}
     bare = {"claim": "levels off", "holds": False, "numbers": "", "explained_at": None}
     iv = {"mean": 3.5, "ci_low": 3.1, "ci_high": 3.9, "n": 3, "paper_in_ci": "yes"}
     table = [["quantity", "paper", "cerebx"], ["PD average MAE ÷ SNN average MAE", "3 to 4× larger", "3.5"],
@@ -179,7 +179,7 @@ def test_checks_pages_and_hero_are_made_from_figures_json(tmp_path):
                           _entry("fig3_3", [bare])]}
     checks = publisher.checks_markdown(report["figures"])
     assert "| `fig3_4` | 2 | 1 | 1 | 0 |" in checks and "| all | 3 | 1 | 1 | 1 |" in checks
-    assert "[why](../reproductions/thesis-ch3.md#the-ann)" in checks and "levels off (): **not explained**" in checks
+    assert "[why](../reproductions/thesis-ch3.md#fig3_4)" in checks and "levels off (): **not explained**" in checks
     page = publisher.page_markdown(["fig3_4"], report, "../results")
     assert page.startswith("**In the published report (full profile):** 1 of 2 shape checks hold, 1 fail with")
     assert "| `fig3_4` | PD average MAE ÷ SNN average MAE | 3 to 4× larger | 3.5 [3.1, 3.9] | 3 | yes |" in page

@@ -9,10 +9,13 @@ imports only this module (and :mod:`cerebx.api`).
 - :class:`Run` and :class:`RunSet`: run folders chosen by content (``RunSet.where``, ``best``, ``seeds``).
 - :func:`interval`: a headline number's mean and 95 % interval over seeds.
 - Convergence: :func:`learning_convergence`, :func:`plateau`, :func:`combined`, :func:`study_plateau`.
+- Learning-curve metrics (Luque et al. 2011): :func:`accuracy_gain`, :func:`final_error`,
+  :func:`final_error_stability`, :func:`convergence_speed`, :func:`improvement_pct`.
 - Plotting: :func:`save` (PNG + SVG), :func:`panel_letter`, :func:`fmt`, :func:`mean_std`; delays:
   :func:`delays`, ``DELAY_TRIALS``.
 """
 
+from cerebx.metrics import accuracy_gain, convergence_speed, final_error, final_error_stability, improvement_pct
 from cerebx.report.convergence import Convergence, combined, learning_convergence, plateau
 from cerebx.report.delays import DELAY_TRIALS, delays
 from cerebx.report.plot import fmt, mean_std, panel_letter, save
@@ -30,11 +33,16 @@ __all__ = [
     "MissingRuns",
     "Run",
     "RunSet",
+    "accuracy_gain",
     "combined",
+    "convergence_speed",
     "delays",
     "explanations",
     "figure",
+    "final_error",
+    "final_error_stability",
     "fmt",
+    "improvement_pct",
     "interval",
     "learning_convergence",
     "mean_std",

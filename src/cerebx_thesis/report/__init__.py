@@ -4,7 +4,7 @@ Importing this package registers the figures with the report engine."""
 
 from pathlib import Path
 
-from cerebx.report.registry import studies
+from cerebx.report.api import studies
 from cerebx_thesis.report import (  # noqa: F401 - their import registers the figures
     adaptation,
     baxter_muscles,

@@ -12,10 +12,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from cerebx.plants.interaction import grab_anchor, half_sine  # noqa: E402
-from cerebx.report.plot import mean_std, save  # noqa: E402
-from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
-from cerebx.report.runs import Run, RunSet  # noqa: E402
+from cerebx.api import grab_anchor, half_sine  # noqa: E402
+from cerebx.report.api import Check, Figure, MissingRuns, Run, RunSet, figure, mean_std, save  # noqa: E402
 from cerebx_thesis.report.common import LEARN_STUDY, TASK_NAMES, learnt, short_path, trial_range  # noqa: E402
 
 # event kind -> (condition, switched on)

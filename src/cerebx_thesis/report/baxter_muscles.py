@@ -15,11 +15,21 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from cerebx.report.plot import fmt, mean_std, panel_letter, save  # noqa: E402
-from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
-from cerebx.report.runs import Run, RunSet  # noqa: E402
-from cerebx.report.stats import Interval, interval  # noqa: E402
-from cerebx.schema.muscles import EkebergConfig  # noqa: E402
+from cerebx.api import EkebergConfig  # noqa: E402
+from cerebx.report.api import (  # noqa: E402
+    Check,
+    Figure,
+    Interval,
+    MissingRuns,
+    Run,
+    RunSet,
+    figure,
+    fmt,
+    interval,
+    mean_std,
+    panel_letter,
+    save,
+)
 from cerebx_thesis.report.common import learnt, with_intervals  # noqa: E402
 
 # thesis §4.7 (Fig. 4.6): k -> position MAE (mean, std; rad) and payload sag (cm)

@@ -19,11 +19,16 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.report.convergence import Convergence, learning_convergence
-from cerebx.report.plot import panel_letter, save
-from cerebx.report.runs import Run, RunSet
-from cerebx.report.stats import Interval
-from cerebx.report.studies import study_plateau
+from cerebx.report.api import (
+    Convergence,
+    Interval,
+    Run,
+    RunSet,
+    learning_convergence,
+    panel_letter,
+    save,
+    study_plateau,
+)
 
 THESIS_KERNEL_MS = 150.0  # chapter 3 ([D]) kernel peak
 CH2_KERNEL_MS = 100.0  # chapter 2 ([B]) kernel peak

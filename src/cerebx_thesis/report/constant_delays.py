@@ -14,11 +14,20 @@ import numpy as np  # noqa: E402
 from matplotlib.colors import to_rgb  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
-from cerebx.report.convergence import Convergence  # noqa: E402
-from cerebx.report.plot import fmt, mean_std, save  # noqa: E402
-from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
-from cerebx.report.runs import Run, RunSet  # noqa: E402
-from cerebx.report.stats import Interval, interval  # noqa: E402
+from cerebx.report.api import (  # noqa: E402
+    Check,
+    Convergence,  # noqa: E402
+    Figure,
+    Interval,
+    MissingRuns,
+    Run,
+    RunSet,
+    figure,
+    fmt,
+    interval,
+    mean_std,
+    save,
+)
 from cerebx_thesis.report.common import (  # noqa: E402
     ANN_STUDY,
     CH3_STUDY,

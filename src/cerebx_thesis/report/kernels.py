@@ -14,13 +14,24 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from cerebx.report.convergence import Convergence, combined  # noqa: E402
-from cerebx.report.plot import fmt, mean_std  # noqa: E402
-from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
-from cerebx.report.runs import Run, RunSet  # noqa: E402
-from cerebx.report.stats import Interval, interval  # noqa: E402
-from cerebx.snn.schema import KernelSTDP  # noqa: E402
-from cerebx.snn.topology import ltd_kernel_table  # noqa: E402
+from cerebx.api import (
+    KernelSTDP,  # noqa: E402
+    ltd_kernel_table,  # noqa: E402
+)
+from cerebx.report.api import (  # noqa: E402
+    Check,
+    Convergence,
+    Figure,
+    Interval,
+    MissingRuns,
+    Run,
+    RunSet,
+    combined,
+    figure,
+    fmt,
+    interval,
+    mean_std,
+)
 from cerebx_thesis.report.common import (  # noqa: E402
     CH3_STUDY,
     HEADER,

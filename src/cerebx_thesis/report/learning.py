@@ -12,11 +12,17 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from cerebx.metrics import final_mae  # noqa: E402
-from cerebx.report.plot import save  # noqa: E402
-from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
-from cerebx.report.runs import Run, RunSet  # noqa: E402
-from cerebx.report.stats import Interval  # noqa: E402
+from cerebx.api import final_mae  # noqa: E402
+from cerebx.report.api import (  # noqa: E402
+    Check,
+    Figure,
+    Interval,  # noqa: E402
+    MissingRuns,
+    Run,
+    RunSet,
+    figure,
+    save,  # noqa: E402
+)
 from cerebx_thesis.report import stages  # noqa: E402
 from cerebx_thesis.report.common import (  # noqa: E402
     CH2_KERNEL_MS,

@@ -12,9 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from cerebx.report.plot import fmt, save  # noqa: E402
-from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
-from cerebx.report.runs import Run, RunSet  # noqa: E402
+from cerebx.report.api import Check, Figure, MissingRuns, Run, RunSet, figure, fmt, save  # noqa: E402
 from cerebx_thesis.report.common import CH3_STUDY, learnt  # noqa: E402
 
 REALISM_PLANTS = ("baxter", "baxter_sea", "baxter_noise", "baxter_lag5", "baxter_lag10", "baxter_urdf_armature")

@@ -15,11 +15,19 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from cerebx.report.convergence import Convergence  # noqa: E402
-from cerebx.report.delays import DELAY_TRIALS, delays  # noqa: E402
-from cerebx.report.plot import fmt, mean_std  # noqa: E402
-from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
-from cerebx.report.runs import Run, RunSet  # noqa: E402
+from cerebx.report.api import (  # noqa: E402
+    DELAY_TRIALS,
+    Check,
+    Convergence,  # noqa: E402
+    Figure,
+    MissingRuns,
+    Run,
+    RunSet,
+    delays,
+    figure,
+    fmt,
+    mean_std,
+)
 from cerebx_thesis.report.common import (  # noqa: E402
     CH3_STUDY,
     HEADER,

@@ -11,9 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from cerebx.report.plot import panel_letter, save  # noqa: E402
-from cerebx.report.registry import Figure, MissingRuns, figure  # noqa: E402
-from cerebx.report.runs import Run, RunSet  # noqa: E402
+from cerebx.report.api import Figure, MissingRuns, Run, RunSet, figure, panel_letter, save  # noqa: E402
 from cerebx_thesis.report import stages  # noqa: E402
 from cerebx_thesis.report.common import (  # noqa: E402
     CH2_KERNEL_MS,

@@ -15,11 +15,16 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.colors import PowerNorm  # noqa: E402
 
-from cerebx.recording.reader import read_messages  # noqa: E402
-from cerebx.report.plot import mean_std, panel_letter, save  # noqa: E402
-from cerebx.report.registry import Check  # noqa: E402
-from cerebx.report.runs import Run  # noqa: E402
-from cerebx.report.stats import Interval, interval  # noqa: E402
+from cerebx.api import read_messages  # noqa: E402
+from cerebx.report.api import (  # noqa: E402
+    Check,  # noqa: E402
+    Interval,
+    Run,  # noqa: E402
+    interval,
+    mean_std,
+    panel_letter,
+    save,
+)
 from cerebx_thesis.report.common import with_intervals  # noqa: E402
 
 # thesis stages for a 500-trial run: t1 = 18-20 s, t2 = 318-320 s, t3 = 998-1000 s

@@ -15,11 +15,20 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from cerebx.controllers.snn.schema import SNNController  # noqa: E402
-from cerebx.report.convergence import Convergence  # noqa: E402
-from cerebx.report.plot import fmt, mean_std, panel_letter, save  # noqa: E402
-from cerebx.report.registry import Check, Figure, MissingRuns, figure  # noqa: E402
-from cerebx.report.runs import Run, RunSet  # noqa: E402
+from cerebx.api import SNNController  # noqa: E402
+from cerebx.report.api import (  # noqa: E402
+    Check,
+    Convergence,  # noqa: E402
+    Figure,
+    MissingRuns,
+    Run,
+    RunSet,
+    figure,
+    fmt,
+    mean_std,
+    panel_letter,
+    save,
+)
 from cerebx_thesis.report.common import learnt  # noqa: E402
 
 TASKS = ("flexion_extension", "circle_slow", "circle_fast")

@@ -79,6 +79,16 @@ def test_a_new_empty_or_run_folder_is_accepted(content, in_tmp, capsys):
     assert main(["validate", *DEMO, f"hydra.run.dir={folder}"]) == 0
 
 
+@pytest.mark.parametrize("multirun", [False, True])
+def test_the_default_run_folder_is_accepted_beside_other_files_in_runs(multirun, in_tmp, capsys):
+    """Each run makes a folder of its own below runs/ (runs/<date>/<time>_<task>), so runs/ may hold anything:
+    a checkout's runs/.gitkeep, a link to a disk with more room."""
+    (in_tmp / "runs" / "multirun").mkdir(parents=True)
+    (in_tmp / "runs" / ".gitkeep").write_text("")
+    (in_tmp / "runs" / "multirun" / "notes.txt").write_text("")
+    assert main(["validate", *(["-m"] if multirun else []), *DEMO]) == 0
+
+
 def test_multirun_validates_every_job(in_tmp, capsys):
     assert main(["validate", "-m", *DEMO, "seed=1,2"]) == 0
     out = capsys.readouterr().out.strip().splitlines()

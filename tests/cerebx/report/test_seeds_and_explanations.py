@@ -99,12 +99,12 @@ def test_figures_draw_the_first_seed_and_group_the_others(tmp_path):
 def test_a_failing_check_links_to_its_explanation_a_passing_one_does_not(tmp_path):
     f = tmp_path / "explanations.yaml"
     f.write_text("explanations:\n"
-                 "  - {figure: figx, claim: 'ANN below', at: 'reproductions/x.md#why-ann', profiles: [full]}\n")
+                 "  - {figure: figx, claim: 'ANN below', at: 'reproductions/thesis-ch3.md#fig3_4', profiles: [full]}\n")
     known = load_explanations(f)
     fig = Figure([], "", checks=[Check("ANN below SNN at 40 ms", False), Check("ANN below PD", True),
                                  Check("other", False)])
     explain("figx", fig, "full", known)
-    assert [c.explained_at for c in fig.checks] == ["docs/reproductions/x.md#why-ann", None, None]
+    assert [c.explained_at for c in fig.checks] == ["docs/reproductions/thesis-ch3.md#fig3_4", None, None]
     explain("figx", fig, "quick", known)  # not said for the quick profile
     assert fig.checks[0].explained_at is None
     bad = tmp_path / "bad.yaml"
@@ -134,19 +134,19 @@ def test_figures_json_and_shapes_csv_carry_explained_at_and_intervals(tmp_path, 
     spec = FigureSpec("figx", "a figure", ("s",), draw)
     monkeypatch.setattr("cerebx.report.build.all_figures", lambda: {"figx": spec})
     f = tmp_path / "explanations.yaml"
-    f.write_text("explanations:\n  - {figure: figx, claim: SNN below, at: 'reproductions/x.md#why'}\n")
+    f.write_text("explanations:\n  - {figure: figx, claim: SNN below, at: 'reproductions/thesis-ch3.md#fig3_5'}\n")
     monkeypatch.setattr("cerebx.report.build.load_explanations", lambda: load_explanations(f))
     build_from(RunSet(), tmp_path / "out", profile="full")
     made = json.loads((tmp_path / "out" / "figures.json").read_text())
     entry = made["figures"][0]
-    assert entry["checks"][0]["explained_at"] == "docs/reproductions/x.md#why"
+    assert entry["checks"][0]["explained_at"] == "docs/reproductions/thesis-ch3.md#fig3_5"
     assert entry["intervals"]["q"]["n"] == 3 and entry["intervals"]["q"]["paper_in_ci"] == "yes"
     with open(tmp_path / "out" / "paper_vs_cerebx.csv") as fh:
         rows = list(csv.reader(fh))
     assert rows[0] == PAPER_HEADER and rows[1][-1] == "yes"
     with open(tmp_path / "out" / "shapes.csv") as fh:
         shapes = list(csv.reader(fh))
-    assert shapes[0][-1] == "explained_at" and shapes[1][-1] == "docs/reproductions/x.md#why"
+    assert shapes[0][-1] == "explained_at" and shapes[1][-1] == "docs/reproductions/thesis-ch3.md#fig3_5"
 
 
 def test_a_plan_can_run_only_the_first_seeds(tmp_path):
