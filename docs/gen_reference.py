@@ -110,6 +110,7 @@ def options_page() -> str:
 
 
 API_MODULES = {
+    "The public API (what a plugin imports)": ["cerebx.api", "cerebx.schema.api", "cerebx.report.api"],
     "The platform": ["cerebx.registry", "cerebx.signals", "cerebx.wiring", "cerebx.runfiles", "cerebx.config",
                      "cerebx.build", "cerebx.loop.loop", "cerebx.loop.runner", "cerebx.loop.link",
                      "cerebx.loop.resume"],
@@ -128,7 +129,9 @@ API_MODULES = {
 
 def api_page() -> str:
     out = ["# API (generated)", "",
-           "From the docstrings, when the docs are built. What a plugin or a script uses; the rest is internal.", ""]
+           "From the docstrings, when the docs are built. A plugin imports only the three modules of the first "
+           "section (the [how-tos](../howto/index.md#the-public-api) say which for what); the modules below them "
+           "are where those names are defined, and are internal.", ""]
     for section, modules in API_MODULES.items():
         out += [f"## {section}", ""]
         for module in modules:

@@ -13,7 +13,8 @@ import from cerebx. Everything else is internal and may change between versions;
 - Learned state: :func:`save_state_npz` and :func:`load_state_npz`.
 - Building and loading an experiment: :func:`load` (compose and validate a command line's overrides),
   :func:`build_components`.
-- Reading runs: :func:`read_messages` (an MCAP log's messages), :func:`final_mae`.
+- Reading runs: :func:`read_summary`, :func:`read_messages` (an MCAP log's messages), :func:`read_metadata`,
+  :func:`channel_counts`, :func:`final_mae`.
 - The report's names (figures, checks, runs) are in :mod:`cerebx.report.api`.
 """
 
@@ -29,7 +30,7 @@ from cerebx.plants.base import Plant, PlantEvent
 from cerebx.plants.check import check_plant
 from cerebx.plants.interaction import grab_anchor, half_sine
 from cerebx.plants.mujoco_arm import MujocoArm
-from cerebx.recording.reader import read_messages
+from cerebx.recording.reader import channel_counts, read_messages, read_metadata, read_summary
 from cerebx.schema.api import *  # noqa: F403 - the schema layer's names are part of this API
 from cerebx.schema.api import __all__ as _schema_names
 from cerebx.signals import Frame
@@ -55,6 +56,7 @@ __all__ = [
     "TorqueMsg",
     "TrialReference",
     "build_components",
+    "channel_counts",
     "check_experiment",
     "check_plant",
     "final_mae",
@@ -65,6 +67,8 @@ __all__ = [
     "ltd_kernel_table",
     "mf_ranges",
     "read_messages",
+    "read_metadata",
+    "read_summary",
     "save_state_npz",
     "updates_every",
 ]
