@@ -16,7 +16,9 @@ from its runs without running anything: ``cerebx report RUNS --out REPORT_DIR``)
                        includes): the table it opens with, its paper numbers beside cerebx's interval over
                        seeds (inside or not) and its figures' checks
 
-and rewrites the README's hero block (between ``<!-- hero:start -->`` and ``<!-- hero:end -->``) from the
+With ``--keep-missing``, a figure the new report did not draw (its runs not finished yet) keeps its earlier
+published entry and images, marked with the profile and date it came from (``kept_from``), and the stamp
+lists it. It rewrites the README's hero block (between ``<!-- hero:start -->`` and ``<!-- hero:end -->``) from the
 hero figure's entry (``--hero``, default fig3_4): its image, caption and the paper's ratios beside cerebx's.
 
 A docs page includes a figure with ``--8<-- "docs/results/<figure>.md"`` and the stamp with
@@ -41,7 +43,7 @@ from typing import Any
 from PIL import Image
 
 KNOWN = {"name", "title", "studies", "module", "files", "caption", "table", "notes", "checks", "intervals",
-         "convergence"}
+         "convergence", "kept_from"}
 HERO_START, HERO_END = "<!-- hero:start -->", "<!-- hero:end -->"
 # the hero table's rows: the quantities of the hero figure's table whose quantity starts with one of these
 HERO_ROWS = ("PD average MAE ÷ SNN", "ANN average MAE ÷ SNN", "SNN MAE ratio", "SNN average MAE over")
@@ -106,6 +108,11 @@ def stamp(report: dict[str, Any]) -> str:
     if report.get("wall_seconds"):
         summed = f"; its runs took {_hours(runs['wall_seconds'])} summed" if runs.get("wall_seconds") else ""
         took = f" The command took {_hours(report['wall_seconds'])} of wall time{summed}."
+    kept = [e for e in report.get("figures") or [] if e.get("kept_from")]
+    if kept:
+        names = ", ".join(f"`{e['name']}` ({e['kept_from'].get('profile')} profile, "
+                          f"{_day(e['kept_from'].get('built_at'))})" for e in kept)
+        took += f" Not yet in this report, so kept from an earlier one: {names}."
     return "\n".join([
         '!!! info "Where these figures and tables come from"',
         f"    `{report.get('command') or 'cerebx report'}` drew them on {_day(report.get('built_at'))} (cerebx "
@@ -159,9 +166,14 @@ def figure_markdown(entry: dict[str, Any], report: dict[str, Any], link_base: st
     notes = [f"- {_text(n)}" for n in entry.get("notes") or []] + list(_extras(entry))
     if notes:
         out += [*notes, ""]
-    profile = report.get("profile")
+    source = entry.get("kept_from") or report
+    profile = source.get("profile")
+    if entry.get("kept_from"):
+        out += [f"!!! warning \"From an earlier report\"\n    This figure is from the {profile} profile of "
+                f"{_day(source.get('built_at'))}: its {report.get('profile')}-profile runs were not finished when "
+                "this report was published.", ""]
     out += [f"<small>Studies: {', '.join(entry.get('studies') or [])}"
-            f"{f' ({profile} profile)' if profile else ''}; report of {_day(report.get('built_at'))}.</small>", ""]
+            f"{f' ({profile} profile)' if profile else ''}; report of {_day(source.get('built_at'))}.</small>", ""]
     return "\n".join(out)
 
 
@@ -193,8 +205,19 @@ def _why(check: dict[str, Any], link_base: str) -> str:
     return f"[why]({_doc_link(at, link_base)})" if at else "**not explained**"
 
 
+def _kept_note(figures: list[dict[str, Any]]) -> list[str]:
+    kept = [e for e in figures if e.get("kept_from")]
+    if not kept:
+        return []
+    return ["", "Not counted here (kept from an earlier report, their runs not finished): "
+            + ", ".join(f"`{e['name']}` ({e['kept_from'].get('profile')} profile)" for e in kept) + "."]
+
+
 def checks_markdown(figures: list[dict[str, Any]], link_base: str = "../results") -> str:
-    """Per figure: its checks, how many hold, and each failing one with its explanation (or none)."""
+    """Per figure: its checks, how many hold, and each failing one with its explanation (or none); figures
+    kept from an earlier report are named, not counted."""
+    note = _kept_note(figures)
+    figures = [e for e in figures if not e.get("kept_from")]
     out = ["| figure | checks | hold | fail, explained | fail, not explained | converged |",
            "|---|---|---|---|---|---|"]
     totals = [0, 0, 0, 0]
@@ -205,6 +228,7 @@ def checks_markdown(figures: list[dict[str, Any]], link_base: str = "../results"
         converged = "–" if not conv else ("yes" if conv.get("converged") else "no")
         out.append(f"| `{e['name']}` | {counts[0]} | {counts[1]} | {counts[2]} | {counts[3]} | {converged} |")
     out.append(f"| all | {totals[0]} | {totals[1]} | {totals[2]} | {totals[3]} | |")
+    out += note
     failing = [(e["name"], c) for e in figures for c in e.get("checks") or [] if c.get("holds") is False]
     if failing:
         out += ["", "Checks that fail:", ""]
@@ -217,7 +241,7 @@ def intervals_markdown(figures: list[dict[str, Any]]) -> str:
     """The headline numbers: the paper's beside cerebx's mean and 95 % interval over seeds, and whether the
     paper's number falls inside (– with one seed or no paper number)."""
     rows = [(e["name"], q, iv, next((r[1] for r in e.get("table") or [] if r and r[0] == q), "–"))
-            for e in figures for q, iv in (e.get("intervals") or {}).items()]
+            for e in figures if not e.get("kept_from") for q, iv in (e.get("intervals") or {}).items()]
     if not rows:
         return ""
     out = ["| figure | quantity | paper | cerebx, mean [95 % interval] | seeds | paper inside |",
@@ -251,7 +275,8 @@ def page_markdown(names: list[str], report: dict[str, Any], link_base: str) -> s
     figures = [e for e in report.get("figures") or [] if e["name"] in names]
     if not figures:
         return "No figure of this page was drawn in the published report.\n"
-    told, held, explained, unexplained = (sum(c) for c in zip(*(_checks(e) for e in figures), strict=True))
+    counted = [e for e in figures if not e.get("kept_from")] or [{}]
+    told, held, explained, unexplained = (sum(c) for c in zip(*(_checks(e) for e in counted), strict=True))
     head = (f"**In the published report ({report.get('profile') or 'runs'} profile):** {held} of {told} shape checks "
             f"hold, {explained} fail with an explanation, {unexplained} fail without one.\n\n")
     intervals = intervals_markdown(figures)
@@ -306,11 +331,30 @@ def render(report: dict[str, Any], link_base: str = "../results",
     return files
 
 
+def _kept(report: dict[str, Any], out: Path) -> tuple[list[dict[str, Any]], dict[str, bytes]]:
+    """The earlier published figures (in ``out``) that ``report`` does not draw, marked with where they came
+    from, and their images' bytes."""
+    old = load_report(out) if (out / "figures.json").is_file() else {}
+    drawn = {e["name"] for e in report.get("figures") or []}
+    entries, images = [], {}
+    for e in old.get("figures") or []:
+        if e["name"] in drawn:
+            continue
+        source = e.get("kept_from") or {k: old.get(k) for k in ("profile", "built_at", "commit")}
+        entries.append({**e, "kept_from": source})
+        for f in e.get("files") or []:
+            src = out / "figures" / Path(f).name
+            if not src.is_file():
+                raise PublishError(f"{out}: the kept figure {e['name']}'s image {src.name} is missing")
+            images[src.name] = src.read_bytes()
+    return entries, images
+
+
 def publish(report_dir: Path, out: Path, link_base: str = "../results", pages_dir: Path | None = None,
-            readme_path: Path | None = None, hero: str = "fig3_4") -> list[str]:
+            readme_path: Path | None = None, hero: str = "fig3_4", keep_missing: bool = False) -> list[str]:
     """Replace ``out`` with the published form of the report in ``report_dir`` (with an opening table for
-    each reproduction page of ``pages_dir``, and the hero block of ``readme_path`` rewritten); returns the
-    figure names."""
+    each reproduction page of ``pages_dir``, and the hero block of ``readme_path`` rewritten; ``keep_missing``:
+    the earlier published figures the report does not draw are kept, marked); returns the figure names."""
     report_dir, out = Path(report_dir), Path(out)
     report = load_report(report_dir)
     images = [(report_dir / f, Path(f).name) for e in report.get("figures") or [] for f in e.get("files") or []]
@@ -319,6 +363,8 @@ def publish(report_dir: Path, out: Path, link_base: str = "../results", pages_di
         raise PublishError(f"{report_dir}: images listed in figures.json are missing: {', '.join(absent)}")
     if out.exists() and any(out.iterdir()) and not (out / "figures.json").is_file():
         raise PublishError(f"{out}: not empty and not a published report (no figures.json): not replaced")
+    kept, kept_images = _kept(report, out) if keep_missing and out.exists() else ([], {})
+    report = {**report, "figures": [*(report.get("figures") or []), *kept]}
     if out.exists():
         shutil.rmtree(out)
     (out / "figures").mkdir(parents=True)
@@ -327,6 +373,8 @@ def publish(report_dir: Path, out: Path, link_base: str = "../results", pages_di
         (out / name).write_text(text)
     for src, name in images:
         _png(src, out / "figures" / name)
+    for name, data in kept_images.items():
+        (out / "figures" / name).write_bytes(data)
     if readme_path is not None and readme_path.is_file():
         rel = Path(os.path.relpath(out, readme_path.parent)).as_posix()
         block = hero_block({**report, "command": portable(report.get("command"))}, hero, f"{rel}/figures")
@@ -346,9 +394,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--readme", type=Path, default=Path("README.md"),
                     help="the README whose hero block to rewrite (default README.md; a missing one is skipped)")
     ap.add_argument("--hero", default="fig3_4", help="the hero figure (default fig3_4)")
+    ap.add_argument("--keep-missing", action="store_true",
+                    help="keep the earlier published figures this report does not draw, marked as such")
     a = ap.parse_args(argv)
     try:
-        names = publish(a.report, a.out, a.link_base, a.pages, a.readme, a.hero)
+        names = publish(a.report, a.out, a.link_base, a.pages, a.readme, a.hero, a.keep_missing)
     except PublishError as err:
         print(f"publish_report: {err}", file=sys.stderr)
         return 2

@@ -196,3 +196,34 @@ def test_checks_pages_and_hero_are_made_from_figures_json(tmp_path):
     assert "![fig3_4](docs/results/figures/fig3_4.png)" in text and "commit `abc123`" in text
     assert "| PD average MAE ÷ SNN average MAE | 3 to 4× larger | 3.5 |" in text and "unrelated" not in text
     assert not publisher.update_readme(pages / "ch3.md", block)  # no markers: left alone
+
+
+def test_a_figure_the_new_report_does_not_draw_keeps_its_earlier_entry_marked(tmp_path):
+    def report(folder: Path, profile: str, day: str, names: list[str]) -> Path:
+        (folder / "figures").mkdir(parents=True)
+        for n in names:
+            fig, ax = plt.subplots()
+            save(fig, folder / "figures" / n)
+        (folder / "figures.json").write_text(json.dumps({
+            "profile": profile, "built_at": f"{day}T12:00:00+00:00", "commit": "c0ffee",
+            "figures": [_entry(n, [{"claim": "c", "holds": False, "numbers": "", "explained_at": None}])
+                        for n in names]}))
+        return folder
+
+    out = tmp_path / "published"
+    publisher.publish(report(tmp_path / "old", "quick", "2026-11-24", ["fig3_4", "fig4_6"]), out)
+    publisher.publish(report(tmp_path / "new", "full", "2026-11-27", ["fig3_4"]), out, keep_missing=True)
+    made = json.loads((out / "figures.json").read_text())
+    assert [e["name"] for e in made["figures"]] == ["fig3_4", "fig4_6"]
+    assert made["figures"][1]["kept_from"]["profile"] == "quick" and "kept_from" not in made["figures"][0]
+    assert (out / "figures" / "fig4_6.png").is_file()
+    assert "From an earlier report" in (out / "fig4_6.md").read_text()
+    assert "`fig4_6` (quick profile, 2026-11-24)" in (out / "stamp.md").read_text()
+    checks = (out / "checks.md").read_text()
+    assert "| all | 1 | 0 | 0 | 1 |" in checks and "kept from an earlier report" in checks
+    # published again with the same report: still kept, still marked with where it came from
+    publisher.publish(tmp_path / "new", out, keep_missing=True)
+    again = json.loads((out / "figures.json").read_text())
+    assert again["figures"][1]["kept_from"]["built_at"].startswith("2026-11-24")
+    publisher.publish(tmp_path / "new", out)  # without the flag: only what the report drew
+    assert [e["name"] for e in json.loads((out / "figures.json").read_text())["figures"]] == ["fig3_4"]
