@@ -48,7 +48,9 @@ change of model, gain, delay or seed shows (those move these metrics by tens of 
 
 
 def this_platform() -> dict[str, str]:
-    """What the exact digests depend on."""
+    """What the exact digests depend on, the CPU that numba compiles for among them (two hosts that both
+    call themselves "AMD EPYC" can be different generations: numba's code for one rounds differently)."""
+    import llvmlite.binding
     import mujoco
     import numba
     import numpy
@@ -60,7 +62,8 @@ def this_platform() -> dict[str, str]:
     except OSError:
         pass
     return {"machine": platform.machine(), "cpu": cpu or platform.processor(), "python": platform.python_version(),
-            "numpy": numpy.__version__, "numba": numba.__version__, "mujoco": mujoco.__version__}
+            "numpy": numpy.__version__, "numba": numba.__version__, "mujoco": mujoco.__version__,
+            "llvm_cpu": llvmlite.binding.get_host_cpu_name()}
 
 
 def digest(run_dir: Path) -> dict:
