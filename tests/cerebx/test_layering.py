@@ -16,8 +16,11 @@ ROOT = Path(__file__).resolve().parents[2]
 LINT = Path(sys.executable).with_name("lint-imports")
 
 
+EXAMPLES = [ROOT / "examples" / "my_lab", ROOT / "examples" / "my_cerebellum"]  # root packages of the contracts too
+
+
 def _lint(src: Path, cwd: Path) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(src)}
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(map(str, [src, *EXAMPLES]))}
     return subprocess.run([str(LINT), "--no-cache", "--config", str(ROOT / "pyproject.toml")], cwd=cwd, env=env,
                           capture_output=True, text=True, timeout=300)
 
@@ -33,6 +36,7 @@ def test_the_tree_keeps_every_contract(tmp_path):
     ("cerebx/schema/planted.py", "import cerebx.loop.runner", "The schema layer imports no runtime module"),
     ("cerebx/stages/planted.py", "import cerebx.report.build", "import no report"),
     ("cerebx_luque2011/planted.py", "import cerebx_capolei2020.task", "The papers are independent"),
+    ("cerebx_thesis/planted.py", "from cerebx.loop.runner import run_experiment", "import only cerebx's public API"),
 ])
 def test_a_planted_violation_breaks_its_contract(tmp_path, where, line, contract):
     src = tmp_path / "src"
