@@ -4,7 +4,7 @@ Importing this package registers the figures with the report engine."""
 
 from pathlib import Path
 
-from cerebx.report.api import studies
+from cerebx.report.api import explanations, studies
 from cerebx_thesis.report import (  # noqa: F401 - their import registers the figures
     adaptation,
     baxter_muscles,
@@ -18,3 +18,4 @@ from cerebx_thesis.report import (  # noqa: F401 - their import registers the fi
 )
 
 studies(Path(__file__).with_name("studies.yaml"))
+explanations(Path(__file__).with_name("explanations.yaml"))
