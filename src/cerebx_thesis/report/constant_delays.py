@@ -137,6 +137,7 @@ def fig3_4(runs: RunSet, stem: Path) -> Figure:
             averaged = [tv_as_paper(r, c) for r in sweep.values()]
             ax_b.plot(x, [np.nan if v is None else v for v in averaged], marker="s", color=color,
                       label=f"{name}, trial-averaged torque (Eq. 3.13)")
+    seeds_note = _seed_band(ax_a, runs)
     pos = reference_run(runs, "position")
     if pos is not None:
         ax_a.axhline(pos.mae.mean(), ls="--", color="0.4", lw=1.1, label="factory position, no delay")
@@ -191,12 +192,32 @@ def fig3_4(runs: RunSet, stem: Path) -> Figure:
                "trial's). "
                f"Runs — {counts}. The thesis used 100 trials per δT and stopped PD and ANN at 50 ms; every δT "
                "run is shown here. The dashed grey line is the factory position controller without delay "
-               "(where such a run exists).")
+               f"(where such a run exists).{seeds_note}")
     table = [row if row[0] not in intervals or not intervals[row[0]].has_interval
              else [*row[:2], f"{row[2]}; over seeds {intervals[row[0]].text(2 if '÷' in row[0] else 3)}"]
              for row in table]
     checks, conv = _fig3_4_shape(runs, sweeps, intervals)
     return Figure([png], caption, table, notes, checks, conv, intervals)
+
+
+def _seed_band(ax, runs: RunSet) -> str:
+    """The SNN's MAE per delay as the mean over its independently learned seeds with a 95 % interval (when
+    there are at least two), drawn on ``ax``; the caption's sentence for it."""
+    per_delay: dict[float, list[float]] = {}
+    for rs in runs.seeds().values():
+        for d, r in delay_sweep(rs, "snn")[0].items():
+            per_delay.setdefault(d, []).append(float(r.mae.mean()))
+    ivs = {d: interval(v) for d, v in sorted(per_delay.items()) if len(v) >= 2}
+    if not ivs:
+        return ""
+    x = np.array(list(ivs))
+    m = np.array([iv.mean for iv in ivs.values()])
+    err = np.array([[iv.mean - iv.low for iv in ivs.values()], [iv.high - iv.mean for iv in ivs.values()]])
+    n = min(iv.n for iv in ivs.values())
+    ax.errorbar(x + 1.5, m, err, marker="D", ms=4, capsize=4, color="C0", ls="none", alpha=0.8,
+                label=f"SNN, mean of {n} learned seeds, 95 % interval")
+    return (f" Blue diamonds (shifted right by 1.5 ms to be seen): the SNN's mean MAE over {n} independently "
+            "learned states (seeds) with its 95 % interval (Student's t).")
 
 
 def _sample_ee(run: Run, trials: int = FIG3_5_TRIALS) -> tuple[np.ndarray, np.ndarray, int]:
