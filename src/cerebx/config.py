@@ -417,10 +417,18 @@ def _refused_folder(value: str) -> str | None:
 
 
 def _holds_runs(folder: Path) -> bool:
-    """``folder`` is empty, a run's or a sweep's, or holds only logs (the report writes a job's log first)."""
+    """``folder`` is empty, a run's or a sweep's (its jobs' folders, even of a sweep cut short before it wrote
+    multirun.yaml), or holds only logs (the report writes a study's log first)."""
     try:
         entries = list(folder.iterdir())
     except OSError:
         return True  # not readable: whether a run can go there is for the creation probe to say
     return (any(e.name in RUN_MARKERS for e in entries)
-            or all(e.is_file() and e.suffix == ".log" for e in entries))
+            or all((e.is_file() and e.suffix == ".log") or (e.is_dir() and _is_run(e)) for e in entries))
+
+
+def _is_run(folder: Path) -> bool:
+    try:
+        return any(e.name in RUN_MARKERS for e in folder.iterdir())
+    except OSError:
+        return False

@@ -89,6 +89,16 @@ def test_the_default_run_folder_is_accepted_beside_other_files_in_runs(multirun,
     assert main(["validate", *(["-m"] if multirun else []), *DEMO]) == 0
 
 
+def test_a_sweep_cut_short_may_go_on_in_its_folder(in_tmp, capsys):
+    """A sweep stopped before Hydra wrote multirun.yaml leaves its jobs' folders and the report's study.log."""
+    sweep = in_tmp / "sweep"
+    (sweep / "delay.total_ms=40" / ".hydra").mkdir(parents=True)
+    (sweep / "study.log").write_text("")
+    assert main(["validate", "-m", *DEMO, f"hydra.sweep.dir={sweep}"]) == 0
+    (sweep / "notes.txt").write_text("")
+    assert main(["validate", "-m", *DEMO, f"hydra.sweep.dir={sweep}"]) == 2
+
+
 def test_multirun_validates_every_job(in_tmp, capsys):
     assert main(["validate", "-m", *DEMO, "seed=1,2"]) == 0
     out = capsys.readouterr().out.strip().splitlines()
