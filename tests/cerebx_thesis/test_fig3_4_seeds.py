@@ -45,6 +45,7 @@ def test_each_seed_is_measured_against_the_deterministic_controllers(tmp_path):
     assert pd.values[0] == pytest.approx(0.09 / np.mean([0.015, 0.0165, 0.01875]))
     assert iv["ANN average MAE ÷ SNN average MAE"].n == 3  # the first seed's ANN for seeds 1 and 2
     assert iv["SNN MAE ratio 80 / 0 ms"].values == pytest.approx((1.25, 1.25, 1.25))
+    assert iv["PD MAE at δT = 0 ms (rad)"].n == 1 and iv["ANN average MAE over δT ≤ 50 ms (rad)"].n == 1
 
 
 def test_the_headline_checks_decide_on_the_mean_over_seeds(tmp_path, monkeypatch):

@@ -29,6 +29,7 @@ class Run:
     dir: Path
     summary: dict[str, Any]
     _config: dict[str, Any] | None = field(default=None, repr=False)
+    _cache: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     @classmethod
     def load(cls, run_dir: Path | str) -> Run:
@@ -182,9 +183,11 @@ class Run:
 
     def torque_variability_of_mean(self) -> float | None:
         """Torque variability of the trial-averaged applied torque (Eq. 3.13-3.15, N·m/ms) over this run's
-        measured trials, or None."""
-        got = self.applied_torque()
-        return None if got is None else torque_variability_of_mean(*got)
+        measured trials, or None; read from the log once per run (a figure and its checks both ask)."""
+        if "tv_of_mean" not in self._cache:
+            got = self.applied_torque()
+            self._cache["tv_of_mean"] = None if got is None else torque_variability_of_mean(*got)
+        return self._cache["tv_of_mean"]
 
     def control(self, keys: Iterable[str], t0: float | None = None, t1: float | None = None,
                 every: int = 1) -> dict[str, np.ndarray]:

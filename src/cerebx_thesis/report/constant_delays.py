@@ -110,7 +110,10 @@ def fig3_4_intervals(runs: RunSet) -> dict[str, Interval]:
         ann = delay_sweep(rs, "ann")[0] or ann_first
         for k, v in headline({"pd": pd_sweep, "ann": ann, "snn": snn}).items():
             per_seed.setdefault(k, []).append(v)
-    return {k: interval(v, PAPER_HEADLINE.get(k)) for k, v in per_seed.items()}
+    # PD's and the ANN's own numbers, the same run's whatever the SNN's seed: one value, no interval
+    fixed = {k: v[:1] for k, v in per_seed.items()
+             if k.startswith(("PD", "ANN")) and "÷ SNN" not in k and len(set(v)) == 1}
+    return {k: interval(fixed.get(k, v), PAPER_HEADLINE.get(k)) for k, v in per_seed.items()}
 
 
 @figure("fig3_4", "PD, ANN and SNN under constant round-trip delays", studies=("fig3_4_snn", "fig3_4_ann", "fig3_4_pd"))
