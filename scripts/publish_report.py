@@ -264,7 +264,8 @@ def reproduction_pages(pages_dir: Path) -> dict[str, list[str]]:
     """Each reproduction page's stem and the figures it includes (in order)."""
     out: dict[str, list[str]] = {}
     for page in sorted(Path(pages_dir).glob("*.md")):
-        names = [n for n in INCLUDE.findall(page.read_text()) if n not in ("stamp", "checks") and not n.startswith("page_")]
+        names = [n for n in INCLUDE.findall(page.read_text())
+                 if n not in ("stamp", "checks") and not n.startswith("page_")]
         if names:
             out[page.stem] = names
     return out
