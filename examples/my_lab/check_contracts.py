@@ -2,7 +2,7 @@
 stage of its demo experiment (the rate limiter among them) to the stage contract. Raises on the first breach."""
 
 from cerebx.api import build_components, check_experiment, check_plant, load
-from cerebx.schema.api import plants
+from cerebx.api.schema import plants
 
 cfg, _ = load(["+experiment=pendulum_demo"])
 check_plant(lambda: plants.build(cfg.plant, None))

@@ -20,8 +20,8 @@ import numpy as np
 
 from cerebx import registry
 from cerebx.controllers.base import Controller
+from cerebx.delay_channel import Link
 from cerebx.errors import ConfigError
-from cerebx.loop.link import Link
 from cerebx.signals import Signal
 from cerebx.stages.base import Receiver, Stage
 from cerebx.stages.controllers import Composite, TorqueControllerStage

@@ -32,7 +32,7 @@ def register() -> None:
 
     registry.controllers.register(c.PDController, "cerebx.controllers.pd:PD")
     registry.controllers.register(c.PositionController, "cerebx.controllers.position:PositionServo")
-    registry.controllers.register(c.PIDVelocity, "cerebx.controllers.pid:build_pid")
+    registry.controllers.register(c.PIDVelocity, "cerebx.stages.pid:build_pid")
     registry.controllers.register(c.CompositeController, "cerebx.build:build_composite")
     registry.controllers.register(snn.SNNController, "cerebx.controllers.snn.controller:SNNControllerImpl")
     registry.controllers.register(m.MuscleRestController, "cerebx.stages.muscles:build_muscle_rest")

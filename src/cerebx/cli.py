@@ -14,8 +14,8 @@ import os
 import sys
 
 from cerebx import __version__
+from cerebx.commands import COMMANDS, run_command
 from cerebx.commands.common import fail
-from cerebx.errors import CerebxError
 from cerebx.jobenv import numba_cache_dir
 
 USAGE = """usage: cerebx COMMAND [args]
@@ -38,20 +38,6 @@ groups: task (required, +task=), controller (snn), plant (baxter), delay (none),
         experiment (presets: +experiment=NAME); network (full), with controller=snn
 every command: cerebx COMMAND --help
 """
-
-COMMANDS = {**{name: f"cerebx.commands.{name}" for name in
-               ("run", "validate", "inspect", "plot", "bench", "report", "tune", "summarize")},
-            "robot": "cerebx.loop.robot_side", "relay": "cerebx.link.relay", "delays": "cerebx.link.trace"}
-"""Command name -> the module whose ``main(args)`` runs it."""
-
-
-def run_command(name: str, args: list[str]) -> int:
-    """Run command ``name``; a CerebxError it raises is its one-line message and exit code 2."""
-    try:
-        return importlib.import_module(COMMANDS[name]).main(args)
-    except CerebxError as err:
-        return fail([str(err)])
-
 
 def main(argv: list[str] | None = None) -> int:
     try:

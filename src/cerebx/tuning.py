@@ -27,8 +27,8 @@ import numpy as np
 from cerebx.build import BuildContext, build_components
 from cerebx.config import load
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
+from cerebx.delay_channel import Link
 from cerebx.errors import CerebxError, Diverged
-from cerebx.loop.link import Link
 from cerebx.loop.loop import ClosedLoop
 from cerebx.schema.controller import PDController
 from cerebx.stages.controllers import TorqueControllerStage

@@ -5,7 +5,7 @@ and figures.
 Registered through the ``cerebx.plugins`` entry point ``capolei2020`` (see pyproject.toml).
 """
 
-from cerebx.schema.api import add_config_source, add_report, controllers, plants, tasks
+from cerebx.api.schema import add_config_source, add_report, controllers, plants, tasks
 from cerebx_capolei2020.modules.schema import CapoleiForward, CapoleiInverse
 from cerebx_capolei2020.schema import ICubWristConfig, WristOscillationTask
 

@@ -7,7 +7,7 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
-from cerebx.schema.api import NonNegFloat, PhysicsStepMs, PlantSchema, PositiveFloat, Strict
+from cerebx.api.schema import NonNegFloat, PhysicsStepMs, PlantSchema, PositiveFloat, Strict
 
 
 class ICubWristConfig(PlantSchema):

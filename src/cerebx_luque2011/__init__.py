@@ -4,7 +4,7 @@ on three joints of a lightweight arm manipulating objects, with its presets, stu
 Registered through the ``cerebx.plugins`` entry point ``luque2011`` (see pyproject.toml).
 """
 
-from cerebx.schema.api import add_config_source, add_report, controllers, plants, tasks
+from cerebx.api.schema import add_config_source, add_report, controllers, plants, tasks
 from cerebx_luque2011.cerebellum.schema import Luque2011Cerebellum
 from cerebx_luque2011.schema import CrudeInverseDynamics, LuqueEightTask, LWR3Config
 

@@ -10,7 +10,7 @@ from typing import ClassVar, Literal
 
 from pydantic import Field
 
-from cerebx.schema.api import (
+from cerebx.api.schema import (
     ControllerConfig,
     NonNegFloat,
     PhysicsStepMs,

@@ -5,7 +5,7 @@ Registered through the ``cerebx.plugins`` entry point ``thesis`` (see pyproject.
 package would be.
 """
 
-from cerebx.schema.api import add_bench_run, add_config_source, add_report, controllers
+from cerebx.api.schema import add_bench_run, add_config_source, add_report, controllers
 from cerebx_thesis.ann.schema import ANNController
 
 

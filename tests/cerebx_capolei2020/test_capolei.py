@@ -9,10 +9,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from cerebx.controllers.pid import PIDVelocityStage
 from cerebx.loop.runner import run_experiment
 from cerebx.schema.controller import PIDVelocity
 from cerebx.signals import Frame
+from cerebx.stages.pid import PIDVelocityStage
 from cerebx_capolei2020.modules.circuit import ModularCerebellarCircuit, k
 from cerebx_capolei2020.modules.controller import ForwardModuleStage
 from cerebx_capolei2020.modules.schema import CapoleiForward, CapoleiInverse

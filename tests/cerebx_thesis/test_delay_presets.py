@@ -10,9 +10,9 @@ import pytest
 
 from cerebx import registry
 from cerebx.build import BuildContext
+from cerebx.delay_channel import DelayChannel
 from cerebx.guard import conf_roots
 from cerebx.loop.delays import Percentiles
-from cerebx.loop.link import DelayChannel
 from cerebx.report.studies import preset_sweep
 
 ROOT = Path(__file__).resolve().parents[2]

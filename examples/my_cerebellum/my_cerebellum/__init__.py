@@ -1,6 +1,6 @@
 """A cerebellar adaptive filter as a cerebx plugin: one function registers the model's kind and its presets."""
 
-from cerebx.schema.api import add_config_source, controllers
+from cerebx.api.schema import add_config_source, controllers
 from my_cerebellum.schema import AdaptiveFilterConfig
 
 

@@ -6,7 +6,7 @@ from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
-from cerebx.schema.api import ControllerConfig
+from cerebx.api.schema import ControllerConfig
 
 
 class AdaptiveFilterConfig(ControllerConfig):

@@ -1,7 +1,7 @@
 """A lab's additions to cerebx as one plugin: a pendulum plant, a robot-side torque rate limiter, a swing task,
 their presets, and a report module with one figure and the study it needs."""
 
-from cerebx.schema.api import add_config_source, add_report, plants, stages, tasks
+from cerebx.api.schema import add_config_source, add_report, plants, stages, tasks
 from my_lab.schema import PendulumConfig, RateLimitConfig, SwingTask
 
 

@@ -7,7 +7,7 @@ from typing import ClassVar, Literal
 
 from pydantic import Field, model_validator
 
-from cerebx.schema.api import (
+from cerebx.api.schema import (
     NonNegFloat,
     PhysicsStepMs,
     PlantSchema,

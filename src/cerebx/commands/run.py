@@ -11,8 +11,9 @@ import os
 import re
 import sys
 
-from cerebx import cli, sweep
+from cerebx import sweep
 from cerebx.app import run_app
+from cerebx.commands import COMMANDS, run_command
 from cerebx.commands.common import fail
 from cerebx.compile_progress import show_progress
 from cerebx.config import check, check_output_dir, output_root, split_args
@@ -62,7 +63,7 @@ def main(args: list[str]) -> int:
     run_app()
     if root is None:
         return 0
-    return cli.run_command("summarize", [str(root), "--end-of-sweep"])
+    return run_command("summarize", [str(root), "--end-of-sweep"])
 
 
 def size_problems(estimates: list, args: list[str], multirun: bool, cold: ColdKernels | None = None) -> list[str]:
@@ -88,7 +89,7 @@ def completion(argv: list[str]) -> int:
         words = line.split()
         if len(words) <= 1 or (len(words) == 2 and not line.endswith(" ")):
             prefix = words[1] if len(words) == 2 else ""
-            print(" ".join(c for c in cli.COMMANDS if c.startswith(prefix)))
+            print(" ".join(c for c in COMMANDS if c.startswith(prefix)))
             return 0
         os.environ["COMP_LINE"] = re.sub(r"^(\s*\S+)\s+(?:run|validate)\b", r"\1", line)
     sys.argv = [sys.argv[0]] + argv

@@ -1,6 +1,6 @@
 """The real link between the brain side and the robot side (docs/guide/links.md).
 
-In simulated time the link is the tick-grid delay channel of ``loop/link.py``. With a real link the
+In simulated time the link is the tick-grid delay channel of ``delay_channel.py``. With a real link the
 two sides are separate processes joined by a registered transport (``zenoh``, ``udp``; a plugin may
 add more), exchanging authenticated packets of the versioned wire format (``wire.py``):
 

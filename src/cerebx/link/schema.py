@@ -136,15 +136,4 @@ class UdpLink(RealLink):
     kind: Literal["udp"] = "udp"
 
 
-def clock_problems(exp: object) -> list[str]:
-    """Cross-field checks of ``link`` and ``clock`` for the experiment validator."""
-    link, clock = exp.link, exp.clock  # type: ignore[attr-defined]
-    if link.real and clock != "wall":
-        return [f"clock: link={link.kind} crosses processes and runs in wall-clock time (add clock=wall)"]
-    if not link.real and clock == "wall":
-        return ["clock: wall-clock pacing needs a real link (link=zenoh or link=udp)"]
-    return []
-
-
-__all__ = ["Address", "RealLink", "SheddingConfig", "SimLink", "UdpLink", "ZenohLink",
-           "clock_problems", "split_address"]
+__all__ = ["Address", "RealLink", "SheddingConfig", "SimLink", "UdpLink", "ZenohLink", "split_address"]

@@ -120,5 +120,5 @@ def with_free_ports(cfg: RealLink, udp: bool) -> RealLink:
 
 
 def build_sim(cfg: Any, *args: Any) -> None:
-    """The ``sim`` link has no transport: its channels are the tick-grid ones of ``loop/link.py``."""
+    """The ``sim`` link has no transport: its channels are the tick-grid ones of ``delay_channel.py``."""
     return None

@@ -186,10 +186,17 @@ class _Pickler(cloudpickle.Pickler):
         return "plain", None
 
 
+MOVED = {"cerebx.controllers.pid": "cerebx.stages.pid", "cerebx.loop.link": "cerebx.delay_channel"}
+"""Modules renamed since a checkpoint may have been written (old -> new), so that an earlier run resumes."""
+
+
 class _Unpickler(pickle.Unpickler):
     def __init__(self, fh: Any, arrays: dict[str, np.ndarray], objects: dict[str, Any]):
         super().__init__(fh)
         self.arrays, self.objects = arrays, objects
+
+    def find_class(self, module: str, name: str) -> Any:
+        return super().find_class(MOVED.get(module, module), name)
 
     def persistent_load(self, pid: Any) -> Any:
         if isinstance(pid, tuple) and len(pid) == 2 and pid[0] == "array" and pid[1] in self.arrays:

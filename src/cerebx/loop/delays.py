@@ -1,4 +1,4 @@
-"""Delay models: per-message delay samplers for the two directions of the link (``loop/link.py``).
+"""Delay models: per-message delay samplers for the two directions of the link (``delay_channel.py``).
 
 Each delay kind has its own builder, registered with its schema in ``schema/builtin.py``; a plugin
 adds a kind the same way.

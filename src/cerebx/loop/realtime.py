@@ -1,7 +1,7 @@
 """What the two sides of a wall-clock run share: their extra MCAP channels, the per-tick timing log,
 link events, and the errors that end a side.
 
-A wall-clock run is one experiment split at the link (``loop/link.py`` in simulated time): the robot
+A wall-clock run is one experiment split at the link (``delay_channel.py`` in simulated time): the robot
 side (``robot_side.py``, ``cerebx robot``) steps the plant and everything after the link, paced by the
 monotonic clock; the brain side (``brain_side.py``, ``cerebx run ... link=... clock=wall``) steps the
 task reference and the brain stages as sensor messages arrive. The phases of ``loop.py`` keep their

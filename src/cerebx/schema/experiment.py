@@ -10,13 +10,21 @@ from pydantic import BaseModel, Field, ValidationError, create_model, model_vali
 
 from cerebx import registry, runfiles
 from cerebx.errors import ConfigError
-from cerebx.link.schema import clock_problems
 from cerebx.registry import Plugin
 from cerebx.schema.base import CONTROL_DT_MS, NonNegFloat, Strict
 from cerebx.schema.init_state import init_from_problems
 from cerebx.schema.live import LiveConfig
 from cerebx.wiring import BODY_SLOTS, wire
 
+
+def clock_problems(exp: object) -> list[str]:
+    """Cross-field checks of ``link`` and ``clock`` for the experiment validator."""
+    link, clock = exp.link, exp.clock  # type: ignore[attr-defined]
+    if link.real and clock != "wall":
+        return [f"clock: link={link.kind} crosses processes and runs in wall-clock time (add clock=wall)"]
+    if not link.real and clock == "wall":
+        return ["clock: wall-clock pacing needs a real link (link=zenoh or link=udp)"]
+    return []
 
 class ScheduledEvent(Strict):
     """An event at a time (``at_s``) or at the start of a trial (``at_trial``)."""

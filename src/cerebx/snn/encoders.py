@@ -16,7 +16,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from cerebx.controllers.snn.schema import BoxEncoder, CFEncoder
+from cerebx.snn.schema import BoxEncoder, CFEncoder
 
 STEP_S = 0.002
 

@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, model_validator
 
 from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
+from cerebx.schema.controller import GivenRanges, TaskRanges
 
 
 class Integration(Strict):
@@ -291,3 +292,39 @@ def _rule_count(rule, n_pre: int, n_post: int, where: str, problems: list[str]) 
         )
         return None
     return n_post * r.signals
+
+
+# ---- the encoders' schemas (their code: snn/encoders.py) ----
+
+class BoxEncoder(Strict):
+    """MF interval coding (Eq. 2.12-2.15): per signal, 10 fibres with box receptive fields;
+    the active fibre fires once per 2 ms step."""
+
+    role: ClassVar[str] = "mossy"
+
+    kind: Literal["box"] = "box"
+    fibers_per_signal: int = Field(10, gt=1)
+    width_factor: PositiveFloat = Field(0.500000000001, description="half-width in units of the centre step")
+    ranges: Annotated[GivenRanges | TaskRanges, Field(discriminator="kind")] = TaskRanges()
+
+
+class CFEncoder(Strict):
+    """CF stochastic error coding (docs/models.md#cf-error-coding): agonist/antagonist split by error sign;
+    rate = r_min + (r_max - r_min)(tanh((|e| - c_k)/w) + 1)/2, Bernoulli per 2 ms, bursts."""
+
+    role: ClassVar[str] = "climbing"
+
+    kind: Literal["tanh_bernoulli"] = "tanh_bernoulli"
+    rate_min_hz: NonNegFloat = 1.0
+    rate_max_hz: PositiveFloat = 10.0
+    center_min: NonNegFloat = 0.001
+    center_max: PositiveFloat = 0.01
+    max_burst: int = Field(6, ge=1)
+
+    @model_validator(mode="after")
+    def _ranges(self) -> CFEncoder:
+        if self.rate_min_hz >= self.rate_max_hz:
+            raise ValueError("rate_min_hz must be below rate_max_hz")
+        if self.center_min >= self.center_max:
+            raise ValueError("center_min must be below center_max")
+        return self

@@ -10,7 +10,7 @@ from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
-from cerebx.schema.api import (
+from cerebx.api.schema import (
     VELOCITY_ERROR,
     ControllerConfig,
     LWPRParams,

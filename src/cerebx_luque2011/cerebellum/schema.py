@@ -11,7 +11,7 @@ from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
-from cerebx.schema.api import ControllerConfig, NonNegFloat, PositiveFloat, Strict, TaskRanges
+from cerebx.api.schema import ControllerConfig, NonNegFloat, PositiveFloat, Strict, TaskRanges
 
 
 class ConductanceLIF(Strict):

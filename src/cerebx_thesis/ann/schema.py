@@ -6,7 +6,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, model_validator
 
-from cerebx.schema.api import ControllerConfig, GivenRanges, NonNegFloat, PositiveFloat, TaskRanges
+from cerebx.api.schema import ControllerConfig, GivenRanges, NonNegFloat, PositiveFloat, TaskRanges
 
 CIRCLE_K_POS = (2.0, 6.0, 6.66, 8.0, 8.0, 6.0)
 CIRCLE_K_VEL = (2.0, 1.66, 0.66, 0.66, 1.33, 0.66)

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from cerebx.delay_channel import DelayChannel
 from cerebx.loop.delays import Constant, Gamma
-from cerebx.loop.link import DelayChannel
 from cerebx.schema.delay import ConstantDelay, GammaParams
 
 

@@ -232,3 +232,17 @@ def test_older_recorded_layouts_are_the_same_experiment(tmp_path):
     assert resume.stale(older, recorded(old_value), done) is None
     assert resume.stale(older, recorded("something else"), done) is not None
     assert resume.stale(older, {**plain, "seed": 7}, done).startswith("the configuration changed: seed")
+
+
+def test_a_checkpoint_naming_a_moved_module_still_loads():
+    """The velocity PID moved from cerebx.controllers.pid to cerebx.stages.pid; a checkpoint written before
+    names the old module."""
+    import io
+    import pickle
+
+    from cerebx.loop.checkpoint import _Unpickler
+    from cerebx.stages.pid import PIDVelocityStage
+
+    data = pickle.dumps(PIDVelocityStage, protocol=0).replace(b"cerebx.stages.pid", b"cerebx.controllers.pid")
+    assert b"cerebx.controllers.pid" in data
+    assert _Unpickler(io.BytesIO(data), {}, {}).load() is PIDVelocityStage

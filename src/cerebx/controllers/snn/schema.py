@@ -5,52 +5,18 @@ Its code is ``controllers/snn/controller.py``; the network engine is ``cerebx.sn
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 from pydantic import Field, model_validator
 
 from cerebx.registry import Plugin
 from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
-from cerebx.schema.controller import ControllerConfig, GivenRanges, TaskRanges, muscle_command_signals
+from cerebx.schema.controller import ControllerConfig, muscle_command_signals
 from cerebx.signals import StageIO, torque_controller_io
-from cerebx.snn.schema import NetworkConfig
+from cerebx.snn.schema import BoxEncoder, CFEncoder, NetworkConfig
 
 DELAYED_RECEIVER = {"kind": "future_past", "min_future_samples": 2, "past_samples": 10, "decay_per_step": 0.998}
 """What ``efferent: auto`` puts in place of a ``mean`` receiver when the link delays."""
-
-
-class BoxEncoder(Strict):
-    """MF interval coding (Eq. 2.12-2.15): per signal, 10 fibres with box receptive fields;
-    the active fibre fires once per 2 ms step."""
-
-    role: ClassVar[str] = "mossy"
-
-    kind: Literal["box"] = "box"
-    fibers_per_signal: int = Field(10, gt=1)
-    width_factor: PositiveFloat = Field(0.500000000001, description="half-width in units of the centre step")
-    ranges: Annotated[GivenRanges | TaskRanges, Field(discriminator="kind")] = TaskRanges()
-
-
-class CFEncoder(Strict):
-    """CF stochastic error coding (docs/models.md#cf-error-coding): agonist/antagonist split by error sign;
-    rate = r_min + (r_max - r_min)(tanh((|e| - c_k)/w) + 1)/2, Bernoulli per 2 ms, bursts."""
-
-    role: ClassVar[str] = "climbing"
-
-    kind: Literal["tanh_bernoulli"] = "tanh_bernoulli"
-    rate_min_hz: NonNegFloat = 1.0
-    rate_max_hz: PositiveFloat = 10.0
-    center_min: NonNegFloat = 0.001
-    center_max: PositiveFloat = 0.01
-    max_burst: int = Field(6, ge=1)
-
-    @model_validator(mode="after")
-    def _ranges(self) -> CFEncoder:
-        if self.rate_min_hz >= self.rate_max_hz:
-            raise ValueError("rate_min_hz must be below rate_max_hz")
-        if self.center_min >= self.center_max:
-            raise ValueError("center_min must be below center_max")
-        return self
 
 
 class ErrorGains(Strict):

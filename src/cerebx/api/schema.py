@@ -2,7 +2,7 @@
 
 Everything here belongs to the schema layer, so importing it runs no physics, network or log (a config can be
 validated without MuJoCo or numba). The runtime names (stages, plants, tasks, the run reader) are in
-:mod:`cerebx.api`, the report's in :mod:`cerebx.report.api`; a plugin imports nothing else from cerebx (an
+:mod:`cerebx.api` too, the report's in :mod:`cerebx.report.api`; a plugin imports nothing else from cerebx (an
 import contract in ``pyproject.toml`` holds it to that).
 
 Registering kinds: each group is a :class:`~cerebx.registry.Registry` (``controllers``, ``stages``,

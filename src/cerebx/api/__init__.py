@@ -1,0 +1,50 @@
+"""The supported names for plugins: what a lab's package (and the paper plugins that ship with cerebx) may
+import from cerebx. Everything else is internal and may change between versions; an import contract in
+``pyproject.toml`` holds the paper packages and ``examples/`` to ``cerebx.api``, ``cerebx.api.schema`` and
+``cerebx.report.api`` (``make lint``).
+
+- Configuration (the schema layer: no physics, network or log loaded): the names of :mod:`cerebx.api.schema`,
+  re-exported here; a plugin's own ``schema`` modules import from there.
+- Runtime shapes: ``Stage`` (a part of the loop that reads and writes named signals every tick; a torque
+  controller is a stage), ``Controller`` (the older controller shape, still accepted), ``Plant`` (a robot or
+  body; ``MujocoArm`` for MuJoCo models), ``Task`` and ``TrialReference`` (desired trajectories), the encoders'
+  interface (``MossyEncoder``, ``ClimbingEncoder``: see the how-tos), ``Frame`` (one tick's signals), ``LWPR``.
+- Checkers a plugin runs in its tests: ``check_plant``, ``check_experiment``.
+- Learned state: ``save_state_npz``, ``load_state_npz``.
+- Building and loading an experiment: ``load`` (compose and validate a command line's overrides),
+  ``build_components``.
+- Reading runs: ``read_summary``, ``read_messages`` (an MCAP log's messages), ``read_metadata``,
+  ``channel_counts``, ``final_mae``.
+- The report's names (figures, checks, runs) are in :mod:`cerebx.report.api`.
+
+The runtime names load MuJoCo and numba; they are imported from :mod:`cerebx.api.runtime` on first use, so
+``import cerebx.api.schema`` (and this package) stays as light as the schema layer.
+"""
+
+from typing import Any
+
+from cerebx.api.schema import *  # noqa: F403 - the schema layer's names are part of this API
+from cerebx.api.schema import __all__ as _schema_names
+
+RUNTIME = (
+    "LWPR", "ClimbingEncoder", "ControlInput", "Controller", "Frame", "MossyEncoder", "MujocoArm", "Plant",
+    "PlantEvent", "Stage", "Task", "TorqueMsg", "TrialReference", "build_components", "channel_counts",
+    "check_experiment", "check_plant", "final_mae", "grab_anchor", "half_sine", "load", "load_state_npz",
+    "ltd_kernel_table", "mf_ranges", "read_messages", "read_metadata", "read_summary", "save_state_npz",
+    "updates_every",
+)
+"""The names :mod:`cerebx.api.runtime` provides."""
+
+__all__ = [*_schema_names, *RUNTIME]
+
+
+def __getattr__(name: str) -> Any:
+    if name in RUNTIME:
+        from cerebx.api import runtime
+
+        return getattr(runtime, name)
+    raise AttributeError(f"module 'cerebx.api' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)
