@@ -45,3 +45,19 @@ def test_a_planted_violation_breaks_its_contract(tmp_path, where, line, contract
     done = _lint(src, tmp_path)
     assert done.returncode != 0
     assert contract in done.stdout and "BROKEN" in done.stdout
+
+
+def test_no_two_folders_of_cerebx_import_each_other():
+    """Each top-level module or folder of cerebx depends on another one way only (the import graph, direct
+    imports, any depth of nesting below the folder)."""
+    import grimp
+
+    graph = grimp.build_graph("cerebx", include_external_packages=False)
+
+    def top(module: str) -> str:
+        return ".".join(module.split(".")[:2])
+
+    edges = {(top(m), top(i)) for m in graph.modules for i in graph.find_modules_directly_imported_by(m)
+             if top(m) != top(i)}
+    ties = sorted({tuple(sorted(e)) for e in edges if (e[1], e[0]) in edges})
+    assert not ties, f"folders importing each other: {ties}"
