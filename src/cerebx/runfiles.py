@@ -10,7 +10,7 @@ A run folder (Hydra's output directory) holds:
 ``checkpoint.pkl``       the whole live loop every ``checkpoint_every`` trials (``resume``), with a
                          small JSON head ``checkpoint.pkl.json``, its large learned arrays in
                          ``checkpoint.<n>.arrays`` and the last changes to them in ``checkpoint.journal``
-                         (``loop/checkpoint.py``); all deleted when the run completes
+                         (``persistence/checkpoint.py``); all deleted when the run completes
 ``error.txt``            a sweep job refused before its run started: why
 ``robot/``, ``relay/``   a wall-clock run over a real link: the robot side's run folder and the delay
                          relay's counts and drawn delays (``injected.csv``)

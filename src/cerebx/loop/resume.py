@@ -3,7 +3,7 @@
 Every ``checkpoint_every`` trials the run writes, into its folder, the whole live loop (plant, task, stages,
 link with the messages in flight, every random generator, the tick and trial counters, the per-trial metrics
 so far): ``checkpoint.pkl`` with its head (also copied to ``checkpoint.pkl.json``), and the large learned
-arrays beside it (``loop/checkpoint.py``: written by a thread of its own while the run goes on, atomically,
+arrays beside it (``persistence/checkpoint.py``: written by a thread of its own while the run goes on, atomically,
 only what changed since the last checkpoint). The learned state itself (``controller_state.npz``, what
 ``init_from`` starts from) is written when the run ends, also when it is interrupted or fails; a run killed
 outright (SIGKILL, OOM) is continued from its checkpoint instead.
@@ -28,8 +28,8 @@ import yaml
 
 from cerebx import __version__, runfiles
 from cerebx.errors import CerebxError, ConfigError
-from cerebx.loop import checkpoint
 from cerebx.loop.loop import ClosedLoop
+from cerebx.persistence import checkpoint
 from cerebx.recording.reader import read_metadata
 from cerebx.recording.recorder import Recorder
 from cerebx.recording.segments import FIRST, add_segment
@@ -71,7 +71,7 @@ def checkpoint_head(run_dir: Path) -> dict:
 
 class Checkpointer:
     """Writes a run's checkpoints: the loop's thread pickles the state and copies what changed, a thread of
-    its own writes it (``loop/checkpoint.py``); :meth:`close` waits until the last one is on the disk."""
+    its own writes it (``persistence/checkpoint.py``); :meth:`close` waits until the last one is on the disk."""
 
     def __init__(self, run_dir: Path):
         self.run_dir = Path(run_dir)

@@ -279,7 +279,7 @@ class Network:
     def changed_ranges(self) -> list[tuple[np.ndarray, np.ndarray, int]]:
         """The weights written since the last call, as (array, start offsets, length) ranges: the rows of
         the plastic projections the kernels marked (LTP, LTD), or all of ``dense_w`` after a load. Lets a
-        checkpoint rewrite only those (``loop/checkpoint.py``); the call starts a new interval.
+        checkpoint rewrite only those (``persistence/checkpoint.py``); the call starts a new interval.
 
         The arrays the network never writes after its build (:meth:`_fixed`) are reported too, whole after a
         load and with no range since: a checkpoint then keeps them in its arrays file, written once per

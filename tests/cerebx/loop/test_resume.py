@@ -17,7 +17,8 @@ import pytest
 
 from cerebx.controllers.snn.schema import SNNController
 from cerebx.errors import ConfigError
-from cerebx.loop import checkpoint, resume
+from cerebx.loop import resume
+from cerebx.persistence import checkpoint
 from cerebx.recording.reader import channel_counts, read_messages, read_metadata
 from cerebx.recording.segments import segments
 
@@ -240,7 +241,7 @@ def test_a_checkpoint_naming_a_moved_module_still_loads():
     import io
     import pickle
 
-    from cerebx.loop.checkpoint import _Unpickler
+    from cerebx.persistence.checkpoint import _Unpickler
     from cerebx.stages.pid import PIDVelocityStage
 
     data = pickle.dumps(PIDVelocityStage, protocol=0).replace(b"cerebx.stages.pid", b"cerebx.controllers.pid")

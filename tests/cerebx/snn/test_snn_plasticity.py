@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cerebx.loop import checkpoint
+from cerebx.persistence import checkpoint
 from cerebx.snn.network import Network
 from cerebx.snn.presets import PC
 from cerebx.snn.schema import NetworkConfig

@@ -186,7 +186,8 @@ class _Pickler(cloudpickle.Pickler):
         return "plain", None
 
 
-MOVED = {"cerebx.controllers.pid": "cerebx.stages.pid", "cerebx.loop.link": "cerebx.delay_channel"}
+MOVED = {"cerebx.controllers.pid": "cerebx.stages.pid", "cerebx.loop.link": "cerebx.delay_channel",
+         "cerebx.loop.checkpoint": "cerebx.persistence.checkpoint"}
 """Modules renamed since a checkpoint may have been written (old -> new), so that an earlier run resumes."""
 
 

@@ -1,4 +1,4 @@
-"""Checkpoint files (``loop/checkpoint.py``): the tracked arrays whole in the first checkpoint, only their
+"""Checkpoint files (``persistence/checkpoint.py``): the tracked arrays whole in the first checkpoint, only their
 changed ranges in later ones, and a crash at any point leaving one whole checkpoint, the old or the new."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import cloudpickle
 import numpy as np
 import pytest
 
-from cerebx.loop import checkpoint
+from cerebx.persistence import checkpoint
 
 
 class Tracked:
