@@ -34,12 +34,14 @@ from pathlib import Path
 from typing import Any
 
 from cerebx import __version__, runfiles
-from cerebx.config import estimate_jobs
+from cerebx.config import estimate_jobs, load
 from cerebx.errors import CerebxError
+from cerebx.estimate import estimate
 from cerebx.report import figures
 from cerebx.report.badge import stamp
 from cerebx.report.delays import delay_rows
 from cerebx.report.explain import explain, load_explanations
+from cerebx.report.pace import profile_pace, remaining_wall_s
 from cerebx.report.plot import fmt
 from cerebx.report.registry import Figure, FigureSpec, MissingRuns, all_figures
 from cerebx.report.runs import RunSet, find_run_dirs, load_runs
@@ -311,6 +313,25 @@ a MuJoCo model); the shapes and orderings are what should hold.</p>
     return index, problems + missing, len(runs)
 
 
+def _at_measured_pace(jobs: list, folder: Path, parallel: int) -> str | None:
+    """The remaining runs' wall time at the pace of the profile's finished runs (``report/pace.py``), or None
+    when none has finished."""
+    exps: dict[Path, Any] = {}
+    for j in jobs:
+        try:
+            exps[j.run_dir] = load([o for o in j.overrides() if not o.lstrip("+").startswith("init_from=")])[0]
+        except CerebxError:
+            continue
+    done = {j.run_dir for j in jobs if j.done()}
+    pace = profile_pace(folder, {d: estimate(e).wall_s for d, e in exps.items() if d in done})
+    if not pace.runs:
+        return None
+    left = [e for d, e in exps.items() if d not in done]
+    wall = remaining_wall_s(pace, left, parallel)
+    return (f"at the pace of this profile's {pace.runs} finished runs (by kind of run, --jobs {parallel}): "
+            f"~{wall / 3600:.1f} h")
+
+
 def needed_studies(names: list[str] | None) -> list[str]:
     specs = all_figures()
     chosen = [specs[n] for n in names if n in specs] if names else list(specs.values())
@@ -357,6 +378,9 @@ def main(argv: list[str]) -> int:
                 todo = [j.overrides() for j in jobs if not j.done()]
                 est, bad = estimate_jobs(todo)
                 print(f"{len(todo)} runs to do: {est.line()}", *bad, sep="\n")
+                paced = _at_measured_pace(jobs, root / a.profile, a.jobs)
+                if paced:
+                    print(paced)
                 return 0
             try:
                 failed = execute(group(jobs), runner=study_runner(a.override), parallel=a.jobs)

@@ -1,0 +1,37 @@
+"""The remaining runs of a profile at the pace its finished runs went, by kind of run, shared out over jobs."""
+
+from __future__ import annotations
+
+import pytest
+
+from cerebx.config import load
+from cerebx.estimate import estimate
+from cerebx.report.pace import kind_of, measured_pace, remaining_wall_s
+
+pytestmark = pytest.mark.unit
+
+
+def _summary(controller: str, plant: str, delay: str, sim: float, wall: float, status: str = "completed") -> dict:
+    return {"controller": controller, "network": None, "plant": plant, "delay": delay, "sim_seconds": sim,
+            "wall_seconds": wall, "status": status}
+
+
+def test_a_run_takes_the_median_pace_of_its_kind_and_runs_share_the_machine():
+    exp, _ = load(["+experiment=demo", "trials=10"])  # PD on the planar arm, 20 s simulated
+    quiet = estimate(exp).wall_s
+    pace = measured_pace([(_summary("pd", "planar2", "none", 20.0, 2.0), quiet),
+                          (_summary("pd", "planar2", "none", 20.0, 4.0), quiet),
+                          (_summary("pd", "planar2", "none", 20.0, 1.0), quiet),
+                          (_summary("pd", "planar2", "constant", 20.0, 10.0), quiet),
+                          (_summary("pd", "planar2", "none", 20.0, 99.0, status="failed"), quiet)])
+    assert pace.runs == 4 and pace.per_kind[kind_of("pd", None, "planar2", "none")] == 10.0  # median of 10, 5, 20
+    assert pace.wall_s(exp) == pytest.approx(2.0)
+    assert remaining_wall_s(pace, [exp, exp, exp, exp], jobs=2) == pytest.approx(4.0)
+
+
+def test_a_kind_without_finished_runs_is_the_quiet_estimate_slowed_as_the_others_were():
+    exp, _ = load(["+experiment=demo", "trials=10"])
+    quiet = estimate(exp).wall_s
+    pace = measured_pace([(_summary("snn", "baxter", "none", 100.0, 3 * quiet), quiet)])
+    assert pace.slowdown == pytest.approx(3.0)
+    assert pace.wall_s(exp) == pytest.approx(3 * quiet)
