@@ -32,6 +32,7 @@ from cerebx.report.api import (  # noqa: E402
     save,  # noqa: E402
     studies,
     study_plateau,  # noqa: E402
+    with_intervals,
 )
 
 studies(Path(__file__).with_name("studies.yaml"))
@@ -122,12 +123,6 @@ def drop_per_seed(g: dict[tuple[str, str], list[Run]], joint: int, k: int) -> li
         if min(len(a), len(b)) > k and a[k, joint] > 0:
             out.append(100.0 * (a[k, joint] - b[k, joint]) / a[k, joint])
     return out
-
-
-def _with_intervals(table: list[list[str]], intervals: dict[str, Interval], nd: int) -> list[list[str]]:
-    """The cerebx cell of each row with an interval over several seeds, followed by it."""
-    return [row if row[0] not in intervals or not intervals[row[0]].has_interval
-            else [*row[:-1], f"{row[-1]}; over seeds {intervals[row[0]].text(nd)}"] for row in table]
 
 
 def _drop(g, joint: int, k0: int, k1: int) -> float | None:
@@ -223,7 +218,7 @@ def fig5(runs: RunSet, stem: Path) -> Figure:
                   f"green line: corrections start (trial {k_corr + 1}). IV's drop against I: of the mean MAE over "
                   "the repetitions (as the paper)"
                   + (f", and over the {n} seeds both ran (each IV repetition against I's of its seed, with the 95 % "
-                     "interval)" if n > 1 else "") + ".", _with_intervals(table, intervals, 0), checks=checks,
+                     "interval)" if n > 1 else "") + ".", with_intervals(table, intervals, 0), checks=checks,
                   convergence=convergence(g), intervals=intervals)
 
 
@@ -301,7 +296,7 @@ def table2(runs: RunSet, stem: Path) -> Figure:
     png = save(fig, stem)
     return Figure([png], "Receptive fields created by each module's LWPR (the paper: one count per module), over "
                   "the repetitions (seeds) of each architecture and case, with the 95 % interval of the mean.",
-                  _with_intervals(table, intervals, 1), checks=table2_checks(intervals), convergence=convergence(g),
+                  with_intervals(table, intervals, 1), checks=table2_checks(intervals), convergence=convergence(g),
                   intervals=intervals)
 
 

@@ -33,6 +33,7 @@ from cerebx.report.api import (
     save,
     studies,
     study_plateau,
+    with_intervals,
 )
 from cerebx_luque2011.cerebellum.schema import Luque2011Cerebellum
 
@@ -362,12 +363,6 @@ def fig12_intervals(runs: RunSet) -> dict[str, Interval]:
     return {q: interval(v, paper.get(q)) for q, v in per_seed.items()}
 
 
-def _with_intervals(table: list[list[str]], intervals: dict[str, Interval], nd: int = 1) -> list[list[str]]:
-    """The cerebx cell of each row with an interval over several seeds, followed by it."""
-    return [row if row[0] not in intervals or not intervals[row[0]].has_interval
-            else [*row[:-1], f"{row[-1]}; over seeds {intervals[row[0]].text(nd)}"] for row in table]
-
-
 @figure("luque2011_fig12", "Luque 2011 Fig. 12: objects of 0.5-2 kg", studies=("luque2011_fig12",))
 def fig12(runs: RunSet, stem: Path) -> Figure:
     by_mass = _fig12_runs(runs)
@@ -427,7 +422,7 @@ def fig12(runs: RunSet, stem: Path) -> Figure:
                + (f" Both over {n_seeds} independently learned seeds: mean and 95 % interval in the table; the checks "
                   "on them decide on the mean over seeds; the curves show the first seed." if n_seeds > 1 else ""))
     conv = _learnt(runs, by_mass, lambda m: f"{m:g} kg", "luque2011_fig12")
-    return Figure([png], caption, _with_intervals(table, intervals), checks=checks, convergence=conv,
+    return Figure([png], caption, with_intervals(table, intervals), checks=checks, convergence=conv,
                   intervals=intervals)
 
 

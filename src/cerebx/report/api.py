@@ -7,7 +7,8 @@ imports only this module (and :mod:`cerebx.api`).
 - :class:`Figure` (images, caption, the paper-vs-cerebx table, notes, :class:`Check` s, convergence,
   :class:`Interval` s); :class:`MissingRuns` when a figure's runs are absent.
 - :class:`Run` and :class:`RunSet`: run folders chosen by content (``RunSet.where``, ``best``, ``seeds``).
-- :func:`interval`: a headline number's mean and 95 % interval over seeds.
+- :func:`interval`: a headline number's mean and 95 % interval over seeds; :func:`with_intervals` adds them
+  to a figure's table.
 - Convergence: :func:`learning_convergence`, :func:`plateau`, :func:`combined`, :func:`study_plateau`.
 - Learning-curve metrics (Luque et al. 2011): :func:`accuracy_gain`, :func:`final_error`,
   :func:`final_error_stability`, :func:`convergence_speed`, :func:`improvement_pct`.
@@ -21,7 +22,7 @@ from cerebx.report.delays import DELAY_TRIALS, delays
 from cerebx.report.plot import fmt, mean_std, panel_letter, save
 from cerebx.report.registry import Check, Figure, MissingRuns, explanations, figure, studies
 from cerebx.report.runs import Run, RunSet
-from cerebx.report.stats import Interval, interval
+from cerebx.report.stats import Interval, interval, with_intervals
 from cerebx.report.studies import study_plateau
 
 __all__ = [
@@ -51,4 +52,5 @@ __all__ = [
     "save",
     "studies",
     "study_plateau",
+    "with_intervals",
 ]

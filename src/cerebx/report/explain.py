@@ -16,13 +16,11 @@ import dataclasses
 import functools
 from pathlib import Path
 
-import yaml
-from pydantic import Field, ValidationError
+from pydantic import Field
 
-from cerebx.errors import ConfigError
 from cerebx.report.registry import EXPLANATION_FILES, Check, Figure, load_reports
+from cerebx.report.studies import read_yaml_model
 from cerebx.schema.base import Strict
-from cerebx.schema.experiment import format_errors
 
 PROFILES = ("quick", "full")
 
@@ -53,15 +51,7 @@ def load_explanations(*paths: Path) -> list[Explanation]:
 
 @functools.lru_cache(maxsize=16)
 def _read(path: Path) -> tuple[Explanation, ...]:
-    try:
-        raw = yaml.safe_load(path.read_text()) or {}
-        return tuple(ExplanationsFile.model_validate(raw).explanations)
-    except OSError as err:
-        raise ConfigError(f"{path}: {err.strerror}") from None
-    except yaml.YAMLError as err:
-        raise ConfigError(f"{path}: not valid YAML ({str(err).splitlines()[0]})") from None
-    except ValidationError as err:
-        raise ConfigError([f"{path}: {line}" for line in format_errors(err)]) from None
+    return tuple(read_yaml_model(path, ExplanationsFile).explanations)
 
 
 def explain(name: str, fig: Figure, profile: str | None, known: list[Explanation]) -> None:

@@ -8,7 +8,7 @@ give t = 4.303: a wide interval, which is the honest answer to "could this 10 % 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -75,3 +75,13 @@ def interval(values: Iterable[float], paper: float | Sequence[float] | None = No
         return Interval(m, m, m, 1, (m,), ref)
     half = t975(v.size - 1) * float(v.std(ddof=1)) / math.sqrt(v.size)
     return Interval(m, m - half, m + half, int(v.size), tuple(float(x) for x in v), ref)
+
+
+def with_intervals(table: list[list[str]], intervals: dict[str, Interval],
+                   nd: int | Callable[[str], int] = 3) -> list[list[str]]:
+    """The table (rows of quantity, …, cerebx) with "; over seeds <mean [low, high] (n seeds)>" after the cerebx
+    cell of each row whose quantity has an interval over several seeds (``nd``: decimals, or a function of the
+    quantity giving them)."""
+    digits = nd if callable(nd) else (lambda _q: nd)
+    return [row if row[0] not in intervals or not intervals[row[0]].has_interval
+            else [*row[:-1], f"{row[-1]}; over seeds {intervals[row[0]].text(digits(row[0]))}"] for row in table]

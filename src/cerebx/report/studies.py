@@ -27,7 +27,7 @@ from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import yaml
 from hydra import compose, initialize_config_module
@@ -48,6 +48,7 @@ from cerebx.schema.base import Strict
 from cerebx.schema.experiment import format_errors, validate
 
 PROFILES = ("quick", "full")
+M = TypeVar("M", bound=Strict)
 
 
 class ProfileSpec(Strict):
@@ -156,16 +157,21 @@ def _read_studies_cached(path: Path) -> dict[str, StudySpec]:
     return _read_studies(path)
 
 
-def _read_studies(path: Path) -> dict[str, StudySpec]:
+def read_yaml_model(path: Path, model: type[M]) -> M:
+    """``path``'s YAML validated as ``model``; any problem is a ConfigError of lines ``path: problem``."""
     try:
         raw = yaml.safe_load(Path(path).read_text())
-        return StudiesFile.model_validate(raw).studies
+        return model.model_validate(raw if raw is not None else {})
     except OSError as err:
         raise ConfigError(f"{path}: {err.strerror}") from None
     except yaml.YAMLError as err:
         raise ConfigError(f"{path}: not valid YAML ({str(err).splitlines()[0]})") from None
     except ValidationError as err:
         raise ConfigError([f"{path}: {line}" for line in format_errors(err)]) from None
+
+
+def _read_studies(path: Path) -> dict[str, StudySpec]:
+    return read_yaml_model(path, StudiesFile).studies
 
 
 def _key(override: str) -> str:

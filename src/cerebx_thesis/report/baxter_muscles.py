@@ -29,8 +29,9 @@ from cerebx.report.api import (  # noqa: E402
     mean_std,
     panel_letter,
     save,
+    with_intervals,
 )
-from cerebx_thesis.report.common import learnt, with_intervals  # noqa: E402
+from cerebx_thesis.report.common import learnt  # noqa: E402
 
 # thesis §4.7 (Fig. 4.6): k -> position MAE (mean, std; rad) and payload sag (cm)
 THESIS_MAE = {0: (0.0189, 0.0042), 1: (0.0191, 0.0034), 5: (0.0179, 0.0051), 9: (0.0189, 0.0052),

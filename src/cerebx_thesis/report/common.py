@@ -21,7 +21,6 @@ import numpy as np
 
 from cerebx.report.api import (
     Convergence,
-    Interval,
     Run,
     RunSet,
     learning_convergence,
@@ -68,13 +67,6 @@ def seed_runs(runs: RunSet, pick: Callable[[RunSet], Run | None], like: Run | No
     one run per seed); with ``like``, only those with as many trials as it (a seed still learning is left out)."""
     out = [r for rs in runs.seeds().values() if (r := pick(rs)) is not None]
     return [r for r in out if like is None or r.trials == like.trials]
-
-
-def with_intervals(table: list[list[str]], intervals: dict[str, Interval], nd: int = 3) -> list[list[str]]:
-    """The table with "; over seeds <mean [low, high] (n seeds)>" after the cerebx cell of each row that has an
-    interval over several seeds."""
-    return [row if row[0] not in intervals or not intervals[row[0]].has_interval
-            else [*row[:-1], f"{row[-1]}; over seeds {intervals[row[0]].text(nd)}"] for row in table]
 
 
 def snn_rows(quantity: str) -> bool:

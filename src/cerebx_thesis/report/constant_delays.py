@@ -27,6 +27,7 @@ from cerebx.report.api import (  # noqa: E402
     interval,
     mean_std,
     save,
+    with_intervals,
 )
 from cerebx_thesis.report.common import (  # noqa: E402
     ANN_STUDY,
@@ -196,9 +197,7 @@ def fig3_4(runs: RunSet, stem: Path) -> Figure:
                f"Runs — {counts}. The thesis used 100 trials per δT and stopped PD and ANN at 50 ms; every δT "
                "run is shown here. The dashed grey line is the factory position controller without delay "
                f"(where such a run exists).{seeds_note}")
-    table = [row if row[0] not in intervals or not intervals[row[0]].has_interval
-             else [*row[:2], f"{row[2]}; over seeds {intervals[row[0]].text(2 if '÷' in row[0] else 3)}"]
-             for row in table]
+    table = with_intervals(table, intervals, lambda q: 2 if "÷" in q else 3)
     checks, conv = _fig3_4_shape(runs, sweeps, intervals)
     return Figure([png], caption, table, notes, checks, conv, intervals)
 

@@ -31,6 +31,7 @@ from cerebx.report.api import (  # noqa: E402
     fmt,
     interval,
     mean_std,
+    with_intervals,
 )
 from cerebx_thesis.report.common import (  # noqa: E402
     CH3_STUDY,
@@ -44,7 +45,6 @@ from cerebx_thesis.report.common import (  # noqa: E402
     plain_circle,
     reference_run,
     trial_counts,
-    with_intervals,
 )
 
 THESIS_FIT = (0.000106, 0.0036)  # Fig. 3.6 C: MAE = slope * peak_ms + intercept

@@ -24,8 +24,8 @@ from cerebx.report.api import (  # noqa: E402
     mean_std,
     panel_letter,
     save,
+    with_intervals,
 )
-from cerebx_thesis.report.common import with_intervals  # noqa: E402
 
 # thesis stages for a 500-trial run: t1 = 18-20 s, t2 = 318-320 s, t3 = 998-1000 s
 STAGE_FRACTIONS = (0.02, 0.32, 1.0)
