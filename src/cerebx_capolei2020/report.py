@@ -26,6 +26,7 @@ from cerebx.report.api import (  # noqa: E402
     MissingRuns,
     Run,
     RunSet,
+    explanations,
     figure,
     interval,
     plateau,
@@ -36,6 +37,7 @@ from cerebx.report.api import (  # noqa: E402
 )
 
 studies(Path(__file__).with_name("studies.yaml"))
+explanations(Path(__file__).with_name("explanations.yaml"))
 
 ARCHS = {"capolei_arch1": ("I", "C2"), "capolei_arch2": ("II", "C0"), "capolei_arch3": ("III", "C9"),
          "capolei_arch4": ("IV", "C6")}
