@@ -290,10 +290,10 @@ def hero_block(report: dict[str, Any], name: str, image_path: str) -> str | None
     if entry is None or not entry.get("files"):
         return None
     rows = [r for r in entry.get("table") or [] if r and str(r[0]).startswith(HERO_ROWS)]
-    caption = str(entry.get("caption", "")).split(". ")[0]
-    out = [f"![{_text(entry['title'])}]({image_path}/{Path(entry['files'][0]).name})", "",
-           f"*{_text(caption)}. Drawn by `cerebx report` from cerebx's own runs ({report.get('profile')} profile, "
-           f"{_day(report.get('built_at'))}, commit `{report.get('commit') or 'unknown'}`); its reproduction page "
+    image = f"{image_path}/{Path(entry['files'][0]).name}"
+    out = [f"![{_text(entry['title'])}]({image})", "",
+           f"*{_text(entry['title'])} (`{name}`). Drawn by `cerebx report` from cerebx's own runs "
+           f"({report.get('profile')} profile, {_day(report.get('built_at'))}, commit `{report.get('commit') or 'unknown'}`); its reproduction page "
            "puts every number of the paper beside cerebx's, with the checks that hold and those that do not.*", ""]
     if rows:
         out += [table_markdown([["quantity", "paper", "cerebx"], *[r[:3] for r in rows]])]
