@@ -293,7 +293,8 @@ def hero_block(report: dict[str, Any], name: str, image_path: str) -> str | None
     image = f"{image_path}/{Path(entry['files'][0]).name}"
     out = [f"![{_text(entry['title'])}]({image})", "",
            f"*{_text(entry['title'])} (`{name}`). Drawn by `cerebx report` from cerebx's own runs "
-           f"({report.get('profile')} profile, {_day(report.get('built_at'))}, commit `{report.get('commit') or 'unknown'}`); its reproduction page "
+           f"({report.get('profile')} profile, {_day(report.get('built_at'))}, "
+           f"commit `{report.get('commit') or 'unknown'}`); its reproduction page "
            "puts every number of the paper beside cerebx's, with the checks that hold and those that do not.*", ""]
     if rows:
         out += [table_markdown([["quantity", "paper", "cerebx"], *[r[:3] for r in rows]])]
