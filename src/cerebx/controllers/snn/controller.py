@@ -76,11 +76,15 @@ class Chunk(NamedTuple):
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def _chunk_outputs(idx, off, lo, hi, per_joint, sign, alpha, rec_lo, rec_hi, first, step_s):  # pragma: no cover
+def _chunk_outputs(idx, off, decode, record, first, step_s):  # pragma: no cover
     """A chunk's torques and DCN counts (:func:`~cerebx.snn.decoder.chunk_torques`) and its recorded spikes'
     messages (:func:`~cerebx.snn.decoder.chunk_select`,
     :func:`~cerebx.recording.spike_chunks.chunk_spike_messages`) in one call: each return from compiled code
-    waits for the interpreter lock, which the loop's thread holds but for its MuJoCo steps."""
+    waits for the interpreter lock, which the loop's thread holds but for its MuJoCo steps. ``decode``: the
+    DCN's first and end index, per_joint, sign and alpha of the decoder; ``record``: the recorded neurons'
+    (lo, hi) ranges."""
+    lo, hi, per_joint, sign, alpha = decode
+    rec_lo, rec_hi = record
     taus, counts = chunk_torques(idx, off, lo, hi, per_joint, sign, alpha)
     local, ends = chunk_select(idx, off, rec_lo, rec_hi)
     words, starts = chunk_spike_messages(local, ends, first, step_s)
@@ -88,15 +92,14 @@ def _chunk_outputs(idx, off, lo, hi, per_joint, sign, alpha, rec_lo, rec_hi, fir
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def _run_chunk_outputs(t0, n_sub, flat, in_off, learn, par, net, idx_buf, off, lo, hi, per_joint, sign, alpha, rec_lo,
-                       rec_hi, first, step_s, pf_lost):  # pragma: no cover
+def _run_chunk_outputs(t0, n_sub, flat, in_off, learn, par, net, idx_buf, off, decode, record, first, step_s,
+                       pf_lost):  # pragma: no cover
     """A whole chunk on the network thread in one compiled call: the network's steps
     (:func:`~cerebx.snn.kernels.run_chunk`), then :func:`_chunk_outputs`, and the PF spikes dropped so far. The
     thread needs the interpreter lock once a chunk, to hand the result over: each time it does, the loop's
     thread, which holds the lock but for its MuJoCo steps, waits for it to let go and for its own wake-up."""
     total = run_chunk(t0, n_sub, flat, in_off, learn, par, net, idx_buf, off)
-    taus, counts, words, starts = _chunk_outputs(idx_buf[:total], off, lo, hi, per_joint, sign, alpha, rec_lo,
-                                                 rec_hi, first, step_s)
+    taus, counts, words, starts = _chunk_outputs(idx_buf[:total], off, decode, record, first, step_s)
     return taus, counts, words, starts, pf_lost.sum()
 
 
@@ -247,10 +250,10 @@ class SNNControllerImpl(Controller):
         if not self.muscles:
             net = self.net
             idx_buf, off = net.chunk_buffers(n)
+            decode = (self.sl_dcn.start, self.sl_dcn.stop, self.decoder.per_joint, self.decoder.sign, self._alpha)
             taus, counts, words, starts, lost = _run_chunk_outputs(
-                net.t_sub, net.n_sub, flat, in_off, net.learn, net.n_threads, net._state, idx_buf, off,
-                self.sl_dcn.start, self.sl_dcn.stop, self.decoder.per_joint, self.decoder.sign, self._alpha, rec_lo,
-                rec_hi, first_step, STEP_S, net.pf_lost)
+                net.t_sub, net.n_sub, flat, in_off, net.learn, net.n_threads, net._state, idx_buf, off, decode,
+                (rec_lo, rec_hi), first_step, STEP_S, net.pf_lost)
             net.t_sub += net.n_sub * n
         else:  # agonist/antagonist outputs: decoded here
             idx, off = self.net.step_packed(flat, in_off)
