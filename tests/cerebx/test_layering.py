@@ -61,3 +61,21 @@ def test_no_two_folders_of_cerebx_import_each_other():
              if top(m) != top(i)}
     ties = sorted({tuple(sorted(e)) for e in edges if (e[1], e[0]) in edges})
     assert not ties, f"folders importing each other: {ties}"
+
+
+def test_few_functions_take_more_than_ten_parameters():
+    """Kernels take their parameters named or grouped (a structref, a tuple); at most three functions of the
+    package, numba kernels included, take more than ten."""
+    import ast
+
+    many = []
+    for path in (ROOT / "src").rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                a = node.args
+                n = (len(a.posonlyargs) + len(a.args) + len(a.kwonlyargs) + (a.vararg is not None)
+                     + (a.kwarg is not None))
+                n -= bool(a.args) and a.args[0].arg in ("self", "cls")
+                if n > 10:
+                    many.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name} ({n})")
+    assert len(many) <= 3, "\n".join(many)
