@@ -28,7 +28,7 @@ from omegaconf.errors import OmegaConfBaseException
 
 from cerebx import runfiles
 from cerebx.errors import ConfigError
-from cerebx.estimate import Estimate, estimate, total
+from cerebx.estimate import estimate
 from cerebx.guard import check_args, conf_roots
 from cerebx.jobenv import source_checkout
 from cerebx.schema.base import closest
@@ -311,16 +311,20 @@ def check(overrides: list[str], multirun: bool = False, estimates: list | None =
     return seen
 
 
-def estimate_jobs(jobs: list[list[str]]) -> tuple[Estimate, list[str]]:
-    """The summed estimate of runs given by their overrides (``init_from`` left out: the run it names may
-    not exist yet, and it changes no size); one line per job that does not validate."""
-    parts, problems = [], []
+def load_jobs(jobs: list[list[str]]) -> tuple[list[Any | None], list[str | None]]:
+    """The validated experiment of each run given by its overrides (``init_from`` left out: the run it names
+    may not exist yet, and it changes no size or pace), and beside it None; or None and the line saying why it
+    does not validate."""
+    exps: list[Any | None] = []
+    problems: list[str | None] = []
     for overrides in jobs:
         try:
-            parts.append(estimate(load([o for o in overrides if not o.lstrip("+").startswith("init_from=")])[0]))
+            exps.append(load([o for o in overrides if not o.lstrip("+").startswith("init_from=")])[0])
+            problems.append(None)
         except ConfigError as err:
+            exps.append(None)
             problems.append(f"[{' '.join(overrides)}] {err.problems[0]}")
-    return total(parts), problems
+    return exps, problems
 
 
 RUN_DIR_DEFAULTS = {"run": "runs", "sweep": "runs/multirun"}

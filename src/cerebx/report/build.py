@@ -34,9 +34,9 @@ from pathlib import Path
 from typing import Any
 
 from cerebx import __version__, runfiles
-from cerebx.config import estimate_jobs, load
+from cerebx.config import load_jobs
 from cerebx.errors import CerebxError
-from cerebx.estimate import estimate
+from cerebx.estimate import estimate, total
 from cerebx.report import figures
 from cerebx.report.badge import stamp
 from cerebx.report.delays import delay_rows
@@ -313,23 +313,21 @@ a MuJoCo model); the shapes and orderings are what should hold.</p>
     return index, problems + missing, len(runs)
 
 
-def _at_measured_pace(jobs: list, folder: Path, parallel: int) -> str | None:
-    """The remaining runs' wall time at the pace of the profile's finished runs (``report/pace.py``), or None
-    when none has finished."""
-    exps: dict[Path, Any] = {}
-    for j in jobs:
-        try:
-            exps[j.run_dir] = load([o for o in j.overrides() if not o.lstrip("+").startswith("init_from=")])[0]
-        except CerebxError:
-            continue
-    done = {j.run_dir for j in jobs if j.done()}
-    pace = profile_pace(folder, {d: estimate(e).wall_s for d, e in exps.items() if d in done})
-    if not pace.runs:
-        return None
-    left = [e for d, e in exps.items() if d not in done]
-    wall = remaining_wall_s(pace, left, parallel)
-    return (f"at the pace of this profile's {pace.runs} finished runs (by kind of run, --jobs {parallel}): "
-            f"~{wall / 3600:.1f} h")
+def dry_run(jobs: list, folder: Path, parallel: int) -> None:
+    """Print each job (reused or to run) and the estimate of those to run: on a quiet machine
+    (``cerebx.estimate``) and at the pace of the profile's finished runs (``report/pace.py``) when some are."""
+    done = [j.done() for j in jobs]
+    for j, d in zip(jobs, done, strict=True):
+        print(f"{'reuse' if d else 'run  '} {j.run_dir}  cerebx run {' '.join(j.overrides())}")
+    exps, problems = load_jobs([j.overrides() for j in jobs])
+    left = [e for e, d in zip(exps, done, strict=True) if not d and e is not None]
+    bad = [p for p, d in zip(problems, done, strict=True) if p is not None and not d]
+    print(f"{done.count(False)} runs to do: {total([estimate(e) for e in left]).line()}", *bad, sep="\n")
+    pace = profile_pace(folder, {j.run_dir: estimate(e).wall_s
+                                 for j, e, d in zip(jobs, exps, done, strict=True) if d and e is not None})
+    if pace.runs:
+        print(f"at the pace of this profile's {pace.runs} finished runs (by kind of run, --jobs {parallel}): "
+              f"~{remaining_wall_s(pace, left, parallel) / 3600:.1f} h")
 
 
 def needed_studies(names: list[str] | None) -> list[str]:
@@ -373,14 +371,7 @@ def main(argv: list[str]) -> int:
                 raise CerebxError(f"--seeds: {a.seeds} is not a number of seeds (at least 1)")
             jobs = plan(a.profile, root, needed_studies(names), max_seeds=a.seeds)
             if a.dry_run:
-                for j in jobs:
-                    print(f"{'reuse' if j.done() else 'run  '} {j.run_dir}  cerebx run {' '.join(j.overrides())}")
-                todo = [j.overrides() for j in jobs if not j.done()]
-                est, bad = estimate_jobs(todo)
-                print(f"{len(todo)} runs to do: {est.line()}", *bad, sep="\n")
-                paced = _at_measured_pace(jobs, root / a.profile, a.jobs)
-                if paced:
-                    print(paced)
+                dry_run(jobs, root / a.profile, a.jobs)
                 return 0
             try:
                 failed = execute(group(jobs), runner=study_runner(a.override), parallel=a.jobs)

@@ -5,8 +5,8 @@ that shows its cause with the runs behind it. The report copies the link into th
 
     explanations:
       - figure: fig3_4
-        claim: "ANN MAE at 40 ms"              # the start of the check's claim
-        at: reproductions/thesis-ch3.md#the-ann-at-40-ms   # docs-relative page and anchor
+        claim: "ANN mean MAE over 0–50 ms"     # the start of the check's claim
+        at: reproductions/thesis-ch3.md#why-the-ann-holds-to-40-ms   # docs-relative page and anchor
         profiles: [full]                        # where it applies (default: every profile)
 """
 

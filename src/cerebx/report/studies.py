@@ -126,10 +126,11 @@ def with_replicas(studies: dict[str, StudySpec], profile: str, max_seeds: int | 
     out: dict[str, StudySpec] = {}
     for name, s in studies.items():
         out[name] = s
+        base = _init_from(s, profile)
         for k in range(1, min(getattr(s, profile).seeds, max_seeds or 10**6)):
-            src = _init_from(s, profile)
-            if src is not None and src in studies and getattr(studies[src], profile).seeds > k:
-                src = f"{src}{REPLICA}{k}"
+            src = base
+            if base is not None and base in studies and getattr(studies[base], profile).seeds > k:
+                src = f"{base}{REPLICA}{k}"
             one = getattr(s, profile).model_copy(update={"seeds": 1, "init_from": src})
             out[f"{name}{REPLICA}{k}"] = s.model_copy(update={"args": [*s.args, f"seed={k}"], profile: one})
     return out

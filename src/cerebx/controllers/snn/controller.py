@@ -246,14 +246,13 @@ class SNNControllerImpl(Controller):
             return Chunk(first_step, np.zeros((n, self.width)), np.zeros(n, np.int64), None, None,
                          int(self.net.pf_lost.sum()))
         recording = bool(self.recorder is not None and self._shed < 3 and self.record)
-        rec_lo, rec_hi = (self._record_lo, self._record_hi) if recording else (_NONE, _NONE)
+        record = (self._record_lo, self._record_hi) if recording else (_NONE, _NONE)
         if not self.muscles:
             net = self.net
             idx_buf, off = net.chunk_buffers(n)
-            decode = (self.sl_dcn.start, self.sl_dcn.stop, self.decoder.per_joint, self.decoder.sign, self._alpha)
             taus, counts, words, starts, lost = _run_chunk_outputs(
-                net.t_sub, net.n_sub, flat, in_off, net.learn, net.n_threads, net._state, idx_buf, off, decode,
-                (rec_lo, rec_hi), first_step, STEP_S, net.pf_lost)
+                net.t_sub, net.n_sub, flat, in_off, net.learn, net.n_threads, net._state, idx_buf, off, self._decode,
+                record, first_step, STEP_S, net.pf_lost)
             net.t_sub += net.n_sub * n
         else:  # agonist/antagonist outputs: decoded here
             idx, off = self.net.step_packed(flat, in_off)
@@ -262,7 +261,7 @@ class SNNControllerImpl(Controller):
             sel = (idx >= lo) & (idx < hi)
             taus = self.decoder.sides(idx[sel] - lo, step_of[sel], n, self.full_scale, self.cfg.decoder.saturate)
             counts = np.bincount(step_of[sel], minlength=n)
-            words, starts = chunk_spike_messages(*chunk_select(idx, off, rec_lo, rec_hi), first_step, STEP_S)
+            words, starts = chunk_spike_messages(*chunk_select(idx, off, *record), first_step, STEP_S)
             lost = int(self.net.pf_lost.sum())
         if not recording:
             return Chunk(first_step, taus, counts, None, None, lost)
@@ -374,6 +373,7 @@ class SNNControllerImpl(Controller):
         self._alpha = np.ascontiguousarray(np.broadcast_to(self.decoder.alpha, (self.n_ctrl,)), dtype=np.float64)
         self._record_lo = np.array([sl.start for sl in self.record.values()], np.int64)
         self._record_hi = np.array([sl.stop for sl in self.record.values()], np.int64)
+        self._decode = (self.sl_dcn.start, self.sl_dcn.stop, self.decoder.per_joint, self.decoder.sign, self._alpha)
         self._spike_topics = tuple(f"/spikes/{name}" for name in self.record)
         self._pair = EncoderPair.of(self.mf, self.cf, self.sl_mf.start, self.sl_cf.start)
 
