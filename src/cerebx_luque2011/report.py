@@ -22,6 +22,7 @@ from cerebx.report.api import (
     RunSet,
     accuracy_gain,
     convergence_speed,
+    explanations,
     figure,
     final_error,
     final_error_stability,
@@ -38,6 +39,7 @@ from cerebx.report.api import (
 from cerebx_luque2011.cerebellum.schema import Luque2011Cerebellum
 
 studies(Path(__file__).with_name("studies.yaml"))
+explanations(Path(__file__).with_name("explanations.yaml"))
 
 HEADER = ["quantity", "paper", "cerebx"]
 N_JOINTS = 3

@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cerebx.report.explain import explain, load_explanations
+from cerebx.report.registry import Figure
 from cerebx.report.runs import Run, RunSet
 from cerebx_luque2011 import report
 
@@ -15,12 +17,12 @@ pytestmark = pytest.mark.unit
 
 
 def _run(tmp: Path, name: str, mae_sum, mass: float = 1.0, seed: int = 0, ltd: float = 0.075, ltp: float = 0.01,
-         peak: float = 100.0) -> Run:
+         peak: float = 100.0, delay: float = 100.0) -> Run:
     """A Luque eight run (one warm-up trial) whose MAE summed over the 3 joints is ``mae_sum`` after it."""
     cer = {"kind": "luque2011_cerebellum",
            "plasticity": {"ltd_nS": ltd, "ltp_nS": ltp, "kernel_peak_ms": peak, "arm_lag_ms": 70.0}}
     cfg = {"controller": {"parts": [{"kind": "crude_inverse_dynamics"}, cer]}, "plant": {"object_mass_kg": mass},
-           "delay": {"total_ms": 100.0}, "events": [], "init_from": None}
+           "delay": {"total_ms": delay}, "events": [], "init_from": None}
     mae = [1.0, *(np.asarray(mae_sum, float) / 3)]
     summary = {"task": "luque_eight", "controller": "composite", "delay": "constant", "status": "completed",
                "seed": seed, "warmup_trials": 1, "trials_completed": len(mae), "mae_per_trial": mae,
@@ -105,3 +107,37 @@ def test_fig7c_checks_read_the_block_pattern():
             w[16 * j + 8: 16 * j + 16, 20 * c + 18: 20 * c + 20] = 3.0 + 3 * j
     assert [c.holds for c in report.fig7c_checks(w)] == [True, True, True]
     assert [c.holds for c in report.fig7c_checks(np.full((48, 120), 20.0))] == [False, False, False]
+
+
+def test_each_explanation_links_the_failing_check_it_names(tmp_path):
+    """Every entry of the plugin's explanations file starts a claim that its figure makes: when that check fails
+    in the full profile it carries the link; in the quick profile, and when it holds, it carries none."""
+    known = load_explanations(Path(report.__file__).with_name("explanations.yaml"))
+    grid = {(ltd, ltp): {"final error (rad)": 0.1, "final error stability (rad)": 0.003, "accuracy gain (rad)": 0.4,
+                         "convergence (trials)": 100.0}
+            for ltd in (0.025, 0.075, 0.2) for ltp in (0.001, 0.005, 0.01, 0.05)}
+    grid[0.025, 0.05] = grid[0.2, 0.001] = {"final error (rad)": 0.46, "final error stability (rad)": 0.0,
+                                            "accuracy gain (rad)": 0.005, "convergence (trials)": 1.0}
+    same = _learning(0.5, 0.06)  # the same curve for every point: nothing grows or falls with the mass
+    figures = {
+        "luque2011_fig7c": report.fig7c_checks(np.full((48, 120), 20.0)),
+        "luque2011_fig8": report._fig8_checks(grid),
+        "luque2011_fig9": report.fig9(RunSet(_run(tmp_path, f"d{d}", _learning(0.5, f), peak=d, delay=d)
+                                             for d, f in ((100.0, 0.06), (150.0, 0.124))), tmp_path / "f9").checks,
+        "luque2011_fig10": report._fig10_checks({d: _run(tmp_path, f"p{d}", _learning(0.5, f), peak=100.0 + d)
+                                                 for d, f in ((-70.0, 0.117), (0.0, 0.06), (70.0, 0.161))}),
+        "luque2011_fig12": report.fig12(RunSet(_run(tmp_path, f"m{m}", same, mass=m) for m in (0.5, 1.0, 2.0)),
+                                        tmp_path / "f12").checks,
+    }
+    used = set()
+    for name, checks in figures.items():
+        for profile, linked in (("full", True), ("quick", False)):
+            fig = Figure([], "", checks=checks)
+            explain(name, fig, profile, known)
+            for c in fig.checks:
+                hit = [e for e in known if e.figure == name and c.claim.startswith(e.claim)]
+                assert (c.explained_at is not None) == (linked and c.holds is False and bool(hit)), c.claim
+                if c.explained_at:
+                    assert c.explained_at == f"docs/{hit[0].at}"
+                    used.add((name, hit[0].claim))
+    assert used == {(e.figure, e.claim) for e in known}, "an explanation names no claim its figure makes"
