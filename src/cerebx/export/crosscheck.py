@@ -62,12 +62,12 @@ def seeded_inputs(cfg: NetworkConfig, ms: float, seed: int = 0, cf_rate_hz: floa
 
 
 def run_cerebx(cfg: NetworkConfig, inputs: Spikes, ms: float, sliced: bool = True,
-               sparse_w: np.ndarray | None = None) -> tuple[Spikes, float]:
+               sparse_w: np.ndarray | None = None, cpu: list[float] | None = None) -> tuple[Spikes, float]:
     """cerebx on one thread, plasticity off, driven by ``inputs`` (every spike at a 2 ms step start); returns
     every population's spikes and the wall time of the run (build excluded). ``sliced``: one ``step`` call per
     2 ms (the 500 Hz loop's pace); otherwise one ``step_packed`` call for the whole run (spike times then at
     step resolution are not recorded: only used for timing). ``sparse_w``: the weights of the sparse projections
-    (their synapses in topology order) instead of the configured ones."""
+    (their synapses in topology order) instead of the configured ones; ``cpu`` receives the run's CPU time."""
     from cerebx.snn.network import Network, pack
 
     net = Network(cfg, parallel=False)
@@ -88,17 +88,21 @@ def run_cerebx(cfg: NetworkConfig, inputs: Spikes, ms: float, sliced: bool = Tru
     dt = cfg.dt_ms
     if not sliced:
         flat, off = pack(step_inputs)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         net.step_packed(flat, off)
+        if cpu is not None:
+            cpu.append(time.process_time() - c0)
         return {}, time.perf_counter() - t0
     ids, times = [], []
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     for s, x in enumerate(step_inputs):
         sp = net.step(x)
         if len(sp.idx):
             ids.append(sp.idx.copy())
             times.append((s * net.n_sub + sp.sub.astype(np.float64)) * dt)
     wall = time.perf_counter() - t0
+    if cpu is not None:
+        cpu.append(time.process_time() - c0)
     gid = np.concatenate(ids) if ids else np.zeros(0, np.int64)
     gt = np.concatenate(times) if times else np.zeros(0)
     out: Spikes = {}
@@ -315,3 +319,62 @@ def single_neuron(neuron: dict[str, Any], weights_nS: tuple[float, float], rate_
     return {"dt_ms": dt_ms, "rate_cerebx_hz": row.rate_cerebx_hz, "rate_nest_hz": row.rate_nest_hz,
             "rate_diff": row.rate_diff, "count_corr": row.count_corr, "matched_same_step": row.matched_step,
             "matched_1ms": row.matched}
+
+
+@dataclass
+class Speed:
+    """Wall time of one run of ``ms`` in each simulator and pace (one thread each, same network and input)."""
+
+    simulator: str
+    pace: str
+    wall_s: float
+    cpu_s: float
+    per_step_ms: float  # CPU time per 2 ms of simulated time
+    build_s: float | None = None
+
+
+def speed(cfg: NetworkConfig, out: Path, ms: float, seed: int = 0, python: str | None = None) -> list[Speed]:
+    """cerebx in 2 ms ``step`` calls (the 500 Hz loop's pace) and in one ``step_packed`` call; NEST (the export in
+    ``out``, written here) in ``Simulate(2.0)`` slices, in ``Run(2.0)`` slices inside one ``RunManager``, and in one
+    ``Simulate``. What NEST cannot express is left out of both, as in :func:`crosscheck`."""
+    p = plan(cfg, static=True, approximate=True)
+    cfg_run = without(cfg, [k for k in p.dropped if not cfg.projections[k].teaching]) if p.dropped else cfg
+    inputs = seeded_inputs(cfg_run, ms, seed)
+    n = ms / STEP_MS
+    rows = []
+    warm = seeded_inputs(cfg_run, 20.0, seed)  # numba's kernels loaded (or compiled) before anything is timed
+    run_cerebx(cfg_run, warm, 20.0, sliced=True)
+    run_cerebx(cfg_run, warm, 20.0, sliced=False)
+    cpu: list[float] = []
+    t0 = time.perf_counter()
+    _, sliced = run_cerebx(cfg_run, inputs, ms, sliced=True, cpu=cpu)
+    rows.append(Speed("cerebx", "step() per 2 ms", sliced, cpu[-1], 1000 * cpu[-1] / n,
+                      time.perf_counter() - t0 - sliced))
+    _, once = run_cerebx(cfg_run, inputs, ms, sliced=False, cpu=cpu)
+    rows.append(Speed("cerebx", "one step_packed() call", once, cpu[-1], 1000 * cpu[-1] / n))
+    export(cfg_run, out, to=("nest",), static=True, approximate=True, inputs=inputs)
+    for slice_ms, mode, pace in ((STEP_MS, "simulate", "Simulate(2.0) per 2 ms"),
+                                 (STEP_MS, "run", "Run(2.0) per 2 ms in one RunManager"),
+                                 (0.0, "simulate", "one Simulate()")):
+        _, timing = run_nest(out, ms, slice_ms, mode, python=python)
+        rows.append(Speed("NEST", pace, timing["sim_s"], timing["sim_cpu_s"], 1000 * timing["sim_cpu_s"] / n,
+                          timing["build_s"]))
+    return rows
+
+
+def speed_table(rows: list[Speed], ms: float) -> str:
+    """The rows as a Markdown table: CPU time (what the machine's other load disturbs least) and wall time."""
+    lines = ["| simulator | pace | CPU (s) | wall (s) | CPU per 2 ms step (ms) | real-time factor (CPU) | build (s) |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        b = "" if r.build_s is None else f"{r.build_s:.1f}"
+        lines.append(f"| {r.simulator} | {r.pace} | {r.cpu_s:.2f} | {r.wall_s:.2f} | {r.per_step_ms:.3f} | "
+                     f"{ms / 1000 / r.cpu_s:.2f}× | {b} |")
+    by = {(r.simulator, r.pace): r.per_step_ms for r in rows}
+    cx = by[("cerebx", "step() per 2 ms")] - by[("cerebx", "one step_packed() call")]
+    ne = by[("NEST", "Simulate(2.0) per 2 ms")] - by[("NEST", "one Simulate()")]
+    nr = by[("NEST", "Run(2.0) per 2 ms in one RunManager")] - by[("NEST", "one Simulate()")]
+    lines.append("")
+    lines.append(f"Per-step overhead (CPU, sliced minus one call, per 2 ms step): cerebx {1000 * cx:.0f} µs, "
+                 f"NEST Simulate {1000 * ne:.0f} µs, NEST Run {1000 * nr:.0f} µs.")
+    return "\n".join(lines)
