@@ -368,7 +368,7 @@ def speed_table(rows: list[Speed], ms: float) -> str:
              "|---|---|---|---|---|---|---|"]
     for r in rows:
         b = "" if r.build_s is None else f"{r.build_s:.1f}"
-        lines.append(f"| {r.simulator} | {r.pace} | {r.cpu_s:.2f} | {r.wall_s:.2f} | {r.per_step_ms:.3f} | "
+        lines.append(f"| {r.simulator} | {r.pace} | {r.cpu_s:.3f} | {r.wall_s:.3f} | {r.per_step_ms:.3f} | "
                      f"{ms / 1000 / r.cpu_s:.2f}× | {b} |")
     by = {(r.simulator, r.pace): r.per_step_ms for r in rows}
     cx = by[("cerebx", "step() per 2 ms")] - by[("cerebx", "one step_packed() call")]
