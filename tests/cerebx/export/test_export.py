@@ -126,3 +126,16 @@ def test_the_command_writes_or_refuses_in_one_line(tiny, tmp_path, capsys):
     assert "--to: unknown target 'brian'" in capsys.readouterr().err
     assert main(["export", str(tmp_path / "none.yaml"), "--out", str(tmp_path / "d")]) == 2
     assert "cannot be read" in capsys.readouterr().err
+
+
+def test_crosscheck_without_nest_is_one_line(monkeypatch, tmp_path, capsys):
+    import importlib.util
+
+    monkeypatch.delenv("CEREBX_NEST_PYTHON", raising=False)
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "nest" else real(name, *a))
+    assert main(["crosscheck", "small", "--out", str(tmp_path)]) == 2
+    assert capsys.readouterr().err.strip() == ("crosscheck: NEST is not importable here: pip install 'cerebx[nest]' "
+                                               "or set CEREBX_NEST_PYTHON to a Python that has it")
+    assert main(["crosscheck", "small", "--ms", "3"]) == 2
+    assert "--ms: must be a positive multiple of 2" in capsys.readouterr().err
