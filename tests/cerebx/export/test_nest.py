@@ -79,7 +79,7 @@ def test_the_small_network_fires_as_in_nest(tmp_path):
 
 def test_the_thesis_purkinje_and_dcn_layer_fires_as_in_nest(tmp_path):
     """The thesis network's PC and DCN in NEST, fed with the GC, MF and CF spikes of cerebx's whole network."""
-    res = crosscheck(load_network("thesis_ch3"), tmp_path, ms=400.0, layer=["pc", "dcn"], python=PYTHON)
+    res = crosscheck(load_network("thesis_ch3"), tmp_path, ms=1000.0, layer=["pc", "dcn"], python=PYTHON)
     rows = {r.population: r for r in res.rows}
     assert set(rows) == {"pc", "dcn"}
     for r in rows.values():
