@@ -1,4 +1,5 @@
-"""``cerebx`` command: run | validate | inspect | plot | bench | report | summarize | tune | robot | relay | delays.
+"""``cerebx`` command: run | validate | inspect | plot | bench | report | summarize | tune | robot | relay | delays |
+export | crosscheck.
 
 ``run`` is a Hydra application (multirun, launchers, --cfg, completion); the other commands
 compose the same config with Hydra's compose API. Input problems print one ``path: message``
@@ -33,6 +34,8 @@ commands:
   robot [--run-dir DIR] OVERRIDES...                   the robot side of a wall-clock run (link=zenoh|udp clock=wall)
   relay [--out DIR] OVERRIDES...                       the delay relay on a real link's path
   delays RUN_DIR [--out trace.csv] [--raw]             measured link delays: vs the model, as a delay=trace file
+  export NETWORK --to nest|pynn --out DIR              a network's exact synapses and a NEST / PyNN script
+  crosscheck NETWORK [--layer pc,dcn]                  the same input through cerebx and NEST: rates, spikes
 
 groups: task (required, +task=), controller (snn), plant (baxter), delay (none),
         experiment (presets: +experiment=NAME); network (full), with controller=snn

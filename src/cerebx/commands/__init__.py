@@ -10,7 +10,8 @@ from cerebx.commands.common import fail
 from cerebx.errors import CerebxError
 
 COMMANDS = {**{name: f"cerebx.commands.{name}" for name in
-               ("run", "validate", "inspect", "plot", "bench", "report", "tune", "summarize")},
+               ("run", "validate", "inspect", "plot", "bench", "report", "tune", "summarize", "export",
+                "crosscheck")},
             "robot": "cerebx.loop.robot_side", "relay": "cerebx.link.relay", "delays": "cerebx.link.trace"}
 """Command name -> the module whose ``main(args)`` runs it."""
 

@@ -1,0 +1,62 @@
+"""The network a ``cerebx export`` or ``cerebx crosscheck`` command names: a network preset (``conf/network`` of
+cerebx or a plugin, e.g. ``full``, ``thesis_ch3``), or a YAML file holding a network (its ``controller.network``
+when it is a whole experiment, e.g. a run's ``config.yaml`` or ``cerebx validate``'s output)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import yaml
+from pydantic import ValidationError
+
+from cerebx.errors import CerebxError, ConfigError
+from cerebx.snn.schema import NetworkConfig
+
+
+def load_network(source: str, overrides: list[str] | None = None) -> NetworkConfig:
+    """The validated network ``source`` names (``overrides``: ``key=value`` as for ``cerebx run``, applied to
+    a preset, e.g. ``controller.network.projections.pf_pc.weight_nS=1.0``)."""
+    path = Path(source)
+    if path.suffix in (".yaml", ".yml") or path.is_file():
+        if overrides:
+            raise CerebxError(f"{source}: overrides apply to a network preset, not to a file")
+        try:
+            doc = yaml.safe_load(path.read_text())
+        except OSError as err:
+            raise CerebxError(f"{source}: cannot be read ({err.strerror or err})") from None
+        except yaml.YAMLError as err:
+            raise CerebxError(f"{source}: not YAML ({str(err).splitlines()[0]})") from None
+        net = _network_part(doc)
+        if net is None:
+            raise CerebxError(f"{source}: holds no network (populations and projections, or controller.network)")
+        return _validate(net, source)
+    from cerebx.config import compose, to_plain  # Hydra only when a preset is composed
+
+    try:
+        plain = to_plain(compose(["+task=circle", f"network={source}", *(overrides or [])]))
+    except ConfigError as err:
+        raise CerebxError(err.problems[0]) from None
+    net = _network_part(plain)
+    if net is None:
+        raise CerebxError(f"{source}: the composed controller has no network")
+    return _validate(net, f"network={source}")
+
+
+def _network_part(doc: Any) -> dict | None:
+    if not isinstance(doc, dict):
+        return None
+    if "populations" in doc and "projections" in doc:
+        return doc
+    ctrl = doc.get("controller")
+    net = ctrl.get("network") if isinstance(ctrl, dict) else None
+    return net if isinstance(net, dict) else None
+
+
+def _validate(net: dict, where: str) -> NetworkConfig:
+    try:
+        return NetworkConfig.model_validate(net)
+    except ValidationError as err:
+        e = err.errors()[0]
+        loc = ".".join(str(x) for x in e["loc"])
+        raise CerebxError(f"{where}: {loc + ': ' if loc else ''}{e['msg']}") from None
