@@ -117,7 +117,7 @@ API_MODULES = {
     "Schemas": ["cerebx.schema.base", "cerebx.schema.experiment", "cerebx.schema.controller",
                 "cerebx.schema.stages", "cerebx.schema.plant", "cerebx.schema.task", "cerebx.schema.delay",
                 "cerebx.schema.events", "cerebx.schema.legacy"],
-    "Controllers and stages": ["cerebx.controllers.base", "cerebx.controllers.state", "cerebx.controllers.snn.schema",
+    "Controllers and stages": ["cerebx.controllers.base", "cerebx.persistence.state", "cerebx.controllers.snn.schema",
                                "cerebx.stages.base", "cerebx.stages.receivers", "cerebx.stages.check"],
     "Plants and tasks": ["cerebx.plants.base", "cerebx.plants.mujoco_arm", "cerebx.plants.check",
                          "cerebx.tasks.base"],

@@ -19,12 +19,11 @@ from typing import Any
 import numpy as np
 
 from cerebx import registry
-from cerebx.controllers.base import Controller
 from cerebx.delay_channel import Link
 from cerebx.errors import ConfigError
 from cerebx.signals import Signal
 from cerebx.stages.base import Receiver, Stage
-from cerebx.stages.controllers import Composite, TorqueControllerStage
+from cerebx.stages.controllers import Composite
 from cerebx.wiring import wire
 
 
@@ -49,7 +48,7 @@ class BuildContext:
     plant: Any = None
     task: Any = None
     run_dir: Path | None = None
-    controller: Any = None  # the object the controller group built (a Controller or a Stage)
+    controller: Any = None  # the stage the controller group built (before the build names its signals)
     brain: list[Stage] = field(default_factory=list)  # controller stage first
     link: Link | None = None
     sent: tuple[Signal, ...] = ()  # what the brain side sends over the link
@@ -66,13 +65,10 @@ class BuildContext:
 
 
 def as_stage(obj: Any, cfg: Any, n_joints: int) -> Stage:
-    """A controller as a brain-side stage (joint-torque controllers run behind an adapter); its signals
-    are the ones its schema declares."""
-    if isinstance(obj, Controller):
-        obj = TorqueControllerStage(obj, cfg.kind, n_joints)
+    """The stage a controller builder returned, named after its kind, with the signals its schema declares."""
     if not isinstance(obj, Stage):
-        raise TypeError(f"controller {cfg.kind!r}: builder returned {type(obj).__name__}, neither a Controller "
-                        "nor a Stage")
+        raise TypeError(f"controller {cfg.kind!r}: builder returned {type(obj).__name__}, not a Stage (a "
+                        "joint-torque controller subclasses Controller, itself a Stage)")
     io = cfg.io(n_joints)
     obj.name, obj.reads, obj.writes, obj.adds = cfg.kind, io.reads, io.writes, io.adds | obj.adds
     return obj

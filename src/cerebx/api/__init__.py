@@ -5,8 +5,9 @@ import from cerebx. Everything else is internal and may change between versions;
 
 - Configuration (the schema layer: no physics, network or log loaded): the names of :mod:`cerebx.api.schema`,
   re-exported here; a plugin's own ``schema`` modules import from there.
-- Runtime shapes: ``Stage`` (a part of the loop that reads and writes named signals every tick; a torque
-  controller is a stage), ``Controller`` (the older controller shape, still accepted), ``Plant`` (a robot or
+- Runtime shapes: ``Stage`` (a part of the loop that reads and writes named signals every tick, with one
+  ``save_state -> bool``), ``Controller`` (the joint-torque controller's base, a ``Stage`` whose subclasses
+  implement ``control(ControlInput) -> TorqueMsg``), ``Plant`` (a robot or
   body; ``MujocoArm`` for MuJoCo models), ``Task`` and ``TrialReference`` (desired trajectories), the encoders'
   interface (``MossyEncoder``, ``ClimbingEncoder``: see the how-tos), ``Frame`` (one tick's signals), ``LWPR``.
 - Checkers a plugin runs in its tests: ``check_plant``, ``check_experiment``.

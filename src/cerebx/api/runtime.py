@@ -5,9 +5,9 @@ from cerebx.build import build_components
 from cerebx.config import load
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
-from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.lwpr.model import LWPR
 from cerebx.metrics import final_mae
+from cerebx.persistence.state import load_state_npz, save_state_npz
 from cerebx.plants.base import Plant, PlantEvent
 from cerebx.plants.check import check_plant
 from cerebx.plants.interaction import grab_anchor, half_sine

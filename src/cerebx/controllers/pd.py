@@ -20,7 +20,7 @@ class PD(Controller):
     def reset(self, rng: np.random.Generator) -> None:
         pass
 
-    def step(self, inp: ControlInput) -> TorqueMsg:
+    def control(self, inp: ControlInput) -> TorqueMsg:
         s = inp.sensor
         if s is None:
             return TorqueMsg(inp.t_s, self._zero)

@@ -31,7 +31,7 @@ class PositionServo(Controller):
     def reset(self, rng: np.random.Generator) -> None:
         pass
 
-    def step(self, inp: ControlInput) -> TorqueMsg:
+    def control(self, inp: ControlInput) -> TorqueMsg:
         if inp.sensor is None:
             return TorqueMsg(stamp_s=inp.t_s, tau=np.zeros(self.n_joints))
         q, qd = inp.sensor.q, inp.sensor.qd

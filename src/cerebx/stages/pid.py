@@ -8,8 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
+from cerebx.persistence.state import load_state_npz, save_state_npz
 from cerebx.schema.controller import VELOCITY_ERROR, PIDVelocity
 from cerebx.signals import Frame
 from cerebx.stages.base import Stage

@@ -129,7 +129,7 @@ class ANN(Controller):
             return self._q_hist[i], self._qd_hist[i]
         return inp.q_des[: self.n_ctrl], inp.qd_des[: self.n_ctrl]
 
-    def step(self, inp: ControlInput) -> TorqueMsg:
+    def control(self, inp: ControlInput) -> TorqueMsg:
         self._remember_desired(inp)
         s = inp.sensor
         if s is None:
@@ -190,7 +190,7 @@ class ANN(Controller):
             "gain_Nm": list(self.cfg.gain_Nm),
         }
 
-    def save_state(self, path: Path) -> None:
+    def save_state(self, path: Path) -> bool:
         path = Path(path)
         meta = {
             "version": STATE_VERSION,
@@ -199,6 +199,7 @@ class ANN(Controller):
             "shape": list(self.w.shape),
         }
         save_state_npz(path, meta, w=self.w)
+        return True
 
     def load_state(self, path: Path) -> None:
         data, meta = load_state_npz(path, "ANN")
