@@ -112,8 +112,8 @@ def options_page() -> str:
 API_MODULES = {
     "The public API (what a plugin imports)": ["cerebx.api", "cerebx.api.schema", "cerebx.report.api"],
     "The platform": ["cerebx.registry", "cerebx.signals", "cerebx.wiring", "cerebx.runfiles", "cerebx.config",
-                     "cerebx.build", "cerebx.loop.loop", "cerebx.loop.runner", "cerebx.delay_channel",
-                     "cerebx.loop.resume"],
+                     "cerebx.builders", "cerebx.build", "cerebx.loop.loop", "cerebx.loop.lifecycle",
+                     "cerebx.loop.runner", "cerebx.delay_channel", "cerebx.loop.resume"],
     "Schemas": ["cerebx.schema.base", "cerebx.schema.experiment", "cerebx.schema.controller",
                 "cerebx.schema.stages", "cerebx.schema.plant", "cerebx.schema.task", "cerebx.schema.delay",
                 "cerebx.schema.events", "cerebx.schema.legacy"],

@@ -10,58 +10,18 @@ neighbours.
 
 from __future__ import annotations
 
-import os
-import zlib
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from cerebx import registry
+from cerebx.builders import BuildContext, cache_dir, component_rng
 from cerebx.delay_channel import Link
 from cerebx.errors import ConfigError
-from cerebx.signals import Signal
-from cerebx.stages.base import Receiver, Stage
+from cerebx.stages.base import Stage
 from cerebx.stages.controllers import Composite
 from cerebx.wiring import wire
 
-
-def component_rng(seed: int, name: str) -> np.random.Generator:
-    """An independent generator per component, derived from the one experiment seed."""
-    return np.random.default_rng(np.random.SeedSequence([seed, zlib.crc32(name.encode())]))
-
-
-def cache_dir() -> Path:
-    """Where derived artefacts (IK joint paths) are cached; override with CEREBX_CACHE."""
-    root = Path(os.environ.get("CEREBX_CACHE", Path.home() / ".cache" / "cerebx"))
-    root.mkdir(parents=True, exist_ok=True)
-    return root
-
-
-@dataclass
-class BuildContext:
-    """What builders may use (the whole config, the parts already built, the seed) and, once
-    :func:`build_components` is done, every part of the loop."""
-
-    cfg: Any
-    plant: Any = None
-    task: Any = None
-    run_dir: Path | None = None
-    controller: Any = None  # the stage the controller group built (before the build names its signals)
-    brain: list[Stage] = field(default_factory=list)  # controller stage first
-    link: Link | None = None
-    sent: tuple[Signal, ...] = ()  # what the brain side sends over the link
-    receiver: Receiver | None = None
-    robot: list[Stage] = field(default_factory=list)
-    events: list[tuple[Any, Any]] = field(default_factory=list)  # (scheduled event, fire)
-
-    def rng(self, name: str) -> np.random.Generator:
-        return component_rng(self.cfg.seed, name)
-
-    @property
-    def cache_dir(self) -> Path:
-        return cache_dir()
+__all__ = ["BuildContext", "as_stage", "build_components", "build_composite", "cache_dir", "component_rng"]
 
 
 def as_stage(obj: Any, cfg: Any, n_joints: int) -> Stage:

@@ -24,24 +24,41 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from importlib.metadata import entry_points
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any, Generic, TypeVar
 
 from pydantic import BaseModel, WrapValidator
 
 from cerebx.errors import CerebxError
+
+if TYPE_CHECKING:
+    from cerebx.builders import (
+        ClimbingEncoderBuilder,
+        ControllerBuilder,
+        DelayBuilder,
+        EventBuilder,
+        LinkBuilder,
+        MossyEncoderBuilder,
+        PlantBuilder,
+        ReceiverBuilder,
+        StageBuilder,
+        TaskBuilder,
+    )
+
+B = TypeVar("B", bound=Callable[..., Any])
+"""A group's builder protocol (``cerebx/builders.py``)."""
 
 ENTRY_POINTS = "cerebx.plugins"
 ONLY_ENV = "CEREBX_PLUGINS"
 
 
 @dataclass(frozen=True)
-class Entry:
+class Entry(Generic[B]):
     kind: str
     schema: type[BaseModel]
-    builder: str | Callable[..., Any]
+    builder: str | B
     plugin: str
 
-    def resolve(self) -> Callable[..., Any]:
+    def resolve(self) -> B:
         """The builder callable; a ``"module:attr"`` string is imported on first use (a plugin's module,
         loaded by name)."""
         if callable(self.builder):
@@ -50,15 +67,25 @@ class Entry:
         return getattr(importlib.import_module(module), attr)
 
 
-class Registry:
-    """Variants of one component group (``task``, ``plant``, ``controller``, ``delay`` ...)."""
+class Registry(Generic[B]):
+    """Variants of one component group (``task``, ``plant``, ``controller``, ``delay`` ...), each built by a
+    builder of the group's protocol ``B`` (``cerebx/builders.py``)."""
 
     def __init__(self, group: str):
         self.group = group
-        self._entries: dict[str, Entry] = {}
+        self._entries: dict[str, Entry[B]] = {}
 
-    def register(self, schema: type[BaseModel], builder: str | Callable[..., Any]) -> type[BaseModel]:
-        """Register ``schema`` (whose ``kind`` field default names the variant) and its builder."""
+    def register(self, schema: type[BaseModel], builder: str | B) -> type[BaseModel]:
+        """Register ``schema`` (whose ``kind`` field default names the variant) and its builder.
+
+        Parameters
+        ----------
+        schema : type[BaseModel]
+            The kind's config model; the default of its ``kind`` field is the kind's name.
+        builder : str or callable
+            The builder (of the group's protocol), or ``"module:attr"`` naming it (imported on first use, so
+            heavy modules load only when a run uses the kind).
+        """
         kind = schema.model_fields["kind"].default
         if not isinstance(kind, str):
             raise TypeError(f"{schema.__name__}: the 'kind' field needs a string default")
@@ -77,7 +104,7 @@ class Registry:
     def __contains__(self, kind: str) -> bool:
         return kind in self._entries
 
-    def __getitem__(self, kind: str) -> Entry:
+    def __getitem__(self, kind: str) -> Entry[B]:
         try:
             return self._entries[kind]
         except KeyError:
@@ -98,14 +125,14 @@ class Registry:
         return self._entries[kind].schema.model_validate(value)
 
 
-tasks = Registry("task")
-plants = Registry("plant")
-controllers = Registry("controller")
-stages = Registry("stage")
-delays = Registry("delay")
-events = Registry("event")
-encoders = Registry("encoder")
-links = Registry("link")
+tasks: Registry[TaskBuilder] = Registry("task")
+plants: Registry[PlantBuilder] = Registry("plant")
+controllers: Registry[ControllerBuilder] = Registry("controller")
+stages: Registry[StageBuilder | ReceiverBuilder] = Registry("stage")
+delays: Registry[DelayBuilder] = Registry("delay")
+events: Registry[EventBuilder] = Registry("event")
+encoders: Registry[MossyEncoderBuilder | ClimbingEncoderBuilder] = Registry("encoder")
+links: Registry[LinkBuilder] = Registry("link")
 
 GROUPS = {r.group: r for r in (tasks, plants, controllers, stages, delays, events, encoders, links)}
 

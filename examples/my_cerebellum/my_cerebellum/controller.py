@@ -7,14 +7,22 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.api import ControlInput, Controller, StateMismatchError, TorqueMsg, load_state_npz, save_state_npz
+from cerebx.api import (
+    BuildContext,
+    ControlInput,
+    Controller,
+    StateMismatchError,
+    TorqueMsg,
+    load_state_npz,
+    save_state_npz,
+)
 from my_cerebellum.schema import AdaptiveFilterConfig
 
 STEP_S = 0.002
 
 
 class AdaptiveFilter(Controller):
-    def __init__(self, cfg: AdaptiveFilterConfig, ctx: Any = None):
+    def __init__(self, cfg: AdaptiveFilterConfig, ctx: BuildContext | None = None):
         self.cfg = cfg
         self.n_joints = cfg.n_joints
         tau = np.geomspace(cfg.tau_min_ms, cfg.tau_max_ms, cfg.filters) / 1000.0

@@ -10,6 +10,11 @@ import from cerebx. Everything else is internal and may change between versions;
   implement ``control(ControlInput) -> TorqueMsg``), ``Plant`` (a robot or
   body; ``MujocoArm`` for MuJoCo models), ``Task`` and ``TrialReference`` (desired trajectories), the encoders'
   interface (``MossyEncoder``, ``ClimbingEncoder``: see the how-tos), ``Frame`` (one tick's signals), ``LWPR``.
+- Builders: ``BuildContext`` (what a builder is given: the config, the parts built before it, a generator per
+  component) and one builder protocol per registry group (``TaskBuilder``, ``PlantBuilder``,
+  ``ControllerBuilder``, ``StageBuilder``, ``ReceiverBuilder``, ``DelayBuilder``, ``EventBuilder``,
+  ``MossyEncoderBuilder``, ``ClimbingEncoderBuilder``, ``LinkBuilder``), with ``PlantView`` and ``TaskView``
+  (what a builder may use of the plant and the task).
 - Checkers a plugin runs in its tests: ``check_plant``, ``check_experiment``.
 - Learned state: ``save_state_npz``, ``load_state_npz``.
 - Building and loading an experiment: ``load`` (compose and validate a command line's overrides),
@@ -28,6 +33,8 @@ from cerebx.api.schema import *  # noqa: F403 - the schema layer's names are par
 from cerebx.api.schema import __all__ as _schema_names
 
 RUNTIME = (
+    "BuildContext", "ClimbingEncoderBuilder", "ControllerBuilder", "DelayBuilder", "EventBuilder", "LinkBuilder",
+    "MossyEncoderBuilder", "PlantBuilder", "PlantView", "ReceiverBuilder", "StageBuilder", "TaskBuilder", "TaskView",
     "LWPR", "ClimbingEncoder", "ControlInput", "Controller", "Frame", "MossyEncoder", "MujocoArm", "Plant",
     "PlantEvent", "Stage", "Task", "TorqueMsg", "TrialReference", "build_components", "channel_counts",
     "check_experiment", "check_plant", "final_mae", "grab_anchor", "half_sine", "load", "load_state_npz",

@@ -28,6 +28,7 @@ import numpy as np
 
 from cerebx import registry, runfiles
 from cerebx.build import build_components
+from cerebx.builders import BuildContext
 from cerebx.errors import CerebxError, LinkLost, PeerEnded, outcome
 from cerebx.link import clock
 from cerebx.link.auth import Signer, key_from_env, new_key, require_key
@@ -55,7 +56,7 @@ BYE_WAIT_S = 5.0  # after the last tick, for the robot side's last trial and its
 class BrainSide:
     """Steps the brain half of the loop as sensor messages arrive."""
 
-    def __init__(self, ctx: Any, rec: Recorder, end: LinkEnd, t0_robot_ns: int, events: LinkEvents):
+    def __init__(self, ctx: BuildContext, rec: Recorder, end: LinkEnd, t0_robot_ns: int, events: LinkEvents):
         cfg = ctx.cfg
         self.cfg, self.ctx, self.rec, self.end = cfg, ctx, rec, end
         self.link = cfg.link
@@ -408,7 +409,7 @@ def run_brain_side(cfg: Any, run_dir: Path, resolved: dict | None = None, overri
         children.finish()
 
 
-def _run_paired(cfg: Any, run_dir: Path, ctx: Any, end: LinkEnd, welcome: Packet, resolved: dict | None,
+def _run_paired(cfg: Any, run_dir: Path, ctx: BuildContext, end: LinkEnd, welcome: Packet, resolved: dict | None,
                 overrides: list[str], choices: dict[str, str] | None, children: Children) -> dict[str, Any]:
     run_id = end.run_id or bytes(16)
     life = RunLifecycle(cfg, run_dir, compression=cfg.link.compression, overrides=overrides, resolved=resolved,

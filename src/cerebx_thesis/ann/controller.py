@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from cerebx.api import (
+    BuildContext,
     ControlInput,
     Controller,
     StateMismatchError,
@@ -47,7 +48,7 @@ STATE_VERSION = 1
 
 
 class ANN(Controller):
-    def __init__(self, cfg: ANNController, ctx: Any = None):
+    def __init__(self, cfg: ANNController, ctx: BuildContext | None = None):
         self.cfg = cfg
         nj = cfg.n_joints
         self.n_ctrl = nj

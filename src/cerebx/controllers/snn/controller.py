@@ -39,6 +39,7 @@ import numpy as np
 from numba import njit
 
 from cerebx import phase_clock, registry
+from cerebx.builders import BuildContext
 from cerebx.controllers.base import CommandMsg, ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
 from cerebx.controllers.snn.schema import SNNController
@@ -151,7 +152,7 @@ def _serve(jobs: queue.SimpleQueue, taken: queue.SimpleQueue, done: queue.Simple
 
 
 class SNNControllerImpl(Controller):
-    def __init__(self, cfg: SNNController, ctx: Any):
+    def __init__(self, cfg: SNNController, ctx: BuildContext):
         t0 = time.perf_counter()
         self.cfg = cfg
         self.net_cfg = cfg.network
