@@ -51,7 +51,21 @@ def _check_step(ctx: BuildContext) -> None:
 
 def build_components(cfg: Any, run_dir: Path | None = None) -> BuildContext:
     """Build and connect every part of the loop of ``cfg`` (its signals were checked by :func:`wire`
-    when the config was validated; the built plant must declare the same signals as its schema)."""
+    when the config was validated; the built plant must declare the same signals as its schema).
+
+    Parameters
+    ----------
+    cfg : ExperimentConfig
+        The validated experiment (``load(overrides)[0]``).
+    run_dir : Path, optional
+        The run's folder, for builders that write there.
+
+    Returns
+    -------
+    BuildContext
+        Every part of the loop: plant, task, controller and brain stages, link, receiver, robot stages,
+        events.
+    """
     wiring = wire(cfg)
     ctx = BuildContext(cfg=cfg, run_dir=run_dir)
     ctx.plant = registry.plants.build(cfg.plant, ctx)

@@ -138,7 +138,13 @@ GROUPS = {r.group: r for r in (tasks, plants, controllers, stages, delays, event
 
 
 def Plugin(group: str) -> Any:  # noqa: N802 - reads as a type in schemas
-    """The type of a config field holding any registered kind of ``group`` (looked up at validation)."""
+    """The type of a config field holding any registered kind of ``group`` (looked up at validation).
+
+    Parameters
+    ----------
+    group : str
+        The registry group (``"controller"``, ``"stage"``, ``"encoder"``, ...).
+    """
 
     def pick(value: Any, handler: Any) -> BaseModel:
         load_plugins()
@@ -166,19 +172,39 @@ bench_runs: dict[str, tuple[str, ...]] = {}
 
 
 def add_config_source(package: str) -> None:
-    """Add the presets in ``package`` (a Python package holding config-group folders, e.g.
-    ``my_lab.conf`` with ``experiment/``, ``controller/`` ...) to every composition."""
+    """Add the presets in ``package`` to every composition (after cerebx's own ``conf/``).
+
+    Parameters
+    ----------
+    package : str
+        A Python package holding config-group folders, e.g. ``my_lab.conf`` with ``experiment/``,
+        ``controller/`` ...
+    """
     config_sources.append(Source(_loading or "<direct>", package))
 
 
 def add_report(module: str) -> None:
-    """Name the module whose import registers this plugin's figures and studies (``cerebx.report``)."""
+    """Name the module whose import registers this plugin's figures and studies (``cerebx.report``).
+
+    Parameters
+    ----------
+    module : str
+        The module's import name, e.g. ``my_lab.report``.
+    """
     report_modules.append(Source(_loading or "<direct>", module))
 
 
 def add_bench_run(name: str, overrides: list[str]) -> None:
     """Have ``cerebx bench`` time ``cerebx run OVERRIDES`` (recording and checkpoints as configured) under
-    ``name``; a name already taken is refused."""
+    ``name``; a name already taken is refused.
+
+    Parameters
+    ----------
+    name : str
+        The run's name in the bench's report.
+    overrides : list of str
+        The command line's overrides.
+    """
     if name in bench_runs:
         raise ValueError(f"bench run {name!r} is already registered")
     bench_runs[name] = tuple(overrides)

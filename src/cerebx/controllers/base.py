@@ -31,7 +31,15 @@ class SensorMsg:
 
 @dataclass(frozen=True)
 class TorqueMsg:
-    """Controller-to-robot message: torque meant to be applied at ``stamp_s``."""
+    """Controller-to-robot message: torque meant to be applied at ``stamp_s``.
+
+    Parameters
+    ----------
+    stamp_s : float
+        When the torque is meant to be applied, s.
+    tau : numpy.ndarray (n_joints,)
+        Joint torques, N·m.
+    """
 
     stamp_s: float
     tau: np.ndarray
@@ -50,10 +58,19 @@ class CommandMsg:
 class ControlInput:
     """What a controller sees at one control step.
 
-    ``t_s`` is the controller's current time; ``q_des``/``qd_des`` the desired state at ``t_s``;
-    ``sensor`` the newest sensor message that has arrived through the R2C link (None before
-    the first one arrives). A controller that pairs a delayed measurement with the desired sample
-    of the measurement's own stamp keeps the recent desired samples itself (as the SNN and ANN do).
+    A controller that pairs a delayed measurement with the desired sample of the measurement's own stamp
+    keeps the recent desired samples itself (as the SNN and ANN do).
+
+    Parameters
+    ----------
+    tick : int
+        The control step's index.
+    t_s : float
+        The controller's current time, s.
+    q_des, qd_des : numpy.ndarray (n_joints,)
+        The desired state at ``t_s`` (rad, rad/s).
+    sensor : SensorMsg or None
+        The newest sensor message that has arrived through the R2C link (None before the first one).
     """
 
     tick: int

@@ -105,8 +105,17 @@ def check_stage(ctx: BuildContext, stage: Stage, twin: Stage, side: str, ticks: 
 
 
 def check_experiment(build: Callable[[], Any], ticks: int = 60) -> None:
-    """Check the controller and every stage of an experiment; ``build`` builds it afresh
-    (e.g. ``lambda: build_components(cfg)``) and is called twice."""
+    """Check the controller and every stage of an experiment against the stage contract: each is stepped
+    over random valid input beside a second build of itself; declared outputs written, finite, of their size
+    and identical between the two; a saved state loads. Raises on the first violation.
+
+    Parameters
+    ----------
+    build : callable
+        Builds the experiment afresh (e.g. ``lambda: build_components(cfg)``); called twice.
+    ticks : int
+        Ticks each stage is stepped.
+    """
     ctx, twin = build(), build()
     earlier: tuple[Signal, ...] = ()
     for st, tw in zip(ctx.brain, twin.brain):

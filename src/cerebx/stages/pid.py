@@ -17,7 +17,15 @@ from cerebx.stages.base import Stage
 
 
 def updates_every(rate_hz: float, ctx: BuildContext) -> int:
-    """Control ticks between two updates of a part running at ``rate_hz``."""
+    """Control ticks between two updates of a part running at ``rate_hz``.
+
+    Parameters
+    ----------
+    rate_hz : float
+        The part's update rate, Hz.
+    ctx : BuildContext
+        The build context (its config's ``control_dt_ms``).
+    """
     return max(1, int(round(1000.0 / (rate_hz * ctx.cfg.control_dt_ms))))
 
 
