@@ -19,7 +19,9 @@ def plugin_env(site: Path, package: str, version: str = "0.1.0") -> dict[str, st
     info.mkdir()
     (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {dist}\nVersion: {version}\n")
     (info / "entry_points.txt").write_text(f"[cerebx.plugins]\n{package} = {package}:register\n")
-    return {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(ROOT / "examples" / package)])}
+    # this tree's cerebx after the plugin: in a git worktree the installed (editable) cerebx is another tree's
+    path = [str(site), str(ROOT / "examples" / package), str(ROOT / "src")]
+    return {**os.environ, "PYTHONPATH": os.pathsep.join(path)}
 
 
 def run_python(env: dict[str, str], cwd: Path, *args: str) -> subprocess.CompletedProcess:

@@ -10,69 +10,25 @@ neighbours.
 
 from __future__ import annotations
 
-import os
-import zlib
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from cerebx import registry
-from cerebx.controllers.base import Controller
+from cerebx.builders import BuildContext, cache_dir, component_rng
 from cerebx.delay_channel import Link
 from cerebx.errors import ConfigError
-from cerebx.signals import Signal
-from cerebx.stages.base import Receiver, Stage
-from cerebx.stages.controllers import Composite, TorqueControllerStage
+from cerebx.stages.base import Stage
+from cerebx.stages.controllers import Composite
 from cerebx.wiring import wire
 
-
-def component_rng(seed: int, name: str) -> np.random.Generator:
-    """An independent generator per component, derived from the one experiment seed."""
-    return np.random.default_rng(np.random.SeedSequence([seed, zlib.crc32(name.encode())]))
-
-
-def cache_dir() -> Path:
-    """Where derived artefacts (IK joint paths) are cached; override with CEREBX_CACHE."""
-    root = Path(os.environ.get("CEREBX_CACHE", Path.home() / ".cache" / "cerebx"))
-    root.mkdir(parents=True, exist_ok=True)
-    return root
-
-
-@dataclass
-class BuildContext:
-    """What builders may use (the whole config, the parts already built, the seed) and, once
-    :func:`build_components` is done, every part of the loop."""
-
-    cfg: Any
-    plant: Any = None
-    task: Any = None
-    run_dir: Path | None = None
-    controller: Any = None  # the object the controller group built (a Controller or a Stage)
-    brain: list[Stage] = field(default_factory=list)  # controller stage first
-    link: Link | None = None
-    sent: tuple[Signal, ...] = ()  # what the brain side sends over the link
-    receiver: Receiver | None = None
-    robot: list[Stage] = field(default_factory=list)
-    events: list[tuple[Any, Any]] = field(default_factory=list)  # (scheduled event, fire)
-
-    def rng(self, name: str) -> np.random.Generator:
-        return component_rng(self.cfg.seed, name)
-
-    @property
-    def cache_dir(self) -> Path:
-        return cache_dir()
+__all__ = ["BuildContext", "as_stage", "build_components", "build_composite", "cache_dir", "component_rng"]
 
 
 def as_stage(obj: Any, cfg: Any, n_joints: int) -> Stage:
-    """A controller as a brain-side stage (joint-torque controllers run behind an adapter); its signals
-    are the ones its schema declares."""
-    if isinstance(obj, Controller):
-        obj = TorqueControllerStage(obj, cfg.kind, n_joints)
+    """The stage a controller builder returned, named after its kind, with the signals its schema declares."""
     if not isinstance(obj, Stage):
-        raise TypeError(f"controller {cfg.kind!r}: builder returned {type(obj).__name__}, neither a Controller "
-                        "nor a Stage")
+        raise TypeError(f"controller {cfg.kind!r}: builder returned {type(obj).__name__}, not a Stage (a "
+                        "joint-torque controller subclasses Controller, itself a Stage)")
     io = cfg.io(n_joints)
     obj.name, obj.reads, obj.writes, obj.adds = cfg.kind, io.reads, io.writes, io.adds | obj.adds
     return obj
@@ -95,7 +51,21 @@ def _check_step(ctx: BuildContext) -> None:
 
 def build_components(cfg: Any, run_dir: Path | None = None) -> BuildContext:
     """Build and connect every part of the loop of ``cfg`` (its signals were checked by :func:`wire`
-    when the config was validated; the built plant must declare the same signals as its schema)."""
+    when the config was validated; the built plant must declare the same signals as its schema).
+
+    Parameters
+    ----------
+    cfg : ExperimentConfig
+        The validated experiment (``load(overrides)[0]``).
+    run_dir : Path, optional
+        The run's folder, for builders that write there.
+
+    Returns
+    -------
+    BuildContext
+        Every part of the loop: plant, task, controller and brain stages, link, receiver, robot stages,
+        events.
+    """
     wiring = wire(cfg)
     ctx = BuildContext(cfg=cfg, run_dir=run_dir)
     ctx.plant = registry.plants.build(cfg.plant, ctx)

@@ -1,6 +1,7 @@
 """The platform's own kinds, registered through the ``cerebx.plugins`` entry point ``core`` like any
 plugin's. Builders are named as ``module:attr`` strings written here in code (never in configuration), so
-heavy modules (MuJoCo, numba kernels) load only when a run uses them."""
+heavy modules (MuJoCo, numba kernels) load only when a run uses them; each group's builders have the
+signature of its protocol in ``cerebx/builders.py`` (``TaskBuilder``, ``ReceiverBuilder``, ...)."""
 
 from cerebx import registry
 from cerebx.controllers.snn import schema as snn
@@ -37,7 +38,7 @@ def register() -> None:
     registry.controllers.register(snn.SNNController, "cerebx.controllers.snn.controller:SNNControllerImpl")
     registry.controllers.register(m.MuscleRestController, "cerebx.stages.muscles:build_muscle_rest")
 
-    # receivers take (cfg, ctx, signals the link delivers); other stages (cfg, ctx)
+    # receivers: ReceiverBuilder (cfg, ctx, the signals the link delivers); the others: StageBuilder (cfg, ctx)
     registry.stages.register(s.HoldConfig, "cerebx.stages.receivers:build_hold")
     registry.stages.register(s.MeanFilterConfig, "cerebx.stages.receivers:build_mean")
     registry.stages.register(s.FuturePastFilterConfig, "cerebx.stages.receivers:build_future_past")
@@ -53,7 +54,7 @@ def register() -> None:
     registry.delays.register(d.TraceDelay, "cerebx.loop.delays:trace_delay")
     registry.delays.register(d.PercentileDelay, "cerebx.loop.delays:percentile_delay")
 
-    # event builders take (cfg, plant) and return the function that fires the event
+    # EventBuilder: (cfg, plant) -> the function that fires the event
     registry.events.register(e.AttachPayload, "cerebx.plants.events:attach_payload")
     registry.events.register(e.DetachPayload, "cerebx.plants.events:detach_payload")
     registry.events.register(e.ElasticBand, "cerebx.plants.events:elastic_band")
@@ -62,11 +63,11 @@ def register() -> None:
     registry.events.register(e.FingerPush, "cerebx.plants.events:finger_push")
     registry.events.register(e.Grab, "cerebx.plants.events:grab")
 
-    # mossy encoders take (cfg, lo, hi); climbing encoders (cfg, n_joints, fibres_per_joint, kpos, kvel, rng)
+    # MossyEncoderBuilder (cfg, lo, hi); ClimbingEncoderBuilder (cfg, n_joints, fibres_per_joint, kpos, kvel, rng)
     registry.encoders.register(snn.BoxEncoder, "cerebx.snn.encoders:MossyEncoder")
     registry.encoders.register(snn.CFEncoder, "cerebx.snn.encoders:ClimbingEncoder")
 
-    # links: the tick-grid one of simulated time, and transports between processes; builders take (cfg, role, via_relay)
+    # links: the tick-grid one of simulated time, and transports between processes (LinkBuilder: cfg, role, via_relay)
     registry.links.register(lk.SimLink, "cerebx.link.transport:build_sim")
     registry.links.register(lk.ZenohLink, "cerebx.link.zenoh_link:ZenohTransport")
     registry.links.register(lk.UdpLink, "cerebx.link.udp:UdpTransport")

@@ -226,7 +226,20 @@ def _is_hydra(override: str) -> bool:
 
 
 def load(overrides: list[str], config_dir: str | None = None) -> tuple[Any, dict[str, Any]]:
-    """Compose and validate; returns (validated experiment, plain resolved dict)."""
+    """Compose the configuration of a command line's overrides (Hydra) and validate it (Pydantic).
+
+    Parameters
+    ----------
+    overrides : list of str
+        As on the command line, e.g. ``["+experiment=demo", "trials=3"]``.
+    config_dir : str, optional
+        A folder of presets used in place of cerebx's own ``conf/``.
+
+    Returns
+    -------
+    (ExperimentConfig, dict)
+        The validated experiment, and the plain resolved configuration it was made from.
+    """
     with _COMPOSING:  # the report composes jobs in threads
         plain = to_plain(compose(overrides, config_dir))
         try:

@@ -90,7 +90,13 @@ def torque_variability_of_mean(tau: np.ndarray, step_ms: float = 2.0) -> float:
 
 
 def final_mae(mae_per_trial: list[float]) -> float | None:
-    """Mean of the last 10 % of trials (at least one)."""
+    """Mean of the last 10 % of trials (at least one); None for no trials.
+
+    Parameters
+    ----------
+    mae_per_trial : list of float
+        The mean absolute joint error of each trial, rad.
+    """
     if not mae_per_trial:
         return None
     k = max(1, int(round(0.1 * len(mae_per_trial))))
@@ -116,28 +122,70 @@ def trials_to_threshold(mae_per_trial: list[float], threshold: float) -> int | N
 # ---- learning estimators over a MAE curve (one value per trial; docs/models.md#learning-estimators) ----------
 
 def final_error(mae_per_trial: list[float], n: int = 30) -> float:
-    """Eq. 9: mean MAE of the last ``n`` trials."""
+    """Eq. 9: mean MAE of the last ``n`` trials.
+
+    Parameters
+    ----------
+    mae_per_trial : list of float
+        The mean absolute joint error of each trial, rad (a summary's ``mae_per_trial``).
+    n : int
+        Trials at the end of the curve that make the final error (Luque et al. 2011 use 30).
+    """
     return float(np.mean(np.asarray(mae_per_trial, float)[-n:]))
 
 
 def accuracy_gain(mae_per_trial: list[float], n: int = 30) -> float:
-    """Eq. 8: MAE of the first trial minus the final error (same unit as the MAE)."""
+    """Eq. 8: MAE of the first trial minus the final error (same unit as the MAE).
+
+    Parameters
+    ----------
+    mae_per_trial : list of float
+        The mean absolute joint error of each trial, rad (a summary's ``mae_per_trial``).
+    n : int
+        Trials at the end of the curve that make the final error (Luque et al. 2011 use 30).
+    """
     return float(mae_per_trial[0]) - final_error(mae_per_trial, n)
 
 
 def final_error_stability(mae_per_trial: list[float], n: int = 30) -> float:
-    """Eq. 10: standard deviation of the MAE over the last ``n`` trials (lower = more stable)."""
+    """Eq. 10: standard deviation of the MAE over the last ``n`` trials (lower = more stable).
+
+    Parameters
+    ----------
+    mae_per_trial : list of float
+        The mean absolute joint error of each trial, rad (a summary's ``mae_per_trial``).
+    n : int
+        Trials at the end of the curve that make the final error (Luque et al. 2011 use 30).
+    """
     return float(np.std(np.asarray(mae_per_trial, float)[-n:]))
 
 
 def convergence_speed(mae_per_trial: list[float], n: int = 30) -> int:
-    """Eq. 11: the first trial whose MAE is at or below the final error (trials to converge)."""
+    """Eq. 11: the first trial whose MAE is at or below the final error (trials to converge).
+
+    Parameters
+    ----------
+    mae_per_trial : list of float
+        The mean absolute joint error of each trial, rad (a summary's ``mae_per_trial``).
+    n : int
+        Trials at the end of the curve that make the final error (Luque et al. 2011 use 30).
+    """
     mae = np.asarray(mae_per_trial, float)
     return int(np.argmax(mae <= final_error(mae_per_trial, n)))
 
 
 def improvement_pct(mae_per_trial: list[float], at_trial: int, n: int = 30) -> float:
     """Error reduction in % by ``at_trial``: 100 (1 - mean MAE of the ``n`` trials before it / MAE of the
-    first trial) (docs/models.md#learning-estimators)."""
+    first trial) (docs/models.md#learning-estimators).
+
+    Parameters
+    ----------
+    mae_per_trial : list of float
+        The mean absolute joint error of each trial, rad (a summary's ``mae_per_trial``).
+    at_trial : int
+        The trial (0-based) the reduction is measured at.
+    n : int
+        Trials before ``at_trial`` whose mean MAE is compared with the first trial's.
+    """
     mae = np.asarray(mae_per_trial, float)
     return float(100.0 * (1.0 - mae[max(0, at_trial - n):at_trial].mean() / mae[0]))

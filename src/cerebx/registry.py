@@ -24,24 +24,41 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from importlib.metadata import entry_points
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any, Generic, TypeVar
 
 from pydantic import BaseModel, WrapValidator
 
 from cerebx.errors import CerebxError
+
+if TYPE_CHECKING:
+    from cerebx.builders import (
+        ClimbingEncoderBuilder,
+        ControllerBuilder,
+        DelayBuilder,
+        EventBuilder,
+        LinkBuilder,
+        MossyEncoderBuilder,
+        PlantBuilder,
+        ReceiverBuilder,
+        StageBuilder,
+        TaskBuilder,
+    )
+
+B = TypeVar("B", bound=Callable[..., Any])
+"""A group's builder protocol (``cerebx/builders.py``)."""
 
 ENTRY_POINTS = "cerebx.plugins"
 ONLY_ENV = "CEREBX_PLUGINS"
 
 
 @dataclass(frozen=True)
-class Entry:
+class Entry(Generic[B]):
     kind: str
     schema: type[BaseModel]
-    builder: str | Callable[..., Any]
+    builder: str | B
     plugin: str
 
-    def resolve(self) -> Callable[..., Any]:
+    def resolve(self) -> B:
         """The builder callable; a ``"module:attr"`` string is imported on first use (a plugin's module,
         loaded by name)."""
         if callable(self.builder):
@@ -50,15 +67,25 @@ class Entry:
         return getattr(importlib.import_module(module), attr)
 
 
-class Registry:
-    """Variants of one component group (``task``, ``plant``, ``controller``, ``delay`` ...)."""
+class Registry(Generic[B]):
+    """Variants of one component group (``task``, ``plant``, ``controller``, ``delay`` ...), each built by a
+    builder of the group's protocol ``B`` (``cerebx/builders.py``)."""
 
     def __init__(self, group: str):
         self.group = group
-        self._entries: dict[str, Entry] = {}
+        self._entries: dict[str, Entry[B]] = {}
 
-    def register(self, schema: type[BaseModel], builder: str | Callable[..., Any]) -> type[BaseModel]:
-        """Register ``schema`` (whose ``kind`` field default names the variant) and its builder."""
+    def register(self, schema: type[BaseModel], builder: str | B) -> type[BaseModel]:
+        """Register ``schema`` (whose ``kind`` field default names the variant) and its builder.
+
+        Parameters
+        ----------
+        schema : type[BaseModel]
+            The kind's config model; the default of its ``kind`` field is the kind's name.
+        builder : str or callable
+            The builder (of the group's protocol), or ``"module:attr"`` naming it (imported on first use, so
+            heavy modules load only when a run uses the kind).
+        """
         kind = schema.model_fields["kind"].default
         if not isinstance(kind, str):
             raise TypeError(f"{schema.__name__}: the 'kind' field needs a string default")
@@ -77,7 +104,7 @@ class Registry:
     def __contains__(self, kind: str) -> bool:
         return kind in self._entries
 
-    def __getitem__(self, kind: str) -> Entry:
+    def __getitem__(self, kind: str) -> Entry[B]:
         try:
             return self._entries[kind]
         except KeyError:
@@ -98,20 +125,26 @@ class Registry:
         return self._entries[kind].schema.model_validate(value)
 
 
-tasks = Registry("task")
-plants = Registry("plant")
-controllers = Registry("controller")
-stages = Registry("stage")
-delays = Registry("delay")
-events = Registry("event")
-encoders = Registry("encoder")
-links = Registry("link")
+tasks: Registry[TaskBuilder] = Registry("task")
+plants: Registry[PlantBuilder] = Registry("plant")
+controllers: Registry[ControllerBuilder] = Registry("controller")
+stages: Registry[StageBuilder | ReceiverBuilder] = Registry("stage")
+delays: Registry[DelayBuilder] = Registry("delay")
+events: Registry[EventBuilder] = Registry("event")
+encoders: Registry[MossyEncoderBuilder | ClimbingEncoderBuilder] = Registry("encoder")
+links: Registry[LinkBuilder] = Registry("link")
 
 GROUPS = {r.group: r for r in (tasks, plants, controllers, stages, delays, events, encoders, links)}
 
 
 def Plugin(group: str) -> Any:  # noqa: N802 - reads as a type in schemas
-    """The type of a config field holding any registered kind of ``group`` (looked up at validation)."""
+    """The type of a config field holding any registered kind of ``group`` (looked up at validation).
+
+    Parameters
+    ----------
+    group : str
+        The registry group (``"controller"``, ``"stage"``, ``"encoder"``, ...).
+    """
 
     def pick(value: Any, handler: Any) -> BaseModel:
         load_plugins()
@@ -139,19 +172,39 @@ bench_runs: dict[str, tuple[str, ...]] = {}
 
 
 def add_config_source(package: str) -> None:
-    """Add the presets in ``package`` (a Python package holding config-group folders, e.g.
-    ``my_lab.conf`` with ``experiment/``, ``controller/`` ...) to every composition."""
+    """Add the presets in ``package`` to every composition (after cerebx's own ``conf/``).
+
+    Parameters
+    ----------
+    package : str
+        A Python package holding config-group folders, e.g. ``my_lab.conf`` with ``experiment/``,
+        ``controller/`` ...
+    """
     config_sources.append(Source(_loading or "<direct>", package))
 
 
 def add_report(module: str) -> None:
-    """Name the module whose import registers this plugin's figures and studies (``cerebx.report``)."""
+    """Name the module whose import registers this plugin's figures and studies (``cerebx.report``).
+
+    Parameters
+    ----------
+    module : str
+        The module's import name, e.g. ``my_lab.report``.
+    """
     report_modules.append(Source(_loading or "<direct>", module))
 
 
 def add_bench_run(name: str, overrides: list[str]) -> None:
     """Have ``cerebx bench`` time ``cerebx run OVERRIDES`` (recording and checkpoints as configured) under
-    ``name``; a name already taken is refused."""
+    ``name``; a name already taken is refused.
+
+    Parameters
+    ----------
+    name : str
+        The run's name in the bench's report.
+    overrides : list of str
+        The command line's overrides.
+    """
     if name in bench_runs:
         raise ValueError(f"bench run {name!r} is already registered")
     bench_runs[name] = tuple(overrides)

@@ -20,7 +20,19 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Signal:
-    """One named array: ``size`` values in ``unit``, each within [low, high]."""
+    """One named array: ``size`` values in ``unit``, each within [low, high].
+
+    Parameters
+    ----------
+    name : str
+        A dotted noun (``joint.q``, ``muscle.activation``).
+    size : int
+        Values.
+    unit : str
+        Their unit (``rad``, ``N·m``).
+    low, high : float or tuple of float
+        Bounds, one for all values or one per value.
+    """
 
     name: str
     size: int
@@ -38,7 +50,16 @@ class Signal:
 
 
 def joint_signals(n: int, tau_max: np.ndarray | None = None) -> dict[str, Signal]:
-    """The joint-space signals of an ``n``-joint torque-controlled plant."""
+    """The joint-space signals of an ``n``-joint torque-controlled plant: ``joint.q``, ``joint.qd``,
+    ``joint.torque``.
+
+    Parameters
+    ----------
+    n : int
+        Joints.
+    tau_max : array (n,), optional
+        Torque limits, N·m (the torque's bounds; unbounded when None).
+    """
     hi = math.inf if tau_max is None else tuple(float(t) for t in tau_max)
     lo = -math.inf if tau_max is None else tuple(-float(t) for t in tau_max)
     return {"joint.q": Signal("joint.q", n, "rad"), "joint.qd": Signal("joint.qd", n, "rad/s"),
@@ -47,7 +68,17 @@ def joint_signals(n: int, tau_max: np.ndarray | None = None) -> dict[str, Signal
 
 @dataclass(frozen=True)
 class StageIO:
-    """What a stage reads, writes, and adds to (a written signal that is summed with the present value)."""
+    """What a stage reads, writes, and adds to (a written signal that is summed with the present value).
+
+    Parameters
+    ----------
+    reads : tuple of str
+        The signals it needs, by name.
+    writes : tuple of Signal
+        The signals it produces.
+    adds : frozenset of str
+        Those of ``writes`` added to the present value instead of replacing it.
+    """
 
     reads: tuple[str, ...] = ()
     writes: tuple[Signal, ...] = ()
@@ -82,6 +113,17 @@ class Frame:
     On the brain side ``sensed`` is the newest sensor message that has arrived through the link
     (None before the first) and its values are also in ``signals``; ``stamp_s`` is the time the
     outgoing command is meant for (the tick's own time unless a stage stamps it later).
+
+    Parameters
+    ----------
+    tick : int
+        The tick's index.
+    t_s : float
+        Its time, s.
+    signals : dict of str to numpy.ndarray
+        The signals so far, by name (``joint.q``, ``ref.q``, ...).
+    sensed : Message, optional
+        The newest sensor message that has arrived (brain side).
     """
 
     __slots__ = ("tick", "t_s", "stamp_s", "signals", "sensed")

@@ -31,7 +31,7 @@ from cerebx.delay_channel import Link
 from cerebx.errors import CerebxError, Diverged
 from cerebx.loop.loop import ClosedLoop
 from cerebx.schema.controller import PDController
-from cerebx.stages.controllers import TorqueControllerStage
+from cerebx.signals import torque_controller_io
 from cerebx.stages.receivers import Hold
 
 STEP_S = 0.002
@@ -90,11 +90,13 @@ class _Law(Controller):
     def __init__(self, target: np.ndarray, tau_ff: np.ndarray, kp: np.ndarray, kd: np.ndarray):
         self.target, self.tau_ff, self.kp, self.kd = target, tau_ff, kp, kd
         self.n_joints = len(kp)
+        io = torque_controller_io(self.n_joints)
+        self.name, self.reads, self.writes = "tuning", io.reads, io.writes
 
     def reset(self, rng: np.random.Generator) -> None:
         pass
 
-    def step(self, inp: ControlInput) -> TorqueMsg:
+    def control(self, inp: ControlInput) -> TorqueMsg:
         s = inp.sensor
         if s is None:
             return TorqueMsg(inp.t_s, self.tau_ff)
@@ -123,7 +125,7 @@ class _Rig:
         Returns the true joint positions (steps, n) and the last applied torque.
         """
         ctx, plant = self.ctx, self.plant
-        law = TorqueControllerStage(_Law(target, tau_ff, kp, kd), "tuning", self.n)
+        law = _Law(target, tau_ff, kp, kd)
         link = Link(ctx.link.r2c.sampler, ctx.link.c2r.sampler)  # fresh queues, the run's delay model
         loop = ClosedLoop(dataclasses.replace(ctx, brain=[law], link=link, receiver=Hold(ctx.sent), robot=[]), None)
         plant.reset(q0, ctx.rng("tuning.plant"))

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from cerebx.api import Task, TrialReference
+from cerebx.api import BuildContext, Task, TrialReference
 from cerebx_capolei2020.schema import WristOscillationTask
 
 
 class WristOscillation(Task):
     control_dt_s = 0.002
 
-    def __init__(self, cfg: WristOscillationTask, ctx=None):
+    def __init__(self, cfg: WristOscillationTask, ctx: BuildContext | None = None):
         self.cfg = cfg
         self.period_s = cfg.period_s
         t = np.arange(self.steps_per_trial) * self.control_dt_s

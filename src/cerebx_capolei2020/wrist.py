@@ -17,7 +17,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from cerebx.api import Plant
+from cerebx.api import BuildContext, Plant
 from cerebx_capolei2020.schema import ICubWristConfig
 
 MJCF = Path(__file__).with_name("icub_wrist.xml")
@@ -28,7 +28,7 @@ class ICubWrist(Plant):
     joint_names = JOINTS
     control_dt_s = 0.002
 
-    def __init__(self, cfg: ICubWristConfig, ctx=None):
+    def __init__(self, cfg: ICubWristConfig, ctx: BuildContext | None = None):
         self.cfg = cfg
         spec = mujoco.MjSpec.from_file(str(MJCF))
         if not cfg.ball:

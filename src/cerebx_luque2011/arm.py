@@ -23,7 +23,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from cerebx.api import MujocoArm
+from cerebx.api import BuildContext, MujocoArm
 from cerebx_luque2011.schema import LWR3Config
 
 MJCF = Path(__file__).with_name("lwr3.xml")
@@ -54,7 +54,7 @@ class LWR3Arm(MujocoArm):
     joint_names = ("a1", "a2", "a4")
     control_dt_s = 0.002
 
-    def __init__(self, cfg: LWR3Config, ctx=None):
+    def __init__(self, cfg: LWR3Config, ctx: BuildContext | None = None):
         self._attach(cfg, lwr3_model(cfg))
 
     def nominal_model(self) -> mujoco.MjModel:

@@ -9,7 +9,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from cerebx.api import ConfigError, Frame, Stage
+from cerebx.api import BuildContext, ConfigError, Frame, Stage
 from cerebx_luque2011.schema import CrudeInverseDynamics
 
 
@@ -26,7 +26,7 @@ def inverse_torque(model: mujoco.MjModel, data: mujoco.MjData, q: np.ndarray, qd
 class CrudeInverseDynamicsStage(Stage):
     """Writes the feed-forward ``joint.torque`` of the nominal (object-free) arm model."""
 
-    def __init__(self, cfg: CrudeInverseDynamics, ctx: Any):
+    def __init__(self, cfg: CrudeInverseDynamics, ctx: BuildContext):
         nominal = getattr(ctx.plant, "nominal_model", None)
         if not callable(nominal):
             raise ConfigError(f"controller: crude_inverse_dynamics needs a plant with a nominal model; "

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cerebx.api import Task, TrialReference
+from cerebx.api import BuildContext, Task, TrialReference
 from cerebx_luque2011.schema import LuqueEightTask
 
 
@@ -20,7 +20,7 @@ def luque_eight(cfg: LuqueEightTask, t_s: np.ndarray) -> tuple[np.ndarray, np.nd
 class LuqueEight(Task):
     control_dt_s = 0.002
 
-    def __init__(self, cfg: LuqueEightTask, ctx=None):
+    def __init__(self, cfg: LuqueEightTask, ctx: BuildContext | None = None):
         self.cfg = cfg
         self.period_s = cfg.period_s
         q, qd, qdd = luque_eight(cfg, np.arange(self.steps_per_trial) * self.control_dt_s)

@@ -71,11 +71,11 @@ def test_first_step_outputs():
     """all_joints: PC = 96 w_init = 1.2 silences the DCN; own_joint: PC = 0.2, tau = 0.2 gain clip(e)."""
     e_pos = np.array([0.05, -0.02, 0.0, 0.3, -0.5, 0.01])  # rad; errors = k_pos * e_pos
     inp = _inp(e_pos, np.zeros(NJ))
-    tau_all = _ann(plasticity=False).step(inp).tau
+    tau_all = _ann(plasticity=False).control(inp).tau
     np.testing.assert_allclose(tau_all, 0.0, atol=1e-12)
     own = _ann(plasticity=False, pc_input="own_joint")
     e = np.asarray(own.cfg.k_pos) * e_pos
-    np.testing.assert_allclose(own.step(inp).tau, 0.2 * np.asarray(own.cfg.gain_Nm) * np.clip(e, -1, 1))
+    np.testing.assert_allclose(own.control(inp).tau, 0.2 * np.asarray(own.cfg.gain_Nm) * np.clip(e, -1, 1))
 
 
 def test_plasticity_one_step_exact():
@@ -85,7 +85,7 @@ def test_plasticity_one_step_exact():
     e_pos[3] = 0.05  # joint e1: e = 8 * 0.05 = 0.4 -> IO_ag = 0.4, IO_an = 0
     z = np.zeros(NJ)
     cells = ann.active_cells(e_pos, z, z, z)
-    ann.step(_inp(e_pos, z))
+    ann.control(_inp(e_pos, z))
     c = ann.cfg
     e = c.k_pos[3] * 0.05
     w0 = ann.w_init
@@ -105,7 +105,7 @@ def test_weights_stay_in_bounds():
     ann = _ann(ltd=0.5, ltp=0.5)
     rng = np.random.default_rng(0)
     for _ in range(200):
-        ann.step(
+        ann.control(
             _inp(
                 rng.uniform(-1, 1, NJ), rng.uniform(-1, 1, NJ), rng.uniform(-2, 2, NJ), rng.uniform(-2, 2, NJ)
             )
@@ -118,7 +118,7 @@ def test_state_round_trip(tmp_path):
     a = _ann()
     rng = np.random.default_rng(1)
     for _ in range(50):
-        a.step(_inp(rng.uniform(-1, 1, NJ), rng.uniform(-1, 1, NJ)))
+        a.control(_inp(rng.uniform(-1, 1, NJ), rng.uniform(-1, 1, NJ)))
     a.save_state(tmp_path / "s.npz")
     b = _ann()
     b.load_state(tmp_path / "s.npz")
@@ -150,12 +150,12 @@ def test_delayed_measurement_is_paired_with_the_newest_desired():
     z = np.zeros(NJ)
     old, new = np.full(NJ, -0.5), np.full(NJ, 0.02)
     for a in (ann, aligned):  # desired sample at tick 0 (t = 0), then at tick 5 (t = 10 ms)
-        a.step(ControlInput(0, 0.0, old, z, None))
+        a.control(ControlInput(0, 0.0, old, z, None))
     meas = SensorMsg(0.0, np.zeros(NJ), z)  # measured at t = 0, arrives 10 ms later
-    tau = ann.step(ControlInput(5, 0.010, new, z, meas)).tau
+    tau = ann.control(ControlInput(5, 0.010, new, z, meas)).tau
     e = np.asarray(ann.cfg.k_pos) * new
     np.testing.assert_allclose(tau, 0.2 * np.asarray(ann.cfg.gain_Nm) * np.clip(e, -1, 1))
-    tau_aligned = aligned.step(ControlInput(5, 0.010, new, z, meas)).tau
+    tau_aligned = aligned.control(ControlInput(5, 0.010, new, z, meas)).tau
     e_old = np.asarray(ann.cfg.k_pos) * old
     np.testing.assert_allclose(tau_aligned, 0.2 * np.asarray(ann.cfg.gain_Nm) * np.clip(e_old, -1, 1))
 
@@ -168,7 +168,7 @@ def test_weight_change_scales_with_the_granule_cells_joint_error():
     e_pos[3] = 0.05  # only joint e1 has an error: e = 8 * 0.05 = 0.4
     z = np.zeros(NJ)
     cells = ann.active_cells(e_pos, z, z, z)
-    ann.step(_inp(e_pos, z))
+    ann.control(_inp(e_pos, z))
     c, w0 = ann.cfg, ann.w_init
     e = c.k_pos[3] * 0.05
     base = np.bincount(cells[3]).argmax()

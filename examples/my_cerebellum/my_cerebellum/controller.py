@@ -7,14 +7,22 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.api import ControlInput, Controller, StateMismatchError, TorqueMsg, load_state_npz, save_state_npz
+from cerebx.api import (
+    BuildContext,
+    ControlInput,
+    Controller,
+    StateMismatchError,
+    TorqueMsg,
+    load_state_npz,
+    save_state_npz,
+)
 from my_cerebellum.schema import AdaptiveFilterConfig
 
 STEP_S = 0.002
 
 
 class AdaptiveFilter(Controller):
-    def __init__(self, cfg: AdaptiveFilterConfig, ctx: Any = None):
+    def __init__(self, cfg: AdaptiveFilterConfig, ctx: BuildContext | None = None):
         self.cfg = cfg
         self.n_joints = cfg.n_joints
         tau = np.geomspace(cfg.tau_min_ms, cfg.tau_max_ms, cfg.filters) / 1000.0
@@ -31,7 +39,7 @@ class AdaptiveFilter(Controller):
         self.x = self.decay * self.x + (1.0 - self.decay) * drive
         return np.concatenate([self.x.reshape(self.n_joints, -1), np.ones((self.n_joints, 1))], axis=1)
 
-    def step(self, inp: ControlInput) -> TorqueMsg:
+    def control(self, inp: ControlInput) -> TorqueMsg:
         g = self._granules(inp.q_des, inp.qd_des)
         self.history[inp.tick] = (g, inp.q_des, inp.qd_des)
         self.history.pop(inp.tick - 1000, None)
@@ -43,9 +51,10 @@ class AdaptiveFilter(Controller):
         tau = np.clip((self.w * g).sum(axis=1), -self.cfg.tau_max_Nm, self.cfg.tau_max_Nm)
         return TorqueMsg(inp.t_s, tau)
 
-    def save_state(self, path: Path) -> None:
+    def save_state(self, path: Path) -> bool:
         save_state_npz(path, {"kind": self.cfg.kind, "n_joints": self.n_joints, "filters": self.cfg.filters},
                        weights=self.w)
+        return True
 
     def load_state(self, path: Path) -> None:
         data, meta = load_state_npz(path, self.cfg.kind)

@@ -16,7 +16,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from cerebx.api import MujocoArm
+from cerebx.api import BuildContext, MujocoArm
 from my_lab.schema import PendulumConfig
 
 MJCF = Path(__file__).with_name("pendulum.xml")
@@ -45,7 +45,7 @@ class Pendulum(MujocoArm):
     joint_names = ("pivot",)
     control_dt_s = 0.002
 
-    def __init__(self, cfg: PendulumConfig, ctx=None):
+    def __init__(self, cfg: PendulumConfig, ctx: BuildContext | None = None):
         self._attach(cfg, pendulum_model(cfg))  # sensing, saturation, stepping and the end effector: MujocoArm
 
     def reset(self, q0: np.ndarray, rng: np.random.Generator) -> None:

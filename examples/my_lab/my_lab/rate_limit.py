@@ -6,12 +6,12 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.api import Frame, Stage
+from cerebx.api import BuildContext, Frame, Stage
 from my_lab.schema import RateLimitConfig
 
 
 class RateLimiter(Stage):
-    def __init__(self, cfg: RateLimitConfig, ctx: Any):
+    def __init__(self, cfg: RateLimitConfig, ctx: BuildContext):
         n = ctx.plant.n_joints
         io = cfg.io(n)
         self.name, self.reads, self.writes = cfg.kind, io.reads, io.writes  # what the loop and checker see

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cerebx.api import Task, TrialReference
+from cerebx.api import BuildContext, Task, TrialReference
 from my_lab.schema import SwingTask
 
 
@@ -17,7 +17,7 @@ def min_jerk(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class Swing(Task):
     control_dt_s = 0.002
 
-    def __init__(self, cfg: SwingTask, ctx=None):
+    def __init__(self, cfg: SwingTask, ctx: BuildContext | None = None):
         self.cfg = cfg
         self.period_s = cfg.period_s
         self.rest = np.asarray(cfg.rest_rad, float)

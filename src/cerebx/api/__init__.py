@@ -5,10 +5,16 @@ import from cerebx. Everything else is internal and may change between versions;
 
 - Configuration (the schema layer: no physics, network or log loaded): the names of :mod:`cerebx.api.schema`,
   re-exported here; a plugin's own ``schema`` modules import from there.
-- Runtime shapes: ``Stage`` (a part of the loop that reads and writes named signals every tick; a torque
-  controller is a stage), ``Controller`` (the older controller shape, still accepted), ``Plant`` (a robot or
+- Runtime shapes: ``Stage`` (a part of the loop that reads and writes named signals every tick, with one
+  ``save_state -> bool``), ``Controller`` (the joint-torque controller's base, a ``Stage`` whose subclasses
+  implement ``control(ControlInput) -> TorqueMsg``), ``Plant`` (a robot or
   body; ``MujocoArm`` for MuJoCo models), ``Task`` and ``TrialReference`` (desired trajectories), the encoders'
   interface (``MossyEncoder``, ``ClimbingEncoder``: see the how-tos), ``Frame`` (one tick's signals), ``LWPR``.
+- Builders: ``BuildContext`` (what a builder is given: the config, the parts built before it, a generator per
+  component) and one builder protocol per registry group (``TaskBuilder``, ``PlantBuilder``,
+  ``ControllerBuilder``, ``StageBuilder``, ``ReceiverBuilder``, ``DelayBuilder``, ``EventBuilder``,
+  ``MossyEncoderBuilder``, ``ClimbingEncoderBuilder``, ``LinkBuilder``), with ``PlantView`` and ``TaskView``
+  (what a builder may use of the plant and the task).
 - Checkers a plugin runs in its tests: ``check_plant``, ``check_experiment``.
 - Learned state: ``save_state_npz``, ``load_state_npz``.
 - Building and loading an experiment: ``load`` (compose and validate a command line's overrides),
@@ -27,6 +33,8 @@ from cerebx.api.schema import *  # noqa: F403 - the schema layer's names are par
 from cerebx.api.schema import __all__ as _schema_names
 
 RUNTIME = (
+    "BuildContext", "ClimbingEncoderBuilder", "ControllerBuilder", "DelayBuilder", "EventBuilder", "LinkBuilder",
+    "MossyEncoderBuilder", "PlantBuilder", "PlantView", "ReceiverBuilder", "StageBuilder", "TaskBuilder", "TaskView",
     "LWPR", "ClimbingEncoder", "ControlInput", "Controller", "Frame", "MossyEncoder", "MujocoArm", "Plant",
     "PlantEvent", "Stage", "Task", "TorqueMsg", "TrialReference", "build_components", "channel_counts",
     "check_experiment", "check_plant", "final_mae", "grab_anchor", "half_sine", "load", "load_state_npz",

@@ -2,12 +2,27 @@
 runs), loaded on first use of one of its names."""
 
 from cerebx.build import build_components
+from cerebx.builders import (
+    BuildContext,
+    ClimbingEncoderBuilder,
+    ControllerBuilder,
+    DelayBuilder,
+    EventBuilder,
+    LinkBuilder,
+    MossyEncoderBuilder,
+    PlantBuilder,
+    PlantView,
+    ReceiverBuilder,
+    StageBuilder,
+    TaskBuilder,
+    TaskView,
+)
 from cerebx.config import load
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
-from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.lwpr.model import LWPR
 from cerebx.metrics import final_mae
+from cerebx.persistence.state import load_state_npz, save_state_npz
 from cerebx.plants.base import Plant, PlantEvent
 from cerebx.plants.check import check_plant
 from cerebx.plants.interaction import grab_anchor, half_sine
@@ -22,6 +37,19 @@ from cerebx.stages.pid import updates_every
 from cerebx.tasks.base import Task, TrialReference
 
 __all__ = [
+    "BuildContext",
+    "ClimbingEncoderBuilder",
+    "ControllerBuilder",
+    "DelayBuilder",
+    "EventBuilder",
+    "LinkBuilder",
+    "MossyEncoderBuilder",
+    "PlantBuilder",
+    "PlantView",
+    "ReceiverBuilder",
+    "StageBuilder",
+    "TaskBuilder",
+    "TaskView",
     "LWPR",
     "ClimbingEncoder",
     "ControlInput",

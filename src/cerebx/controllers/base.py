@@ -1,22 +1,23 @@
-"""The joint-torque controller contract and its small per-step records.
+"""The joint-torque controller: a :class:`~cerebx.stages.base.Stage` with one input shape, and its small
+per-step records.
 
-A :class:`Controller` maps the desired joint state and the newest delayed joint measurement to a
-joint torque stamped with its application time. The loop runs it as a brain-side stage
-(``stages/controllers.py``); controllers with other inputs or outputs are stages themselves.
+A :class:`Controller` maps the desired joint state and the newest delayed joint measurement to a joint
+torque stamped with its application time (or to the named command signals its schema declares). It is a
+brain-side stage like any other (one ``save_state`` signature, one contract checker); its :meth:`step`
+hands the tick to :meth:`Controller.control` as a :class:`ControlInput`. Controllers with other inputs or
+outputs subclass :class:`~cerebx.stages.base.Stage` directly.
 """
 
 from __future__ import annotations
 
-from abc import ABC, abstractmethod
-from collections.abc import Mapping
+from abc import abstractmethod
 from dataclasses import dataclass
-from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from cerebx.recording.recorder import Recorder
+from cerebx.signals import Frame
+from cerebx.stages.base import Stage
 
 
 @dataclass(frozen=True)
@@ -30,7 +31,15 @@ class SensorMsg:
 
 @dataclass(frozen=True)
 class TorqueMsg:
-    """Controller-to-robot message: torque meant to be applied at ``stamp_s``."""
+    """Controller-to-robot message: torque meant to be applied at ``stamp_s``.
+
+    Parameters
+    ----------
+    stamp_s : float
+        When the torque is meant to be applied, s.
+    tau : numpy.ndarray (n_joints,)
+        Joint torques, N·m.
+    """
 
     stamp_s: float
     tau: np.ndarray
@@ -49,10 +58,19 @@ class CommandMsg:
 class ControlInput:
     """What a controller sees at one control step.
 
-    ``t_s`` is the controller's current time; ``q_des``/``qd_des`` the desired state at ``t_s``;
-    ``sensor`` the newest sensor message that has arrived through the R2C link (None before
-    the first one arrives). A controller that pairs a delayed measurement with the desired sample
-    of the measurement's own stamp keeps the recent desired samples itself (as the SNN and ANN do).
+    A controller that pairs a delayed measurement with the desired sample of the measurement's own stamp
+    keeps the recent desired samples itself (as the SNN and ANN do).
+
+    Parameters
+    ----------
+    tick : int
+        The control step's index.
+    t_s : float
+        The controller's current time, s.
+    q_des, qd_des : numpy.ndarray (n_joints,)
+        The desired state at ``t_s`` (rad, rad/s).
+    sensor : SensorMsg or None
+        The newest sensor message that has arrived through the R2C link (None before the first one).
     """
 
     tick: int
@@ -62,33 +80,56 @@ class ControlInput:
     sensor: SensorMsg | None
 
 
-class Controller(ABC):
-    """Produces torque commands. Stateful controllers also save and load their learned state."""
+class Controller(Stage):
+    """A brain-side stage that computes joint torques from the desired joint state and the newest sensor
+    message; subclasses implement :meth:`reset` and :meth:`control`.
+
+    It reads ``ref.q`` and ``ref.qd`` and writes ``joint.torque`` (or what its schema's ``io`` declares: the
+    build sets ``name``, ``reads`` and ``writes`` from the schema). Stateful controllers also implement
+    :meth:`~cerebx.stages.base.Stage.save_state` (returning True once written) and
+    :meth:`~cerebx.stages.base.Stage.load_state`.
+
+    Attributes
+    ----------
+    n_joints : int
+        Joints the controller commands.
+    """
 
     n_joints: int
+    _sensed: Any = None  # the sensor message last converted to a SensorMsg, and that SensorMsg
+    _sensor: SensorMsg | None = None
 
     @abstractmethod
     def reset(self, rng: np.random.Generator) -> None:
         """Prepare for a run (called once, before the first step)."""
 
     @abstractmethod
-    def step(self, inp: ControlInput) -> TorqueMsg | CommandMsg:
-        """One 2 ms control step: a joint torque, or the named signals the controller's schema declares."""
+    def control(self, inp: ControlInput) -> TorqueMsg | CommandMsg:
+        """One control step.
 
-    def end_trial(self, trial: int) -> Mapping[str, float]:
-        """Called after each trial; may return scalars to record (e.g. weight summaries), or a
-        :class:`~cerebx.signals.Deferred` that has them a little later."""
-        return {}
+        Parameters
+        ----------
+        inp : ControlInput
+            The tick, its time, the desired joint state and the newest sensor message that has arrived.
 
-    def attach_recorder(self, recorder: Recorder) -> None:
-        """Register extra MCAP channels (spikes, weights) before the run starts."""
+        Returns
+        -------
+        TorqueMsg or CommandMsg
+            A joint torque, or the named signals the controller's schema declares, stamped with the time
+            they are meant to be applied at.
+        """
 
-    def save_state(self, path: Path) -> None:
-        """Write the learned state; stateless controllers write nothing."""
-
-    def load_state(self, path: Path) -> None:
-        """Restore a state written by :meth:`save_state` (clear error on mismatch)."""
-
-    def describe(self) -> dict[str, Any]:
-        """Static facts for the run summary (sizes, gains)."""
-        return {}
+    def step(self, frame: Frame) -> None:
+        """The tick as a :class:`ControlInput` to :meth:`control`, its output written into ``frame``."""
+        sensed = frame.sensed
+        if sensed is not self._sensed:  # a new sensor message arrived: convert it once
+            self._sensed = sensed
+            self._sensor = None if sensed is None else SensorMsg(sensed.stamp_s, sensed["joint.q"], sensed["joint.qd"])
+        sig = frame.signals
+        cmd = self.control(ControlInput(frame.tick, frame.t_s, sig["ref.q"], sig["ref.qd"], self._sensor))
+        frame.stamp_s = cmd.stamp_s
+        if isinstance(cmd, CommandMsg):
+            for name, value in cmd.values.items():
+                self.emit(frame, name, value)
+        else:
+            self.emit(frame, "joint.torque", cmd.tau)

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 from cerebx.schema.controller import PDController
 
 
 class PD(Controller):
-    def __init__(self, cfg: PDController, ctx=None):
+    def __init__(self, cfg: PDController, ctx: BuildContext | None = None):
         self.cfg = cfg
         self.kp, self.kd = np.asarray(cfg.kp, float), np.asarray(cfg.kd, float)
         self.tau_max = np.asarray(cfg.tau_max_Nm, float)
@@ -20,7 +21,7 @@ class PD(Controller):
     def reset(self, rng: np.random.Generator) -> None:
         pass
 
-    def step(self, inp: ControlInput) -> TorqueMsg:
+    def control(self, inp: ControlInput) -> TorqueMsg:
         s = inp.sensor
         if s is None:
             return TorqueMsg(inp.t_s, self._zero)

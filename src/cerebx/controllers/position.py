@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 
 
@@ -17,7 +18,7 @@ class PositionServo(Controller):
     Before the first sensor message arrives the output is zero.
     """
 
-    def __init__(self, cfg: Any, ctx: Any = None):
+    def __init__(self, cfg: Any, ctx: BuildContext | None = None):
         self.cfg = cfg
         self.n_joints = len(cfg.kp)
         self._kp = np.asarray(cfg.kp, dtype=float)
@@ -31,7 +32,7 @@ class PositionServo(Controller):
     def reset(self, rng: np.random.Generator) -> None:
         pass
 
-    def step(self, inp: ControlInput) -> TorqueMsg:
+    def control(self, inp: ControlInput) -> TorqueMsg:
         if inp.sensor is None:
             return TorqueMsg(stamp_s=inp.t_s, tau=np.zeros(self.n_joints))
         q, qd = inp.sensor.q, inp.sensor.qd

@@ -23,6 +23,7 @@ import uuid
 from typing import Any
 
 from cerebx import __version__
+from cerebx.builders import BuildContext
 from cerebx.errors import CerebxError
 from cerebx.link import clock
 from cerebx.link.channel import LinkEnd
@@ -51,7 +52,7 @@ def new_run_id() -> bytes:
     return uuid.uuid4().bytes
 
 
-def controller_facts(ctx: Any) -> dict[str, Any]:
+def controller_facts(ctx: BuildContext) -> dict[str, Any]:
     """What the robot side needs from the brain side's controller: the position bounds its supervisor
     watches (the controller's encoder ranges), when the controller has them."""
     bounds = getattr(ctx.controller, "position_bounds", None)

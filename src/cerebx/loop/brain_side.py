@@ -17,7 +17,6 @@ relay (``cerebx relay``, in ``RUN_DIR/relay``) itself unless ``link.spawn_robot=
 
 from __future__ import annotations
 
-import json
 import os
 import subprocess
 import sys
@@ -27,8 +26,9 @@ from typing import Any
 
 import numpy as np
 
-from cerebx import __version__, registry, runfiles
+from cerebx import registry, runfiles
 from cerebx.build import build_components
+from cerebx.builders import BuildContext
 from cerebx.errors import CerebxError, LinkLost, PeerEnded, outcome
 from cerebx.link import clock
 from cerebx.link.auth import Signer, key_from_env, new_key, require_key
@@ -39,13 +39,13 @@ from cerebx.link.shedding import Watchdog, prepare_real_time, shed_targets
 from cerebx.link.stats import describe
 from cerebx.link.transport import with_free_ports
 from cerebx.link.wire import Kind, Packet
+from cerebx.loop.lifecycle import RunLifecycle
 from cerebx.loop.loop import RECORD_AS
 from cerebx.loop.phases import brain_phase
 from cerebx.loop.realtime import ROBOT_DIR, LinkEvents, TickLog, side_summary
 from cerebx.metrics import TrialMetrics
 from cerebx.recording.recorder import Recorder
-from cerebx.recording.sentinel import Sentinel
-from cerebx.recording.summary import finish_run, new_summary, read_summary, trial_fields, write_summary
+from cerebx.recording.summary import read_summary, trial_fields
 from cerebx.signals import Message
 
 CHILD_DROPS = ("init_from", "resume", "link.robot", "link.brain", "link.relay", "link.spawn_robot",
@@ -56,7 +56,7 @@ BYE_WAIT_S = 5.0  # after the last tick, for the robot side's last trial and its
 class BrainSide:
     """Steps the brain half of the loop as sensor messages arrive."""
 
-    def __init__(self, ctx: Any, rec: Recorder, end: LinkEnd, t0_robot_ns: int, events: LinkEvents):
+    def __init__(self, ctx: BuildContext, rec: Recorder, end: LinkEnd, t0_robot_ns: int, events: LinkEvents):
         cfg = ctx.cfg
         self.cfg, self.ctx, self.rec, self.end = cfg, ctx, rec, end
         self.link = cfg.link
@@ -409,26 +409,29 @@ def run_brain_side(cfg: Any, run_dir: Path, resolved: dict | None = None, overri
         children.finish()
 
 
-def _run_paired(cfg: Any, run_dir: Path, ctx: Any, end: LinkEnd, welcome: Packet, resolved: dict | None,
+def _run_paired(cfg: Any, run_dir: Path, ctx: BuildContext, end: LinkEnd, welcome: Packet, resolved: dict | None,
                 overrides: list[str], choices: dict[str, str] | None, children: Children) -> dict[str, Any]:
-    started = time.time()
-    wall0 = time.perf_counter()
-    summary = new_summary(cfg, version=__version__, overrides=overrides, started_at=started,
-                          presets=dict(choices or {}), side="brain")
-    write_summary(run_dir, summary)
-    sentinel = Sentinel(run_dir)
-    rec = Recorder(run_dir / runfiles.MCAP, chunk_size_kb=cfg.recording.chunk_size_kb, compression=cfg.link.compression)
     run_id = end.run_id or bytes(16)
+    life = RunLifecycle(cfg, run_dir, compression=cfg.link.compression, overrides=overrides, resolved=resolved,
+                        fields={"presets": dict(choices or {}), "side": "brain"},
+                        metadata={"link": {"run_id": run_id.hex(), "side": "brain", "transport": cfg.link.kind,
+                                           "fingerprint": fingerprint(cfg), "robot_dir": ROBOT_DIR,
+                                           **{k: str(v) for k, v in end.transport.describe().items()}}})
+    rec = life.rec
     rec.joint_names = tuple(ctx.plant.joint_names)
-    rec.metadata("cerebx", {"version": __version__, "overrides": json.dumps(overrides)})
-    rec.metadata("config", {"json": json.dumps(resolved if resolved is not None else cfg.model_dump(mode="json"))})
-    rec.metadata("link", {"run_id": run_id.hex(), "side": "brain", "transport": cfg.link.kind,
-                          "fingerprint": fingerprint(cfg), "robot_dir": ROBOT_DIR,
-                          **{k: str(v) for k, v in end.transport.describe().items()}})
     events = LinkEvents("brain", rec)
     side: BrainSide | None = None
     sync: list[dict[str, Any]] = []
-    try:
+
+    @life.on_close
+    def _close() -> None:
+        if isinstance(life.error, LinkLost):
+            print(f"brain side: {life.error} (status interrupted, {run_dir})", file=sys.stderr)
+        if side is not None and (side.robot_bye is None or life.status != "completed"):
+            _bye(end, life.summary)
+        _finish(life, side, end, events, sync, children)
+
+    with life:
         est, shared = sync_clock(end, cfg, welcome)
         sync.append(record_estimate(rec, 0.0, est, est.method))
         t0 = start(end, est.offset_ns, cfg.link.pair_timeout_s)
@@ -436,32 +439,18 @@ def _run_paired(cfg: Any, run_dir: Path, ctx: Any, end: LinkEnd, welcome: Packet
         side = BrainSide(ctx, rec, end, t0, events)
         side.shared_clock = shared
         side.start()
-        summary["controller_info"] = ctx.brain[0].describe()
+        life.summary["controller_info"] = ctx.brain[0].describe()
         try:
             for trial in range(cfg.trials):
                 side.run_trial(trial)
-                summary.update(trial_fields(side.metrics(), side.tick * side.dt_s))
-                write_summary(run_dir, summary)
+                life.progress(side.metrics(), side.tick * side.dt_s)
             side.wait_for_end(BYE_WAIT_S)
         except PeerEnded as err:
             if err.status == "completed" and side.tick >= cfg.trials * ctx.task.steps_per_trial:
-                summary["status"] = "completed"
+                life.completed()
             else:
-                summary.update(outcome(err), status="diverged" if err.status == "diverged" else "interrupted")
-    except BaseException as err:  # recorded in the log and summary.json; the exit code follows it
-        summary.update(outcome(err))
-        if isinstance(err, LinkLost):
-            print(f"brain side: {err} (status interrupted, {run_dir})", file=sys.stderr)
-        if not isinstance(err, (Exception, KeyboardInterrupt)):
-            raise
-    finally:
-        if summary["status"] == "running":
-            summary["status"] = "failed"
-        if side is not None and (side.robot_bye is None or summary["status"] != "completed"):
-            _bye(end, summary)
-        _finish(cfg, run_dir, summary, side, end, events, sync, wall0, children)
-        finish_run(rec, run_dir, summary, sentinel)
-    return summary
+                life.summary.update(outcome(err), status="diverged" if err.status == "diverged" else "interrupted")
+    return life.summary
 
 
 def _bye(end: LinkEnd, summary: dict[str, Any]) -> None:
@@ -473,10 +462,11 @@ def _bye(end: LinkEnd, summary: dict[str, Any]) -> None:
         time.sleep(0.02)
 
 
-def _finish(cfg: Any, run_dir: Path, summary: dict[str, Any], side: BrainSide | None, end: LinkEnd,
-            events: LinkEvents, sync: list[dict[str, Any]], wall0: float, children: Children) -> None:
+def _finish(life: RunLifecycle, side: BrainSide | None, end: LinkEnd, events: LinkEvents,
+            sync: list[dict[str, Any]], children: Children) -> None:
     """Fill the summary: the robot side's metrics (its own summary.json when it ran here), both sides'
     timing, the measured delays, the controller state."""
+    cfg, run_dir, summary = life.cfg, life.run_dir, life.summary
     robot: dict[str, Any] = {}
     if side is not None and side.robot_bye is not None:
         robot = dict(side.robot_bye)
@@ -503,7 +493,7 @@ def _finish(cfg: Any, run_dir: Path, summary: dict[str, Any], side: BrainSide | 
     wall = robot.get("wall_seconds") or ((now_ns() - side.t0()) / 1e9 if side is not None else 0.0)
     summary["wall_seconds"] = wall
     summary["rt_factor"] = sim / wall if wall else None
-    summary["setup_seconds"] = round(time.perf_counter() - wall0 - wall, 3)
+    summary["setup_seconds"] = round(time.perf_counter() - life.wall0 - wall, 3)
     brain_timing = side.timing() if side is not None else {}
     summary["link"] = side_summary(
         cfg, "brain", end.run_id or bytes(16), end, {"brain": brain_timing, "robot": robot.get("timing")}, events,
@@ -511,9 +501,6 @@ def _finish(cfg: Any, run_dir: Path, summary: dict[str, Any], side: BrainSide | 
         robot_dir=ROBOT_DIR if cfg.link.spawn_robot else None, children=codes,
         delays={"r2c_ms": describe(side.r2c_delays if side is not None else []),
                 "c2r_ms": (robot.get("timing") or {}).get("c2r_ms")})
-    if side is not None and cfg.recording.save_state and side.tick > 0:
-        try:
-            side.ctx.brain[0].save_state(run_dir / runfiles.STATE)
-        except Exception as err:  # the state is a bonus; the log must still be finished
-            summary["state_error"] = str(err)
+    if side is not None and side.tick > 0:
+        life.save_state(side.ctx.brain[0])
 

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.errors import CerebxError
 from cerebx.schema import delay as schema
 
@@ -112,16 +113,16 @@ def load_trace(path: str) -> np.ndarray:
     return data
 
 
-def no_delay(cfg: schema.NoDelay, ctx: Any) -> DelayModel:
+def no_delay(cfg: schema.NoDelay, ctx: BuildContext) -> DelayModel:
     return DelayModel(Constant(0.0), Constant(0.0))
 
 
-def constant_delay(cfg: schema.ConstantDelay, ctx: Any) -> DelayModel:
+def constant_delay(cfg: schema.ConstantDelay, ctx: BuildContext) -> DelayModel:
     r2c, c2r = cfg.per_direction()
     return DelayModel(Constant(r2c), Constant(c2r))
 
 
-def gamma_delay(cfg: schema.GammaDelay, ctx: Any) -> DelayModel:
+def gamma_delay(cfg: schema.GammaDelay, ctx: BuildContext) -> DelayModel:
     rng_r2c, rng_c2r = ctx.rng("delay.r2c"), ctx.rng("delay.c2r")
     if cfg.symmetric:
         shared = HalfRoundTrip(Gamma(cfg.r2c, cfg.monotonic, rng_r2c))
@@ -129,13 +130,13 @@ def gamma_delay(cfg: schema.GammaDelay, ctx: Any) -> DelayModel:
     return DelayModel(Gamma(cfg.r2c, cfg.monotonic, rng_r2c), Gamma(cfg.c2r, cfg.monotonic, rng_c2r))
 
 
-def trace_delay(cfg: schema.TraceDelay, ctx: Any) -> DelayModel:
+def trace_delay(cfg: schema.TraceDelay, ctx: BuildContext) -> DelayModel:
     data = load_trace(str(cfg.file()))
     r2c = data[:, 0]
     c2r = data[:, 1] if data.shape[1] > 1 else data[:, 0]
     return DelayModel(Trace(r2c, cfg.loop), Trace(c2r, cfg.loop))
 
 
-def percentile_delay(cfg: schema.PercentileDelay, ctx: Any) -> DelayModel:
+def percentile_delay(cfg: schema.PercentileDelay, ctx: BuildContext) -> DelayModel:
     return DelayModel(Percentiles(cfg.r2c_percentiles, ctx.rng("delay.r2c")),
                       Percentiles(cfg.c2r_percentiles, ctx.rng("delay.c2r")))

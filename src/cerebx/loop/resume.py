@@ -132,6 +132,7 @@ def load(cfg: Any, run_dir: Path, recorder: Recorder) -> tuple[ClosedLoop, float
         raise CerebxError(f"resume: {path} cannot be read ({type(err).__name__}: {err})") from None
     check(cfg, run_dir)  # again: the pickle may be newer than when the run started
     ctx = state["ctx"]
+    ctx.brain = checkpoint.unwrap_adapters(ctx.brain)  # a checkpoint from before controllers were stages
     ctx.cfg = cfg  # the trial count (and logging options) may change on resumption
     loop = ClosedLoop(ctx, recorder)
     for f, v in state["loop"].items():

@@ -25,7 +25,6 @@ stopped, or when nothing came from it for ``link_lost_after_ms`` (status interru
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import sys
 import time
@@ -35,23 +34,23 @@ from typing import Any
 
 import numpy as np
 
-from cerebx import __version__, registry, runfiles
+from cerebx import registry
 from cerebx.build import BuildContext
 from cerebx.config import load
-from cerebx.errors import CerebxError, LinkLost, PeerEnded, outcome
+from cerebx.errors import CerebxError, LinkLost, PeerEnded
 from cerebx.link.auth import require_key
 from cerebx.link.channel import Arrived, LinkEnd
 from cerebx.link.clock import host_identity, host_steal_ms, now_ns, pace, realtime_process
 from cerebx.link.pairing import START_LEAD_S, RemoteController, fingerprint, pong, wait_for_hello
 from cerebx.link.stats import describe
 from cerebx.link.wire import Kind, Packet
+from cerebx.loop.lifecycle import RunLifecycle
 from cerebx.loop.phases import DIVERGENCE_CHECK_TICKS, all_finite, check_diverged, control_message, robot_phase
 from cerebx.loop.realtime import LinkEvents, TickLog, side_summary
 from cerebx.metrics import TrialAccumulator, TrialMetrics, _put_row
 from cerebx.plants.mujoco_arm import _saturate
 from cerebx.recording.recorder import Recorder
-from cerebx.recording.sentinel import Sentinel
-from cerebx.recording.summary import finish_run, new_summary, trial_fields, write_summary
+from cerebx.recording.summary import trial_fields
 from cerebx.schema.stages import SupervisorConfig
 from cerebx.signals import Message
 from cerebx.stages.receivers import _push
@@ -364,21 +363,31 @@ def prepare_real_time() -> None:
 
 def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, hello: Any, overrides: list[str]) -> dict[str, Any]:
     """Build the robot side, open its files, start with the brain side and run; returns the summary."""
-    run_dir.mkdir(parents=True, exist_ok=True)
-    started = time.time()
-    summary = new_summary(cfg, version=__version__, overrides=overrides, started_at=started, side="robot")
-    write_summary(run_dir, summary)
-    sentinel = Sentinel(run_dir)
-    rec = Recorder(run_dir / runfiles.MCAP, chunk_size_kb=cfg.recording.chunk_size_kb, compression=cfg.link.compression)
     run_id = end.run_id or bytes(16)
-    rec.metadata("cerebx", {"version": __version__, "overrides": json.dumps(overrides)})
-    rec.metadata("config", {"json": json.dumps(cfg.model_dump(mode="json"))})
-    rec.metadata("link", {"run_id": run_id.hex(), "side": "robot", "transport": cfg.link.kind,
-                          "fingerprint": fingerprint(cfg), **{k: str(v) for k, v in end.transport.describe().items()}})
+    life = RunLifecycle(cfg, run_dir, compression=cfg.link.compression, overrides=overrides,
+                        fields={"side": "robot"},
+                        metadata={"link": {"run_id": run_id.hex(), "side": "robot", "transport": cfg.link.kind,
+                                           "fingerprint": fingerprint(cfg),
+                                           **{k: str(v) for k, v in end.transport.describe().items()}}})
+    rec = life.rec
     events = LinkEvents("robot", rec)
     side: RobotSide | None = None
-    wall0 = time.perf_counter()
-    try:
+
+    @life.on_close
+    def _close() -> None:
+        summary = life.summary
+        timing = side.timing() if side is not None else {}
+        wall = (side.ended_ns - side.t0) / 1e9 if side is not None and side.tick else time.perf_counter() - life.wall0
+        if side is not None:
+            summary.update(trial_fields(side.metrics, side.sim_seconds))
+        summary["wall_seconds"] = wall
+        summary["rt_factor"] = summary["sim_seconds"] / wall if wall > 0 else None
+        summary["setup_seconds"] = round(time.perf_counter() - life.wall0 - (wall if side is not None else 0), 3)
+        summary["link"] = side_summary(cfg, "robot", run_id, end, timing, events)
+        if not isinstance(summary.get("error"), str) or not summary["error"].startswith("the brain side ended"):
+            _bye(end, summary, timing)
+
+    with life:
         ctx = build_robot_parts(cfg, hello.info.get("controller") or {}, run_dir)
         rec.joint_names = tuple(ctx.plant.joint_names)
         prepare_real_time()
@@ -390,28 +399,9 @@ def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, hello: Any, overrides: list
         side.start()
         for trial in range(cfg.trials):
             side.run_trial(trial)
-            summary.update(trial_fields(side.metrics, side.sim_seconds))
-            write_summary(run_dir, summary)
-        summary["status"] = "completed"
-    except BaseException as err:  # recorded in the log and summary.json; the exit code follows it
-        summary.update(outcome(err))
-        if not isinstance(err, (Exception, KeyboardInterrupt)):
-            raise
-    finally:
-        if summary["status"] == "running":
-            summary["status"] = "failed"
-        timing = side.timing() if side is not None else {}
-        wall = (side.ended_ns - side.t0) / 1e9 if side is not None and side.tick else time.perf_counter() - wall0
-        if side is not None:
-            summary.update(trial_fields(side.metrics, side.sim_seconds))
-        summary["wall_seconds"] = wall
-        summary["rt_factor"] = summary["sim_seconds"] / wall if wall > 0 else None
-        summary["setup_seconds"] = round(time.perf_counter() - wall0 - (wall if side is not None else 0), 3)
-        summary["link"] = side_summary(cfg, "robot", run_id, end, timing, events)
-        if not isinstance(summary.get("error"), str) or not summary["error"].startswith("the brain side ended"):
-            _bye(end, summary, timing)
-        finish_run(rec, run_dir, summary, sentinel)
-    return summary
+            life.progress(side.metrics, side.sim_seconds)
+        life.completed()
+    return life.summary
 
 
 def _bye(end: LinkEnd, summary: dict[str, Any], timing: dict[str, Any]) -> None:

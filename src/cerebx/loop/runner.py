@@ -3,7 +3,6 @@ records, and writes a summary whatever happens (completed, interrupted, diverged
 
 from __future__ import annotations
 
-import json
 import logging
 import signal
 import sys
@@ -14,18 +13,17 @@ from typing import Any
 
 from tqdm import tqdm
 
-from cerebx import __version__, phase_clock, runfiles
+from cerebx import phase_clock, runfiles
 from cerebx.build import build_components
-from cerebx.errors import CerebxError, outcome
+from cerebx.errors import CerebxError
 from cerebx.loop import resume
 from cerebx.loop.brain_side import run_brain_side
 from cerebx.loop.instrument import instrument
+from cerebx.loop.lifecycle import RunLifecycle
 from cerebx.loop.loop import ClosedLoop
 from cerebx.recording import live as live_view
-from cerebx.recording.recorder import Recorder
 from cerebx.recording.scene import scene_writer
-from cerebx.recording.sentinel import Sentinel
-from cerebx.recording.summary import finish_run, new_summary, trial_fields, write_summary
+from cerebx.recording.summary import trial_fields
 
 log = logging.getLogger("cerebx")
 
@@ -66,73 +64,19 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
     if cfg.link.real:
         return run_brain_side(cfg, Path(run_dir), resolved, overrides, choices)
     run_dir = Path(run_dir)
-    run_dir.mkdir(parents=True, exist_ok=True)
-    started = time.time()
-    wall0 = time.perf_counter()
-    cpu0 = time.process_time()
     clock = phase_clock.PhaseClock("open") if cfg.recording.phase_times else None
     phase_clock.activate(clock)
-    summary = new_summary(cfg, version=__version__, overrides=list(overrides or []), started_at=started,
-                          presets=dict(choices or {}))
-    write_summary(run_dir, summary)
-    sentinel = Sentinel(run_dir)  # finishes the log and summary.json if this process is hard-killed
     live = live_view.start(cfg)
-    rec = Recorder(resume.recorder_path(cfg, run_dir), chunk_size_kb=cfg.recording.chunk_size_kb,
-                   compression=cfg.recording.compression, live=live)
-    rec.metadata("cerebx", {"version": __version__, "overrides": json.dumps(list(overrides or []))})
-    rec.metadata("config", {"json": json.dumps(resolved if resolved is not None else cfg.model_dump(mode="json"))})
+    life = RunLifecycle(cfg, run_dir, log_path=resume.recorder_path(cfg, run_dir), overrides=overrides,
+                        resolved=resolved, fields={"presets": dict(choices or {})}, live=live)
     loop: ClosedLoop | None = None
     ckpt = resume.Checkpointer(run_dir)
     bar = None
     wall_before = 0.0  # spent by the run this one continues
-    try:
-        with _sigterm_as_interrupt():
-            with phase_clock.span("build"):
-                if cfg.resume is not None:
-                    loop, wall_before = resume.load(cfg, run_dir, rec)
-                ctx = loop.ctx if loop is not None else build_components(cfg, run_dir)
-            rec.joint_names = tuple(ctx.plant.joint_names)
-            if cfg.init_from and loop is None:
-                state = Path(cfg.init_from) / runfiles.STATE
-                if not state.exists():
-                    raise CerebxError(f"init_from: {state} does not exist")
-                ctx.brain[0].load_state(state)
-            if loop is None:
-                loop = ClosedLoop(ctx, rec)
-                loop.start()
-            if clock is not None:
-                instrument(loop, clock)
-                clock.switch("loop")
-            loop.scene = scene_writer(cfg, ctx.plant, rec, live)
-            summary["controller_info"] = ctx.brain[0].describe()
-            with phase_clock.span("checkpoint"):
-                ckpt.prime(loop)  # the learned arrays written ahead of the first checkpoint, off this thread
-            bar = _progress(cfg, cfg.trials)
-            if bar is not None:
-                bar.update(loop.trials_done)
-            summary_written = float("-inf")  # the first trial is always written
-            for trial in range(loop.trials_done, cfg.trials):
-                m = loop.run_trial(trial)
-                if resume.due(loop):
-                    with phase_clock.span("checkpoint"):
-                        loop.settle()  # the checkpoint holds no /weights message still to write
-                        ckpt.save(loop, wall_before + time.perf_counter() - wall0)
-                if bar is not None:
-                    bar.set_postfix_str(f"trial {trial + 1}/{cfg.trials}  MAE {m.mae:.4f} rad")
-                    bar.update(1)
-                now = time.perf_counter()
-                if now - summary_written >= SUMMARY_EVERY_S:  # the last one is written when the run ends
-                    with phase_clock.span("summary"):
-                        summary.update(trial_fields(loop.metrics, loop.sim_seconds),
-                                       wall_seconds=wall_before + now - wall0)
-                        write_summary(run_dir, summary)
-                    summary_written = now
-            summary["status"] = "completed"
-    except BaseException as err:  # recorded in the log and summary.json; the caller's exit code follows it
-        summary.update(outcome(err))
-        if not isinstance(err, (Exception, KeyboardInterrupt)):
-            raise
-    finally:
+
+    @life.on_close
+    def _close() -> None:
+        summary = life.summary
         if clock is not None:
             clock.switch("finish")
         try:
@@ -141,33 +85,64 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             log.error("could not write the last checkpoint: %s", err)
         if bar is not None:
             bar.close()
-        if summary["status"] == "running":  # left by an exception that is not an Exception (SystemExit)
-            summary["status"] = "failed"
         if loop is not None:
             try:
                 loop.settle()  # the last trials' /weights
             except Exception as err:  # e.g. the network thread failed: the log must still be finished
                 log.error("could not write the last weight summaries: %s", err)
-        wall = wall_before + time.perf_counter() - wall0
+        wall = wall_before + time.perf_counter() - life.wall0
         if loop is not None:
             summary.update(trial_fields(loop.metrics, loop.sim_seconds))
-            if cfg.recording.save_state and loop.trials_done > 0:
-                try:
-                    with phase_clock.span("save_state"):
-                        loop.controller.save_state(run_dir / runfiles.STATE)
-                except Exception as err:  # the state is a bonus; the log must still be finished
-                    log.error("could not save controller state: %s", err)
+            if loop.trials_done > 0:
+                life.save_state(loop.controller)
         summary["wall_seconds"] = wall
         summary["rt_factor"] = summary["sim_seconds"] / wall if wall > 0 else None
-        summary["cpu_seconds"] = time.process_time() - cpu0
+        summary["cpu_seconds"] = time.process_time() - life.cpu0
         if clock is not None:
             summary["phase_times"] = clock.report()  # closing the log comes after: untimed
             phase_clock.activate(None)
-        try:
-            finish_run(rec, run_dir, summary, sentinel)
-        finally:
-            if live is not None:
-                live.stop()
-            if summary["status"] == "completed":
-                resume.finish(run_dir)
-    return summary
+
+    with life, _sigterm_as_interrupt():
+        rec = life.rec
+        with phase_clock.span("build"):
+            if cfg.resume is not None:
+                loop, wall_before = resume.load(cfg, run_dir, rec)
+            ctx = loop.ctx if loop is not None else build_components(cfg, run_dir)
+        rec.joint_names = tuple(ctx.plant.joint_names)
+        if cfg.init_from and loop is None:
+            state = Path(cfg.init_from) / runfiles.STATE
+            if not state.exists():
+                raise CerebxError(f"init_from: {state} does not exist")
+            ctx.brain[0].load_state(state)
+        if loop is None:
+            loop = ClosedLoop(ctx, rec)
+            loop.start()
+        if clock is not None:
+            instrument(loop, clock)
+            clock.switch("loop")
+        loop.scene = scene_writer(cfg, ctx.plant, rec, live)
+        life.summary["controller_info"] = ctx.brain[0].describe()
+        with phase_clock.span("checkpoint"):
+            ckpt.prime(loop)  # the learned arrays written ahead of the first checkpoint, off this thread
+        bar = _progress(cfg, cfg.trials)
+        if bar is not None:
+            bar.update(loop.trials_done)
+        summary_written = float("-inf")  # the first trial is always written
+        for trial in range(loop.trials_done, cfg.trials):
+            m = loop.run_trial(trial)
+            if resume.due(loop):
+                with phase_clock.span("checkpoint"):
+                    loop.settle()  # the checkpoint holds no /weights message still to write
+                    ckpt.save(loop, wall_before + time.perf_counter() - life.wall0)
+            if bar is not None:
+                bar.set_postfix_str(f"trial {trial + 1}/{cfg.trials}  MAE {m.mae:.4f} rad")
+                bar.update(1)
+            now = time.perf_counter()
+            if now - summary_written >= SUMMARY_EVERY_S:  # the last one is written when the run ends
+                with phase_clock.span("summary"):
+                    life.progress(loop.metrics, loop.sim_seconds, wall_seconds=wall_before + now - life.wall0)
+                summary_written = now
+        life.completed()
+    if life.status == "completed":
+        resume.finish(run_dir)
+    return life.summary

@@ -70,9 +70,21 @@ def _buffer(head: np.ndarray, norm_in: np.ndarray, norm_out: np.ndarray, capacit
 
 
 class LWPR:
-    """``LWPR(n_in, n_out, **params)``; ``update(x, y)`` trains on one pair and returns the prediction
-    of the RFs it updated; ``update_many(X, Y)`` does the same for a whole stream in one call;
-    ``predict(x)``, ``predict_many(X)``; ``activations(x)`` per output."""
+    """Locally weighted projection regression (Vijayakumar & Schaal): ``update(x, y)`` trains on one pair and
+    returns the prediction of the RFs it updated; ``update_many(X, Y)`` does the same for a whole stream in one
+    call; ``predict(x)``, ``predict_many(X)``; ``activations(x)`` per output.
+
+    Parameters
+    ----------
+    n_in : int
+        Input dimensions.
+    n_out : int
+        Output dimensions (one model per output).
+    params : LWPRParams, optional
+        The learning parameters (defaults when None).
+    **overrides
+        Fields of ``LWPRParams`` that replace those of ``params``.
+    """
 
     def __init__(self, n_in: int, n_out: int = 1, params: LWPRParams | None = None, **overrides: Any) -> None:
         if n_in < 1 or n_out < 1:

@@ -187,8 +187,37 @@ class _Pickler(cloudpickle.Pickler):
 
 
 MOVED = {"cerebx.controllers.pid": "cerebx.stages.pid", "cerebx.loop.link": "cerebx.delay_channel",
-         "cerebx.loop.checkpoint": "cerebx.persistence.checkpoint"}
+         "cerebx.loop.checkpoint": "cerebx.persistence.checkpoint",
+         "cerebx.controllers.state": "cerebx.persistence.state"}
 """Modules renamed since a checkpoint may have been written (old -> new), so that an earlier run resumes."""
+
+MOVED_CLASSES = {("cerebx.stages.controllers", "TorqueControllerStage"):
+                 ("cerebx.persistence.checkpoint", "TorqueControllerStage")}
+"""Classes gone or moved since a checkpoint may have been written ((module, name) old -> new)."""
+
+
+class TorqueControllerStage:
+    """What a checkpoint written before joint-torque controllers were stages holds in a controller's place:
+    the adapter that ran it. :func:`unwrap_adapters` puts the controller back in its place."""
+
+
+def unwrap_adapters(stages: list[Any]) -> list[Any]:
+    """``stages`` (and, in place, the parts of composite ones) with each old adapter replaced by the
+    controller it ran, which takes over the adapter's name, signals and last converted sensor message."""
+    out = []
+    for st in stages:
+        if isinstance(st, TorqueControllerStage):
+            d = st.__dict__
+            inner = d["controller"]
+            inner.name, inner.reads, inner.writes = d["name"], d["reads"], d["writes"]
+            inner.adds = d.get("adds", frozenset())
+            inner._sensed, inner._sensor = d.get("_sensed"), d.get("_sensor")
+            st = inner
+        parts = getattr(st, "parts", None)
+        if isinstance(parts, list):
+            parts[:] = unwrap_adapters(parts)
+        out.append(st)
+    return out
 
 
 class _Unpickler(pickle.Unpickler):
@@ -197,6 +226,7 @@ class _Unpickler(pickle.Unpickler):
         self.arrays, self.objects = arrays, objects
 
     def find_class(self, module: str, name: str) -> Any:
+        module, name = MOVED_CLASSES.get((module, name), (module, name))
         return super().find_class(MOVED.get(module, module), name)
 
     def persistent_load(self, pid: Any) -> Any:

@@ -25,7 +25,17 @@ from cerebx.signals import Signal, joint_signals
 
 @dataclass(frozen=True)
 class PlantEvent:
-    """Something that happens to the plant at a scheduled time (payload, force pulse, ...)."""
+    """Something that happens to the plant at a scheduled time (payload, force pulse, ...).
+
+    Parameters
+    ----------
+    time_s : float
+        When it happens, s of simulated time.
+    kind : str
+        What happens.
+    params : dict
+        Its parameters.
+    """
 
     time_s: float
     kind: str

@@ -30,11 +30,11 @@ joint.torque   motor torque            N·m (saturated at ``torque_limit_Nm``)
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import mujoco
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.plants.interaction import HandInteractions, add_to_spec
 from cerebx.plants.interaction import grab_anchor as grab_anchor  # re-exported for importers of this module
 from cerebx.plants.interaction import half_sine as half_sine
@@ -147,7 +147,7 @@ class BaxterArm(MujocoArm):
     joint_names = JOINTS
     control_dt_s = CONTROL_DT_S
 
-    def __init__(self, cfg: BaxterConfig | None = None, ctx: Any = None):
+    def __init__(self, cfg: BaxterConfig | None = None, ctx: BuildContext | None = None):
         cfg = cfg if cfg is not None else BaxterConfig()
         # the pendulum payload is built only when the experiment schedules one (or, without an
         # experiment, always: contract checks apply every event kind)

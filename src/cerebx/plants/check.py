@@ -93,7 +93,15 @@ def _rollout(plant: Plant, commands: Sequence[dict[str, np.ndarray]], seed: int,
 
 
 def check_plant(plant_factory: Callable[[], Plant], steps: int = ROLLOUT_STEPS) -> None:
-    """Raise :class:`PlantContractError` (an AssertionError) on the first contract violation."""
+    """Raise :class:`PlantContractError` (an AssertionError) on the first contract violation.
+
+    Parameters
+    ----------
+    plant_factory : callable
+        Builds the plant afresh (called more than once: determinism is checked on a second plant).
+    steps : int
+        Control steps of the rollouts.
+    """
     plant = plant_factory()
     n = plant.n_joints
     _require(n > 0 and len(plant.joint_names) == n, "joint_names must name every joint")

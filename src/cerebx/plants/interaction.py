@@ -20,14 +20,34 @@ _EPS_S = 1e-9  # an interaction ends on the first physics step at or after its e
 
 
 def half_sine(t_s: np.ndarray | float, duration_s: float) -> np.ndarray:
-    """Profile of a finger push: sin(pi t / T) on [0, T], else 0."""
+    """Profile of a finger push: sin(pi t / T) on [0, T], else 0.
+
+    Parameters
+    ----------
+    t_s : float or array
+        Time since the push began, s.
+    duration_s : float
+        The push's duration T, s.
+    """
     t = np.asarray(t_s, dtype=float)
     return np.where((t >= 0) & (t <= duration_s), np.sin(np.pi * np.clip(t / duration_s, 0.0, 1.0)), 0.0)
 
 
 def grab_anchor(t_s: np.ndarray | float, start_m: np.ndarray, displacement_m: np.ndarray, drag_s: float) -> np.ndarray:
     """Where the grabbing hand holds the spring, ``t_s`` after the grab: from ``start_m`` along
-    ``displacement_m`` with a minimum-jerk profile over ``drag_s``, then still (shape (..., 3))."""
+    ``displacement_m`` with a minimum-jerk profile over ``drag_s``, then still (shape (..., 3)).
+
+    Parameters
+    ----------
+    t_s : float or array
+        Time since the grab, s.
+    start_m : array (3,)
+        Where the hand grabs, m.
+    displacement_m : array (3,)
+        How far the hand drags, m.
+    drag_s : float
+        How long the drag lasts, s.
+    """
     s = np.clip(np.asarray(t_s, dtype=float) / drag_s, 0.0, 1.0)[..., None]
     return np.asarray(start_m) + (s**3 * (10 - 15 * s + 6 * s**2)) * np.asarray(displacement_m)
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import mujoco
 
+from cerebx.builders import BuildContext
 from cerebx.plants.mujoco_arm import MujocoArm
 from cerebx.schema.plant import Planar2Config
 
@@ -46,5 +47,5 @@ class Planar2Arm(MujocoArm):
     joint_names = ("shoulder", "elbow")
     control_dt_s = 0.002
 
-    def __init__(self, cfg: Planar2Config, ctx=None):
+    def __init__(self, cfg: Planar2Config, ctx: BuildContext | None = None):
         self._attach(cfg, mujoco.MjModel.from_xml_string(planar2_mjcf(cfg)))

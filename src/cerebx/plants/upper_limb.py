@@ -24,6 +24,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.plants.mujoco_arm import MujocoArm
 from cerebx.schema.plant import MUSCLES_UPPER_LIMB, UpperLimbConfig
 from cerebx.signals import Signal
@@ -65,7 +66,7 @@ class UpperLimb(MujocoArm):
     muscle_names = MUSCLES_UPPER_LIMB
     control_dt_s = 0.002
 
-    def __init__(self, cfg: UpperLimbConfig, ctx=None):
+    def __init__(self, cfg: UpperLimbConfig, ctx: BuildContext | None = None):
         model = mujoco.MjModel.from_xml_path(str(MJCF))
         names = tuple(model.actuator(i).name for i in range(model.nu))
         if names != MUSCLES_UPPER_LIMB:

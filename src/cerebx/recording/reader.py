@@ -114,6 +114,15 @@ def read_messages(path: Path | str, topics: list[str] | None = None, start_ns: i
     log. A file without a summary section (a run still going, or one killed with SIGKILL) is read as a
     stream up to its last complete record. The folder of a wall-clock run also holds its robot side's log
     (``robot/run.mcap``): the two are read as one (``recording/pair.py``).
+
+    Parameters
+    ----------
+    path : Path or str
+        A run folder or an MCAP file.
+    topics : list of str, optional
+        Only these topics (e.g. ``["/trial_metrics"]``); all when None.
+    start_ns, end_ns : int, optional
+        Only messages logged in [start_ns, end_ns) (simulated time, ns).
     """
     p = Path(path)
     if not p.is_dir():
@@ -162,7 +171,13 @@ def _read_file(p: Path, topics: list[str] | None, start_ns: int | None,
 
 def channel_counts(path: Path | str) -> dict[str, int]:
     """Message count per topic: from the file's summary section, by scanning a file without one, or (a
-    resumed run's folder) counted over its segments as :func:`read_messages` reads them."""
+    resumed run's folder) counted over its segments as :func:`read_messages` reads them.
+
+    Parameters
+    ----------
+    path : Path or str
+        A run folder or an MCAP file.
+    """
     if Path(path).is_dir() and len(segments(path)) > 1:
         per_topic: dict[str, int] = {}
         for topic, _t, _msg in read_messages(path):
@@ -201,7 +216,13 @@ def has_summary(path: Path | str) -> bool:
 def read_metadata(path: Path | str) -> dict[str, dict[str, str]]:
     """The metadata records of a file; of a run folder, its last segment's (each segment carries the
     config, and the last one the summary of the whole run); of a wall-clock run's folder, also the robot
-    side's records under ``robot.<name>``."""
+    side's records under ``robot.<name>``.
+
+    Parameters
+    ----------
+    path : Path or str
+        A run folder or an MCAP file.
+    """
     if Path(path).is_dir() and robot_log(path) is not None:
         both = _metadata(segments(path)[-1].path)
         both.update({f"robot.{k}": v for k, v in _metadata(robot_log(path)).items()})

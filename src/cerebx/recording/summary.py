@@ -122,7 +122,18 @@ def validate_summary(data: Any, where: Path | str) -> dict[str, Any]:
 
 
 def read_summary(run_dir: Path | str) -> dict[str, Any]:
-    """Read and validate ``RUN_DIR/summary.json``; a missing, unreadable or wrong-shaped file is one line."""
+    """Read and validate ``RUN_DIR/summary.json``; a missing, unreadable or wrong-shaped file is one line.
+
+    Parameters
+    ----------
+    run_dir : Path or str
+        The run folder.
+
+    Returns
+    -------
+    dict
+        The summary (a ``running`` one whose process is gone reads as ``killed``).
+    """
     p = Path(run_dir) / SUMMARY_FILE
     try:
         text = p.read_text()

@@ -83,9 +83,19 @@ class Plateau:
 
 def plateau(mae: Sequence[float] | np.ndarray, rule: PlateauRule | int, label: str = "",
             trials: int | None = None) -> Plateau:
-    """The plateau test of ``mae`` (MAE per measured learning trial) by ``rule`` (an int: the trials the
-    paper's shape needs, with the default window and tolerance); ``trials``: the run's trial count (default:
-    the curve's length)."""
+    """The plateau test of ``mae`` (MAE per measured learning trial) by ``rule``.
+
+    Parameters
+    ----------
+    mae : sequence of float
+        The MAE of each measured learning trial, rad.
+    rule : PlateauRule or int
+        The test; an int: the trials the paper's shape needs, with the default window and tolerance.
+    label : str
+        The curve's name in the figure's table.
+    trials : int, optional
+        The run's trial count (default: the curve's length).
+    """
     rule = rule if isinstance(rule, PlateauRule) else PlateauRule(int(rule))
     m = np.asarray(mae, dtype=float)
     n = int(m.size if trials is None else trials)
@@ -99,8 +109,13 @@ def plateau(mae: Sequence[float] | np.ndarray, rule: PlateauRule | int, label: s
 class Convergence:
     """The plateau tests of every learning curve behind a figure.
 
-    ``rows``: which paper-vs-cerebx rows (by their quantity) the learning concerns (every row when None); the
-    others (a baseline, a measurement without learning) get "–" in the ``converged`` column.
+    Parameters
+    ----------
+    curves : tuple of Plateau
+        One test per learning curve.
+    rows : callable, optional
+        Which paper-vs-cerebx rows (by their quantity) the learning concerns (every row when None); the
+        others (a baseline, a measurement without learning) get "–" in the ``converged`` column.
     """
 
     curves: tuple[Plateau, ...]
@@ -154,11 +169,23 @@ class Convergence:
 
 def learning_convergence(curves: Iterable[tuple[str, Run, PlateauRule | int]], runs: RunSet | None = None,
                          rows: Callable[[str], bool] | None = None, own: bool = False) -> Convergence:
-    """The convergence of the learning behind ``curves`` ((label, run, its study's rule)): the MAE
-    per measured trial of the run that learned each run's state from scratch (its origin: the run itself, or
-    the one it started from, in ``runs`` or on disk; ``own``: each run's own curve, for runs whose learning
-    from a state is the experiment). A run whose origin cannot be found is left out; an origin behind several
-    runs is tested once, under the first run's label."""
+    """The convergence of the learning behind ``curves``: the MAE per measured trial of the run that
+    learned each run's state from scratch (its origin: the run itself, or the one it started from).
+
+    A run whose origin cannot be found is left out; an origin behind several runs is tested once, under the
+    first run's label.
+
+    Parameters
+    ----------
+    curves : iterable of (str, Run, PlateauRule or int)
+        Each curve's label, its run and its study's rule.
+    runs : RunSet, optional
+        Where origins are looked up first (else on disk).
+    rows : callable, optional
+        Which paper-vs-cerebx rows (by their quantity) the learning concerns (default: every row).
+    own : bool
+        Test each run's own curve (runs whose learning from a state is the experiment).
+    """
     seen: dict[Path, Plateau] = {}
     for label, run, rule in curves:
         origin = run if own else (runs if runs is not None else RunSet()).origin(run)
@@ -172,5 +199,11 @@ def learning_convergence(curves: Iterable[tuple[str, Run, PlateauRule | int]], r
 
 
 def combined(*parts: Convergence) -> Convergence:
-    """The plateau tests of several convergences together (the first one's rows)."""
+    """The plateau tests of several convergences together (the first one's rows).
+
+    Parameters
+    ----------
+    *parts : Convergence
+        The convergences to join, in the order their tests are listed.
+    """
     return Convergence(tuple(c for p in parts for c in p.curves), parts[0].rows if parts else None)

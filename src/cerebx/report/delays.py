@@ -20,7 +20,13 @@ def _read_delays(run_dir: str, t1: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def delays(run: Run) -> tuple[np.ndarray, np.ndarray]:
-    """R2C and C2R delays (ms) of every 2 ms step in the run's first DELAY_TRIALS trials."""
+    """R2C and C2R delays (ms) of every 2 ms step in the run's first DELAY_TRIALS trials.
+
+    Parameters
+    ----------
+    run : Run
+        A run recorded over a delayed link (its ``/control`` messages carry the delays).
+    """
     return _read_delays(str(run.dir), round(max(1, min(run.trials, DELAY_TRIALS)) * run.period_s, 6))
 
 

@@ -35,7 +35,19 @@ class MissingRuns(Exception):
 @dataclass(frozen=True)
 class Check:
     """One shape of the paper tested on the runs (an ordering, a trend): the claim in the paper's terms,
-    whether it holds in these runs (None: they cannot tell) and the numbers it was decided on."""
+    whether it holds in these runs (None: they cannot tell) and the numbers it was decided on.
+
+    Parameters
+    ----------
+    claim : str
+        The claim, in the paper's terms.
+    holds : bool or None
+        Whether it holds in these runs (None: they cannot tell).
+    numbers : str
+        The numbers it was decided on.
+    explained_at : str, optional
+        Where a failing check's cause is shown (a docs page and anchor; set from the plugin's explanations file).
+    """
 
     claim: str
     holds: bool | None
@@ -46,6 +58,25 @@ class Check:
 
 @dataclass
 class Figure:
+    """What a figure function returns: its files, caption, the paper-vs-cerebx table and the checks.
+
+    Parameters
+    ----------
+    files : list of Path
+        The images written (:func:`save` returns each PNG).
+    caption : str
+        The caption.
+    table : list of list of str
+        Header row and rows, typically [quantity, paper, cerebx].
+    notes : list of str
+        Notes under the table.
+    checks : list of Check
+        The paper's shapes tested on the runs.
+    convergence : Convergence, optional
+        The plateau tests of the learning behind the figure; None: nothing learns in its runs.
+    intervals : dict of str to Interval
+        Headline quantities over independently learned seeds, keyed by the quantity of their table row.
+    """
     files: list[Path]
     caption: str
     # header row + rows, typically [quantity, paper, cerebx]
@@ -78,7 +109,20 @@ EXPLANATION_FILES: list[Path] = []
 
 
 def figure(name: str, title: str, studies: tuple[str, ...]) -> Callable:
-    """Register a figure function under ``name`` (unique across plugins)."""
+    """Register a figure function under ``name`` (unique across plugins); a decorator.
+
+    The decorated function takes the runs and a file stem and returns a :class:`Figure`
+    (``(runs: RunSet, stem: Path) -> Figure``); it raises :class:`MissingRuns` when its runs are absent.
+
+    Parameters
+    ----------
+    name : str
+        The figure's name (``cerebx report --figures NAME``), e.g. ``fig3_4``.
+    title : str
+        The title on the figure's page.
+    studies : tuple of str
+        The studies (from the plugin's studies file) whose runs the figure draws.
+    """
     def deco(fn: Callable[[RunSet, Path], Figure]) -> Callable[[RunSet, Path], Figure]:
         if name in FIGURES:
             raise ValueError(f"figure {name!r} registered twice")
@@ -88,7 +132,13 @@ def figure(name: str, title: str, studies: tuple[str, ...]) -> Callable:
 
 
 def studies(path: Path) -> None:
-    """Register a studies file (YAML, ``report/studies.py``) whose runs the plugin's figures need."""
+    """Register a studies file (YAML, ``report/studies.py``) whose runs the plugin's figures need.
+
+    Parameters
+    ----------
+    path : Path
+        The YAML file, usually beside the plugin's report module.
+    """
     path = Path(path).resolve()
     if path not in STUDY_FILES:
         STUDY_FILES.append(path)
@@ -96,7 +146,13 @@ def studies(path: Path) -> None:
 
 def explanations(path: Path) -> None:
     """Register an explanations file (YAML, ``report/explain.py``): for checks that fail, the docs page that
-    shows why, with the runs that show the cause."""
+    shows why, with the runs that show the cause.
+
+    Parameters
+    ----------
+    path : Path
+        The YAML file, usually beside the plugin's report module.
+    """
     path = Path(path).resolve()
     if path not in EXPLANATION_FILES:
         EXPLANATION_FILES.append(path)

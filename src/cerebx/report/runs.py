@@ -26,6 +26,15 @@ from cerebx.schema.legacy import upgrade
 
 @dataclass
 class Run:
+    """One run folder as the report reads it: its summary, and its config and log read on first use.
+
+    Parameters
+    ----------
+    dir : Path
+        The run folder.
+    summary : dict
+        Its ``summary.json`` (:meth:`Run.load` reads both).
+    """
     dir: Path
     summary: dict[str, Any]
     _config: dict[str, Any] | None = field(default=None, repr=False)
@@ -207,7 +216,9 @@ class Run:
 
 
 class RunSet(list):
-    """A list of runs with content filters."""
+    """A list of runs with content filters (``where``), the best of several (``best``), the seeds of a study
+    (``seeds``) and the run a state was learned in (``origin``); made like a list, from runs.
+    """
 
     def where(self, pred: Callable[[Run], bool] | None = None, **eq: Any) -> RunSet:
         def ok(r: Run) -> bool:

@@ -28,7 +28,19 @@ def t975(df: int) -> float:
 @dataclass(frozen=True)
 class Interval:
     """One headline quantity over seeds: the mean of ``n`` per-seed values and its 95 % interval
-    (``low`` = ``high`` = the value when n = 1), with the paper's number or range when it gives one."""
+    (``low`` = ``high`` = the value when n = 1), with the paper's number or range when it gives one.
+
+    Parameters
+    ----------
+    mean, low, high : float
+        The mean and the interval's ends.
+    n : int
+        Seeds.
+    values : tuple of float
+        The per-seed values.
+    paper : (float, float), optional
+        The paper's value (low == high) or range, in the same unit.
+    """
 
     mean: float
     low: float
@@ -63,8 +75,15 @@ class Interval:
 
 
 def interval(values: Iterable[float], paper: float | Sequence[float] | None = None) -> Interval:
-    """The mean and 95 % interval of per-seed ``values`` (non-finite ones left out); ``paper``: the paper's
-    number, or its (low, high) range."""
+    """The mean and 95 % interval of per-seed ``values`` (non-finite ones left out).
+
+    Parameters
+    ----------
+    values : iterable of float
+        One number per seed.
+    paper : float or (float, float), optional
+        The paper's number, or its (low, high) range, which the interval is compared with.
+    """
     v = np.asarray([x for x in values if x is not None and math.isfinite(x)], dtype=float)
     if v.size == 0:
         raise ValueError("no finite value to take an interval over")
@@ -79,9 +98,18 @@ def interval(values: Iterable[float], paper: float | Sequence[float] | None = No
 
 def with_intervals(table: list[list[str]], intervals: dict[str, Interval],
                    nd: int | Callable[[str], int] = 3) -> list[list[str]]:
-    """The table (rows of quantity, …, cerebx) with "; over seeds <mean [low, high] (n seeds)>" after the cerebx
-    cell of each row whose quantity has an interval over several seeds (``nd``: decimals, or a function of the
-    quantity giving them)."""
+    """The table (rows of quantity, …, cerebx) with "; over seeds <mean [low, high] (n seeds)>" after the
+    cerebx cell of each row whose quantity has an interval over several seeds.
+
+    Parameters
+    ----------
+    table : list of list of str
+        The paper-vs-cerebx rows, the quantity first and cerebx's value last.
+    intervals : dict of str to Interval
+        The interval of each quantity (by the row's first cell).
+    nd : int or callable
+        Decimals, or a function of the quantity giving them.
+    """
     digits = nd if callable(nd) else (lambda _q: nd)
     return [row if row[0] not in intervals or not intervals[row[0]].has_interval
             else [*row[:-1], f"{row[-1]}; over seeds {intervals[row[0]].text(digits(row[0]))}"] for row in table]

@@ -143,8 +143,14 @@ def profile_of(run_dirs: list[Path]) -> str | None:
 
 
 def study_plateau(name: str) -> PlateauRule:
-    """The plateau test of study ``name``'s learning curves, from the plugins' studies files: its full profile's
-    trials (where the paper's shape appears) and its ``plateau`` settings."""
+    """The plateau test of study ``name``'s learning curves, from the plugins' studies files: its full
+    profile's trials (where the paper's shape appears) and its ``plateau`` settings.
+
+    Parameters
+    ----------
+    name : str
+        The study's name in a studies file.
+    """
     load_reports()
     for path in STUDY_FILES:
         spec = _read_studies_cached(path).get(name)

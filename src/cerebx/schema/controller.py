@@ -123,7 +123,24 @@ class PIDVelocity(ControllerConfig):
 
 def periodic_part_problems(joints_field: str, n_joints: int, rate_hz: float, exp: Any) -> list[str]:
     """Problems of a part that updates ``n_joints`` joints at ``rate_hz``: it must drive the plant's joints,
-    and its rate must be the loop rate divided by a whole number."""
+    and its rate must be the loop rate divided by a whole number.
+
+    Parameters
+    ----------
+    joints_field : str
+        The config field that sets the joints (named in the problem).
+    n_joints : int
+        Joints the part drives.
+    rate_hz : float
+        The part's update rate, Hz.
+    exp : ExperimentConfig
+        The experiment (its plant and ``control_dt_ms``).
+
+    Returns
+    -------
+    list of str
+        One line per problem ("field: problem"); empty when none.
+    """
     out = []
     if n_joints != exp.plant.n_joints:
         out.append(f"{joints_field}: {n_joints} joints, plant {exp.plant.kind} has {exp.plant.n_joints}")

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.signals import Frame, Message, Signal
 from cerebx.stages.base import Receiver, Stage
 from cerebx.wiring import reference_signals
@@ -61,7 +62,7 @@ def _run(stage: Stage, available: dict[str, Signal], ticks: int, seed: int, sens
     return outs
 
 
-def _available(ctx: Any, side: str, earlier: tuple[Signal, ...] = ()) -> dict[str, Signal]:
+def _available(ctx: BuildContext, side: str, earlier: tuple[Signal, ...] = ()) -> dict[str, Signal]:
     """What a stage may read: the plant's sensors, the task's reference (brain side) or what crossed the
     link (robot side), and what the stages before it on its side wrote."""
     available = dict(ctx.plant.sensor_signals())
@@ -82,7 +83,7 @@ def check_receiver(stage: Receiver) -> None:
         _require(bool(np.all(np.isfinite(out[s.name]))), f"{stage.name}: receive() gave non-finite {s.name}")
 
 
-def check_stage(ctx: Any, stage: Stage, twin: Stage, side: str, ticks: int = 60,
+def check_stage(ctx: BuildContext, stage: Stage, twin: Stage, side: str, ticks: int = 60,
                 earlier: tuple[Signal, ...] = ()) -> None:
     """Step ``stage`` and ``twin`` (the same stage built again from the same config) over the same
     random valid input: declared outputs written, finite, of their size, and identical between the
@@ -104,8 +105,17 @@ def check_stage(ctx: Any, stage: Stage, twin: Stage, side: str, ticks: int = 60,
 
 
 def check_experiment(build: Callable[[], Any], ticks: int = 60) -> None:
-    """Check the controller and every stage of an experiment; ``build`` builds it afresh
-    (e.g. ``lambda: build_components(cfg)``) and is called twice."""
+    """Check the controller and every stage of an experiment against the stage contract: each is stepped
+    over random valid input beside a second build of itself; declared outputs written, finite, of their size
+    and identical between the two; a saved state loads. Raises on the first violation.
+
+    Parameters
+    ----------
+    build : callable
+        Builds the experiment afresh (e.g. ``lambda: build_components(cfg)``); called twice.
+    ticks : int
+        Ticks each stage is stepped.
+    """
     ctx, twin = build(), build()
     earlier: tuple[Signal, ...] = ()
     for st, tw in zip(ctx.brain, twin.brain):

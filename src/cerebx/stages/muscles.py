@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.schema.muscles import EkebergConfig, MuscleRestController
 from cerebx.signals import Frame
 from cerebx.stages.base import Stage
@@ -55,7 +56,7 @@ class Ekeberg(Stage):
         return {"cocontraction_c": self.params["c"].tolist()}
 
 
-def build_ekeberg(cfg: EkebergConfig, ctx: Any) -> Ekeberg:
+def build_ekeberg(cfg: EkebergConfig, ctx: BuildContext) -> Ekeberg:
     return Ekeberg(cfg, ctx.plant.n_joints)
 
 
@@ -72,5 +73,5 @@ class MuscleRest(Stage):
         self.emit(frame, "muscle.at", self.zero)
 
 
-def build_muscle_rest(cfg: MuscleRestController, ctx: Any) -> MuscleRest:
+def build_muscle_rest(cfg: MuscleRestController, ctx: BuildContext) -> MuscleRest:
     return MuscleRest(ctx.plant.n_joints)

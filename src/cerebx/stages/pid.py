@@ -8,22 +8,31 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.controllers.state import load_state_npz, save_state_npz
+from cerebx.builders import BuildContext
 from cerebx.errors import StateMismatchError
+from cerebx.persistence.state import load_state_npz, save_state_npz
 from cerebx.schema.controller import VELOCITY_ERROR, PIDVelocity
 from cerebx.signals import Frame
 from cerebx.stages.base import Stage
 
 
-def updates_every(rate_hz: float, ctx: Any) -> int:
-    """Control ticks between two updates of a part running at ``rate_hz``."""
+def updates_every(rate_hz: float, ctx: BuildContext) -> int:
+    """Control ticks between two updates of a part running at ``rate_hz``.
+
+    Parameters
+    ----------
+    rate_hz : float
+        The part's update rate, Hz.
+    ctx : BuildContext
+        The build context (its config's ``control_dt_ms``).
+    """
     return max(1, int(round(1000.0 / (rate_hz * ctx.cfg.control_dt_ms))))
 
 
 class PIDVelocityStage(Stage):
     """PID on the velocity error e = qdot_r - qdot (+ the configured correction signal)."""
 
-    def __init__(self, cfg: PIDVelocity, ctx: Any):
+    def __init__(self, cfg: PIDVelocity, ctx: BuildContext):
         self.cfg = cfg
         self.kp, self.ki, self.kd = (np.asarray(v, float) for v in (cfg.kp, cfg.ki, cfg.kd))
         self.every = updates_every(cfg.rate_hz, ctx)
@@ -62,5 +71,5 @@ class PIDVelocityStage(Stage):
         return {"kp": list(self.cfg.kp), "ki": list(self.cfg.ki), "kd": list(self.cfg.kd), "rate_hz": self.cfg.rate_hz}
 
 
-def build_pid(cfg: PIDVelocity, ctx: Any) -> PIDVelocityStage:
+def build_pid(cfg: PIDVelocity, ctx: BuildContext) -> PIDVelocityStage:
     return PIDVelocityStage(cfg, ctx)

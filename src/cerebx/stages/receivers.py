@@ -13,6 +13,7 @@ from typing import Any
 import numba
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.schema import stages as schema
 from cerebx.signals import Message, Signal
 from cerebx.stages.base import Receiver
@@ -121,13 +122,14 @@ class FuturePastFilter(Receiver):
         return self.values
 
 
-def build_hold(cfg: Any, ctx: Any, signals: tuple[Signal, ...]) -> Hold:
+def build_hold(cfg: Any, ctx: BuildContext, signals: tuple[Signal, ...]) -> Hold:
     return Hold(signals)
 
 
-def build_mean(cfg: schema.MeanFilterConfig, ctx: Any, signals: tuple[Signal, ...]) -> MeanFilter:
+def build_mean(cfg: schema.MeanFilterConfig, ctx: BuildContext, signals: tuple[Signal, ...]) -> MeanFilter:
     return MeanFilter(signals, cfg.taps)
 
 
-def build_future_past(cfg: schema.FuturePastFilterConfig, ctx: Any, signals: tuple[Signal, ...]) -> FuturePastFilter:
+def build_future_past(cfg: schema.FuturePastFilterConfig, ctx: BuildContext,
+                      signals: tuple[Signal, ...]) -> FuturePastFilter:
     return FuturePastFilter(signals, cfg)

@@ -31,6 +31,7 @@ from typing import Any
 import numba
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.errors import ConfigError
 from cerebx.schema.base import CONTROL_DT_MS
 from cerebx.schema.spinal import DirectMusclesConfig, SpinalCordConfig, SplitPairsConfig, _MuscleMap
@@ -53,12 +54,12 @@ def command_matrix(cfg: _MuscleMap, n_joints: int) -> np.ndarray:
     return out
 
 
-def _declare(stage: Stage, cfg: Any, ctx: Any) -> None:
+def _declare(stage: Stage, cfg: Any, ctx: BuildContext) -> None:
     io = cfg.io(ctx.plant.n_joints)
     stage.name, stage.reads, stage.writes = cfg.kind, io.reads, io.writes
 
 
-def _check_muscles(cfg: _MuscleMap, ctx: Any) -> None:
+def _check_muscles(cfg: _MuscleMap, ctx: BuildContext) -> None:
     have = tuple(getattr(ctx.plant, "muscle_names", ()))
     if have != tuple(cfg.muscles):
         raise ConfigError(f"{cfg.kind}: muscles {', '.join(cfg.muscles)} differ from plant "
@@ -66,7 +67,7 @@ def _check_muscles(cfg: _MuscleMap, ctx: Any) -> None:
 
 
 class DirectMuscles(Stage):
-    def __init__(self, cfg: DirectMusclesConfig, ctx: Any):
+    def __init__(self, cfg: DirectMusclesConfig, ctx: BuildContext):
         _check_muscles(cfg, ctx)
         _declare(self, cfg, ctx)
         self.cmd = command_matrix(cfg, ctx.plant.n_joints)
@@ -130,7 +131,7 @@ def cord_tick(ag, at, length, velocity, cmd_map, ant, fifo, head, delay, r_lo, r
 
 
 class SpinalCord(Stage):
-    def __init__(self, cfg: SpinalCordConfig, ctx: Any):
+    def __init__(self, cfg: SpinalCordConfig, ctx: BuildContext):
         _check_muscles(cfg, ctx)
         _declare(self, cfg, ctx)
         self.cfg = cfg
@@ -180,7 +181,7 @@ class SpinalCord(Stage):
 
 
 class SplitPairs(Stage):
-    def __init__(self, cfg: SplitPairsConfig, ctx: Any):
+    def __init__(self, cfg: SplitPairsConfig, ctx: BuildContext):
         _declare(self, cfg, ctx)
         self.full = np.asarray(cfg.full_command_Nm, float)
 

@@ -8,6 +8,7 @@ from typing import Any
 import numba
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.schema.stages import SupervisorConfig
 from cerebx.signals import Frame
 from cerebx.stages.base import Stage
@@ -65,7 +66,7 @@ class Supervisor(Stage):
         return {"tau_supervisor": self.tau}
 
 
-def build_supervisor(cfg: SupervisorConfig, ctx: Any) -> Supervisor:
+def build_supervisor(cfg: SupervisorConfig, ctx: BuildContext) -> Supervisor:
     """Bounds: the controller's MF position ranges (``encoder``, when it has them) or the plant's limits."""
     lo, hi = ctx.plant.joint_limits()
     bounds = getattr(ctx.controller, "position_bounds", None)

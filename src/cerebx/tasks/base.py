@@ -12,10 +12,17 @@ import numpy as np
 class TrialReference:
     """Desired joint positions/velocities for one trial, one row per control step.
 
-    ``q`` and ``qd`` have shape (steps, n_joints); ``xyz`` is the desired Cartesian path
-    (steps, 3) when the task is defined in Cartesian space, else None. ``extra`` holds further
-    reference arrays (steps, n_joints) by name, e.g. ``{"qdd": ...}``: the loop puts row i into the
-    brain frame as ``ref.<name>`` (the task's schema declares them in ``extra_reference``).
+    Parameters
+    ----------
+    q, qd : numpy.ndarray (steps, n_joints)
+        Desired joint positions (rad) and velocities (rad/s).
+    xyz : numpy.ndarray (steps, 3), optional
+        The desired Cartesian path when the task is defined in Cartesian space, m.
+    label : str
+        The trial's name (e.g. which figure of a task that alternates).
+    extra : dict of str to numpy.ndarray (steps, n_joints)
+        Further reference arrays by name, e.g. ``{"qdd": ...}``: the loop puts row i into the brain frame as
+        ``ref.<name>`` (the task's schema declares them in ``extra_reference``).
     """
 
     q: np.ndarray

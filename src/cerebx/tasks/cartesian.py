@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.plants.baxter import JOINT_RANGE, MJCF, W2_RANGE, kinematic_model
 from cerebx.tasks.base import Task, TrialReference
 from cerebx.tasks.ik import SiteIK
@@ -252,7 +253,7 @@ def _builder(offsets_of: Offsets | None = None, solve: Solver | None = None) -> 
     else:
         name = solve.__name__
 
-    def build(cfg: Any, ctx: Any = None) -> CartesianTask:
+    def build(cfg: Any, ctx: BuildContext | None = None) -> CartesianTask:
         cache = getattr(ctx, "cache_dir", None) if ctx is not None else None
         return CartesianTask(cfg, load_or_solve(cfg, cache, solve))
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.schema.task import JointSineTask
 from cerebx.tasks.base import Task, TrialReference
 
@@ -11,7 +12,7 @@ from cerebx.tasks.base import Task, TrialReference
 class JointSine(Task):
     control_dt_s = 0.002
 
-    def __init__(self, cfg: JointSineTask, ctx=None):
+    def __init__(self, cfg: JointSineTask, ctx: BuildContext | None = None):
         self.cfg = cfg
         self.period_s = cfg.period_s
         t = np.arange(self.steps_per_trial) * self.control_dt_s

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from cerebx.builders import BuildContext
 from cerebx.errors import ConfigError
 from cerebx.schema.arm_tasks import FlexionExtensionTask, VerticalCircleTask
 from cerebx.tasks.base import Task, TrialReference
@@ -76,7 +77,7 @@ class _UpperLimbTask(Task):
 
 
 class FlexionExtension(_UpperLimbTask):
-    def __init__(self, cfg: FlexionExtensionTask, ctx=None):
+    def __init__(self, cfg: FlexionExtensionTask, ctx: BuildContext | None = None):
         self.period_s = cfg.period_s
         n = self.steps_per_trial
         t = np.arange(n) * self.control_dt_s
@@ -91,7 +92,7 @@ class FlexionExtension(_UpperLimbTask):
 
 
 class VerticalCircle(_UpperLimbTask):
-    def __init__(self, cfg: VerticalCircleTask, ctx=None):
+    def __init__(self, cfg: VerticalCircleTask, ctx: BuildContext | None = None):
         self.period_s = cfg.period_s
         n = self.steps_per_trial
         t = np.arange(n) * self.control_dt_s

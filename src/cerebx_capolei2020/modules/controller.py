@@ -14,7 +14,16 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.api import VELOCITY_ERROR, Frame, Stage, StateMismatchError, load_state_npz, save_state_npz, updates_every
+from cerebx.api import (
+    VELOCITY_ERROR,
+    BuildContext,
+    Frame,
+    Stage,
+    StateMismatchError,
+    load_state_npz,
+    save_state_npz,
+    updates_every,
+)
 from cerebx_capolei2020.modules.circuit import ModularCerebellarCircuit
 from cerebx_capolei2020.modules.schema import QD_CORRECTION, CapoleiForward, CapoleiInverse
 
@@ -24,7 +33,7 @@ class _ModuleStage(Stage):
 
     output: str
 
-    def __init__(self, cfg: Any, ctx: Any):
+    def __init__(self, cfg: Any, ctx: BuildContext):
         self.cfg = cfg
         self.every = updates_every(cfg.rate_hz, ctx)
         self.n = cfg.n_joints
@@ -95,7 +104,7 @@ class InverseModuleStage(_ModuleStage):
 
     output = "joint.torque"
 
-    def __init__(self, cfg: Any, ctx: Any):
+    def __init__(self, cfg: Any, ctx: BuildContext):
         super().__init__(cfg, ctx)
         self._mf_prev: np.ndarray | None = None
 
@@ -112,9 +121,9 @@ class InverseModuleStage(_ModuleStage):
         return mf, mf_train, self.tau_previous(), err
 
 
-def build_forward(cfg: CapoleiForward, ctx: Any) -> ForwardModuleStage:
+def build_forward(cfg: CapoleiForward, ctx: BuildContext) -> ForwardModuleStage:
     return ForwardModuleStage(cfg, ctx)
 
 
-def build_inverse(cfg: CapoleiInverse, ctx: Any) -> InverseModuleStage:
+def build_inverse(cfg: CapoleiInverse, ctx: BuildContext) -> InverseModuleStage:
     return InverseModuleStage(cfg, ctx)

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from cerebx.api import Frame, Stage, StateMismatchError, load_state_npz, save_state_npz
+from cerebx.api import BuildContext, Frame, Stage, StateMismatchError, load_state_npz, save_state_npz
 from cerebx_luque2011.cerebellum import kernels as k
 from cerebx_luque2011.cerebellum.schema import ConductanceLIF, Luque2011Cerebellum
 
@@ -38,7 +38,7 @@ def lif_params(cell: ConductanceLIF, dt_ms: float) -> np.ndarray:
 class Luque2011Stage(Stage):
     """Writes the corrective ``joint.torque`` (added to the feed-forward when it is a composite's part)."""
 
-    def __init__(self, cfg: Luque2011Cerebellum, ctx: Any):
+    def __init__(self, cfg: Luque2011Cerebellum, ctx: BuildContext):
         self.cfg = cfg
         n_per = cfg.inputs.cells_per_signal
         self.n_per, self.n_in = n_per, 2 * N_JOINTS * n_per

@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from cerebx.api import (
+    BuildContext,
     ControlInput,
     Controller,
     StateMismatchError,
@@ -47,7 +48,7 @@ STATE_VERSION = 1
 
 
 class ANN(Controller):
-    def __init__(self, cfg: ANNController, ctx: Any = None):
+    def __init__(self, cfg: ANNController, ctx: BuildContext | None = None):
         self.cfg = cfg
         nj = cfg.n_joints
         self.n_ctrl = nj
@@ -129,7 +130,7 @@ class ANN(Controller):
             return self._q_hist[i], self._qd_hist[i]
         return inp.q_des[: self.n_ctrl], inp.qd_des[: self.n_ctrl]
 
-    def step(self, inp: ControlInput) -> TorqueMsg:
+    def control(self, inp: ControlInput) -> TorqueMsg:
         self._remember_desired(inp)
         s = inp.sensor
         if s is None:
@@ -190,7 +191,7 @@ class ANN(Controller):
             "gain_Nm": list(self.cfg.gain_Nm),
         }
 
-    def save_state(self, path: Path) -> None:
+    def save_state(self, path: Path) -> bool:
         path = Path(path)
         meta = {
             "version": STATE_VERSION,
@@ -199,6 +200,7 @@ class ANN(Controller):
             "shape": list(self.w.shape),
         }
         save_state_npz(path, meta, w=self.w)
+        return True
 
     def load_state(self, path: Path) -> None:
         data, meta = load_state_npz(path, "ANN")

@@ -65,7 +65,7 @@ def test_pd_tracks_within_bound(load, tmp_path):
 
 def test_crash_midway_leaves_readable_log(load, tmp_path, monkeypatch):
     calls = {"n": 0}
-    original = PD.step
+    original = PD.control
 
     def exploding(self, inp):
         calls["n"] += 1
@@ -73,7 +73,7 @@ def test_crash_midway_leaves_readable_log(load, tmp_path, monkeypatch):
             raise RuntimeError("boom")
         return original(self, inp)
 
-    monkeypatch.setattr(PD, "step", exploding)
+    monkeypatch.setattr(PD, "control", exploding)
     s = run_experiment(load([*DEMO, "trials=5"]), tmp_path)
     assert s["status"] == "failed" and "boom" in s["error"]
     assert s["trials_completed"] == 1
@@ -85,14 +85,14 @@ def test_crash_midway_leaves_readable_log(load, tmp_path, monkeypatch):
 def test_diverging_run_stops_cleanly(load, tmp_path, monkeypatch):
     """A controller that starts emitting NaN ends the run with status 'diverged', log intact."""
     calls = {"n": 0}
-    original = PD.step
+    original = PD.control
 
     def nan_after_a_while(self, inp):
         calls["n"] += 1
         msg = original(self, inp)
         return type(msg)(msg.stamp_s, msg.tau * np.nan) if calls["n"] > 1200 else msg
 
-    monkeypatch.setattr(PD, "step", nan_after_a_while)
+    monkeypatch.setattr(PD, "control", nan_after_a_while)
     s = run_experiment(load([*DEMO, "trials=3"]), tmp_path)
     assert s["status"] == "diverged", s
     assert "non-finite joint.torque command" in s["error"]

@@ -241,7 +241,7 @@ def test_sea_deflection_carries_the_holding_torque():
     servo = PositionServo(PositionController(), SimpleNamespace(plant=plant))
     for k in range(1000):
         q, qd = plant.sensors()
-        msg = servo.step(ControlInput(k, k * 0.002, REF, np.zeros(6), SensorMsg(k * 0.002, q, qd)))
+        msg = servo.control(ControlInput(k, k * 0.002, REF, np.zeros(6), SensorMsg(k * 0.002, q, qd)))
         plant.apply(msg.tau)
         plant.step()
     q, qd = plant.true_state()
@@ -266,11 +266,11 @@ def test_sensor_noise_is_seeded():
 def test_position_servo_holds_and_outputs_zero_without_sensor():
     plant = make()
     servo = PositionServo(PositionController(), SimpleNamespace(plant=plant))
-    msg = servo.step(ControlInput(0, 0.0, REF, np.zeros(6), None))
+    msg = servo.control(ControlInput(0, 0.0, REF, np.zeros(6), None))
     assert msg.stamp_s == 0.0 and np.all(msg.tau == 0.0)
     for k in range(500):
         q, qd = plant.sensors()
-        plant.apply(servo.step(ControlInput(k, k * 0.002, REF, np.zeros(6), SensorMsg(k * 0.002, q, qd))).tau)
+        plant.apply(servo.control(ControlInput(k, k * 0.002, REF, np.zeros(6), SensorMsg(k * 0.002, q, qd))).tau)
         plant.step()
     assert np.abs(plant.true_state()[0] - REF).max() < 1e-3
 

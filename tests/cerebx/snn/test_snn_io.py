@@ -143,7 +143,7 @@ def drive(ctrl, n, t0=0):
         q = np.sin(np.pi * t) * 0.3 * np.ones(6)
         qd = np.cos(np.pi * t) * 0.3 * np.ones(6)
         s = SensorMsg(t, q - 0.02, qd)
-        taus.append(ctrl.step(ControlInput(k, t, q, qd, s)).tau)
+        taus.append(ctrl.control(ControlInput(k, t, q, qd, s)).tau)
     return np.array(taus)
 
 
@@ -240,7 +240,7 @@ def test_stamped_efferent_sends_what_hold_applies_later(pipeline):
             t = k * 0.002
             q = np.sin(np.pi * t) * 0.3 * np.ones(6)
             qd = np.cos(np.pi * t) * 0.3 * np.ones(6)
-            msgs.append(ctrl.step(ControlInput(k, t, q, qd, SensorMsg(t, q - 0.02, qd))))
+            msgs.append(ctrl.control(ControlInput(k, t, q, qd, SensorMsg(t, q - 0.02, qd))))
         out[mode] = msgs
     D = 10
     for k in range(120 - D):
@@ -266,7 +266,7 @@ def test_cf_pathway_delay_shorter_than_mf(pipeline):
         t = k * 0.002
         q, qd = np.full(6, 0.2), np.zeros(6)
         s = SensorMsg(t, q - 0.3, qd) if k < 10 else None
-        ctrl.step(ControlInput(k, t, q, qd, s))
+        ctrl.control(ControlInput(k, t, q, qd, s))
     ctrl.end_trial(0)
     mf, cf = ctrl.sl_mf, ctrl.sl_cf
     mf_steps = [i for i, a in enumerate(seen) if ((a >= mf.start) & (a < mf.stop)).any()]
@@ -321,7 +321,7 @@ def test_agonist_antagonist_output_is_the_torque_split_by_side():
         t = k * 0.002
         q = np.sin(np.pi * t) * 0.3 * np.ones(6)
         qd = np.cos(np.pi * t) * 0.3 * np.ones(6)
-        msg = muscles.step(ControlInput(k, t, q, qd, SensorMsg(t, q - 0.02, qd)))
+        msg = muscles.control(ControlInput(k, t, q, qd, SensorMsg(t, q - 0.02, qd)))
         ag.append(msg.values["muscle.ag"])
         at.append(msg.values["muscle.at"])
     ag, at = np.array(ag), np.array(at)

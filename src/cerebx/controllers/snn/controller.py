@@ -39,11 +39,12 @@ import numpy as np
 from numba import njit
 
 from cerebx import phase_clock, registry
+from cerebx.builders import BuildContext
 from cerebx.controllers.base import CommandMsg, ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
 from cerebx.controllers.snn.schema import SNNController
-from cerebx.controllers.state import load_state_npz, save_state_npz
 from cerebx.errors import StateMismatchError
+from cerebx.persistence.state import load_state_npz, save_state_npz
 from cerebx.recording.spike_chunks import chunk_spike_messages
 from cerebx.signals import Deferred
 from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
@@ -151,7 +152,7 @@ def _serve(jobs: queue.SimpleQueue, taken: queue.SimpleQueue, done: queue.Simple
 
 
 class SNNControllerImpl(Controller):
-    def __init__(self, cfg: SNNController, ctx: Any):
+    def __init__(self, cfg: SNNController, ctx: BuildContext):
         t0 = time.perf_counter()
         self.cfg = cfg
         self.net_cfg = cfg.network
@@ -435,7 +436,7 @@ class SNNControllerImpl(Controller):
     def _desired_at(self, stamp_s: float, inp: ControlInput) -> tuple[np.ndarray, np.ndarray]:
         return self._des.get(int(round(stamp_s / STEP_S)), (inp.q_des, inp.qd_des))
 
-    def step(self, inp: ControlInput) -> TorqueMsg:
+    def control(self, inp: ControlInput) -> TorqueMsg:
         self._des[inp.tick] = (inp.q_des, inp.qd_des)
         self._des.pop(inp.tick - 2000, None)
         s = inp.sensor
@@ -528,7 +529,7 @@ class SNNControllerImpl(Controller):
         }
 
     # ------------------------------------------------------------------ state
-    def save_state(self, path: Path) -> None:
+    def save_state(self, path: Path) -> bool:
         self._join()
         path = Path(path)
         arrays = {f"net_{k}": v for k, v in self.net.state_arrays().items()}
@@ -540,6 +541,7 @@ class SNNControllerImpl(Controller):
         arrays["lag_fifos"] = np.array(json.dumps([[a.tolist() for a in self._mf_lag],
                                                    [a.tolist() for a in self._cf_lag]]))
         save_state_npz(path, meta, **arrays)
+        return True
 
     def load_state(self, path: Path) -> None:
         path = Path(path)

@@ -14,6 +14,19 @@ from cerebx.errors import StateMismatchError
 
 
 def save_state_npz(path: Path, meta: dict[str, Any], **arrays: np.ndarray) -> None:
+    """Write a learned state as an ``.npz`` with its metadata, atomically (a crash never leaves a
+    half-written state).
+
+    Parameters
+    ----------
+    path : Path
+        The file (a run's state is ``RUN_DIR/controller_state.npz``).
+    meta : dict
+        JSON-serialisable facts that say which configuration the state fits (read back by
+        :func:`load_state_npz`, checked by the schema's ``state_problems``).
+    **arrays : numpy.ndarray
+        The learned arrays, by name.
+    """
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
     # an .npz as np.savez_compressed writes it, at deflate level 1: half its write time and a quarter of its
@@ -26,7 +39,16 @@ def save_state_npz(path: Path, meta: dict[str, Any], **arrays: np.ndarray) -> No
 
 
 def load_state_npz(path: Path, what: str) -> tuple[Any, dict[str, Any]]:
-    """(the npz mapping, its metadata); any unreadable file gives the same one-line error."""
+    """(the npz mapping, its metadata) of a state written by :func:`save_state_npz`; any unreadable file
+    gives the same one-line :class:`StateMismatchError`.
+
+    Parameters
+    ----------
+    path : Path
+        The state file.
+    what : str
+        The model's name in the error message (``"SNN"``, ``"ANN"``, ...).
+    """
     try:
         data = np.load(Path(path), allow_pickle=False)
         return data, json.loads(str(data["meta"]))
