@@ -525,6 +525,7 @@ class SNNControllerImpl(Controller):
             "pathway_delay_steps": self.k_delay,
             "cf_pathway_delay_steps": self.k_cf,
             "fingerprint": self.fingerprint,
+            "integrators": self.net.integrators(),
         }
 
     # ------------------------------------------------------------------ state
