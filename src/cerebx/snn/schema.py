@@ -371,6 +371,31 @@ class BoxEncoder(Strict):
     ranges: Annotated[GivenRanges | TaskRanges, Field(discriminator="kind")] = TaskRanges()
 
 
+class PoissonEncoder(Strict):
+    """MF rate coding (docs/models.md#mf-poisson-coding): per joint and signal, fibres with Gaussian (or box)
+    receptive fields over the signal's range; each fires in a 2 ms step with probability rate x 2 ms,
+    rate = rate_min_hz + (rate_max_hz - rate_min_hz) RF(value), from the run's seeded generator."""
+
+    role: ClassVar[str] = "mossy"
+
+    kind: Literal["poisson"] = "poisson"
+    fibers_per_signal: int = Field(10, gt=1)
+    field: Literal["gaussian", "box"] = Field(
+        "gaussian", description="receptive field: gaussian exp(-z^2/2), or box 1 for |z| < 1, with z = "
+        "(value - centre) / (width_factor x centre step)")
+    width_factor: PositiveFloat = Field(1.0, description="gaussian sigma, or box half-width, in centre steps")
+    rate_min_hz: NonNegFloat = Field(0.0, description="rate far from the receptive field")
+    rate_max_hz: float = Field(100.0, gt=0, le=500, description="rate at the centre (at most one spike per "
+                               "2 ms step: 500 Hz)")
+    ranges: Annotated[GivenRanges | TaskRanges, Field(discriminator="kind")] = TaskRanges()
+
+    @model_validator(mode="after")
+    def _rates(self) -> PoissonEncoder:
+        if self.rate_min_hz >= self.rate_max_hz:
+            raise ValueError(f"rate_min_hz ({self.rate_min_hz}) must be below rate_max_hz ({self.rate_max_hz})")
+        return self
+
+
 class CFEncoder(Strict):
     """CF stochastic error coding (docs/models.md#cf-error-coding): agonist/antagonist split by error sign;
     rate = r_min + (r_max - r_min)(tanh((|e| - c_k)/w) + 1)/2, Bernoulli per 2 ms, bursts."""
