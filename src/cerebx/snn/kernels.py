@@ -487,13 +487,46 @@ W_FLOOR = np.float32(1e-12)  # |w| below this (pA) becomes exactly 0 (avoids den
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _exp32(y):
+    """e^y in float32 without a library call, so the AdEx loop vectorises (numba has no vector exp without
+    SVML): e^y = (e^(y/256))^256, a degree-6 Taylor polynomial for e^(y/256), y clamped to [-80, 60] (the
+    schema bounds the exponent at 60; e^-80 ~ 2e-35). Max relative error 5e-5 (float32 rounding of the eight
+    squarings; see tests)."""
+    f32 = np.float32
+    y = min(max(y, f32(-80.0)), f32(60.0)) * f32(1.0 / 256.0)
+    e = f32(1.0) + y * (f32(1.0) + y * (f32(0.5) + y * (f32(1.0 / 6.0) + y * (f32(1.0 / 24.0) + y * (
+        f32(1.0 / 120.0) + y * f32(1.0 / 720.0))))))
+    e = e * e
+    e = e * e
+    e = e * e
+    e = e * e
+    e = e * e
+    e = e * e
+    e = e * e
+    return e * e
+
+
+def exp32(y: np.ndarray) -> np.ndarray:
+    """The AdEx kernel's exponential (float32), for tests."""
+    return _exp32_vec(np.ascontiguousarray(y, dtype=np.float32))
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _exp32_vec(y):
+    out = np.empty_like(y)
+    for i in range(y.shape[0]):
+        out[i] = _exp32(y[i])
+    return out
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
 def _adex_rhs(x, w, ge, gi, live, c):
     """(du/dt, dw/dt) of NEST aeif_cond_exp at u = x (V - E_L), adaptation w, conductances (ge, gi); V is
     bounded by V_peak in every term (as NEST does) and held (du = 0) while refractory (live = 0).
     c: (gL, invC, EEL, EIL, VT, upk, sc, invDT, a, itw, Ie) in float32, u-relative potentials."""
     gL, invC, EEL, EIL, VT, upk, sc, invDT, a, itw, Ie = c
     v = min(x, upk)
-    iexp = sc * np.exp((v - VT) * invDT)  # sc = 0 without the exponential term (then invDT = 0 too)
+    iexp = sc * _exp32((v - VT) * invDT)  # sc = 0 without the exponential term (then invDT = 0 too)
     du = live * (-gL * v + iexp - ge * (v - EEL) - gi * (v - EIL) - w + Ie) * invC
     dw = (a * v - w) * itw
     return du, dw
@@ -519,6 +552,32 @@ def _adex_rk(x, w, ge, gi, live, h, dE, dEh, dI, dIh, method, c):
     return x + h * k1, w + h * l1
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _adex_loop(u, w, gE, gI, ref, flag, c, k, method, fine):
+    """The neurons of :func:`_adex`; inlined with a constant ``method`` and ``fine`` = False, the loop has no
+    branch and vectorises (ten times faster than with the refinement's branch)."""
+    h, hf, dE, dEh, dI, dIh, fE, fEh, fI, fIh, uth, urst, b, nref, ufine, nf = k
+    zero, one = np.float32(0.0), np.float32(1.0)
+    cnt = zero
+    for i in range(u.shape[0]):
+        x, wi, ge, gi, r = u[i], w[i], gE[i], gI[i], ref[i]
+        live = one if r <= zero else zero
+        un, wn = _adex_rk(x, wi, ge, gi, live, h, dE, dEh, dI, dIh, method, c)
+        if fine and ((x > ufine) | (un > ufine)):
+            un, wn = x, wi
+            for _ in range(nf):
+                un, wn = _adex_rk(un, wn, ge, gi, live, hf, fE, fEh, fI, fIh, method, c)
+                ge, gi = ge * fE, gi * fI
+        spk = (un >= uth) & (r <= zero)
+        u[i] = urst if spk else un
+        wn = wn + b if spk else wn
+        w[i] = wn if abs(wn) >= W_FLOOR else zero
+        ref[i] = nref if spk else max(r - one, zero)
+        flag[i] = np.uint8(spk)
+        cnt += one if spk else zero
+    return int(cnt)
+
+
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
 def _adex(u, w, gE, gI, ref, flag, p, nf):
     """One step of an adex_cond population (u = V - E_L, adaptation w, g_ex in gE, g_in in gI): the method's
@@ -527,37 +586,23 @@ def _adex(u, w, gE, gI, ref, flag, p, nf):
     evolving (with V = V_reset). Returns the spike count."""
     f32 = np.float32
     h = f32(p[P_H])
-    hf = h / f32(nf)
     el = p[P_EL]
     c = (f32(p[P_GL]), f32(1.0 / p[P_CM]), f32(p[P_EA] - el), f32(p[P_EG] - el), f32(p[P_VT]), f32(p[P_UPK]),
          f32(p[P_GL] * p[P_DT]), f32(p[P_INVDT]), f32(p[P_A]), f32(p[P_ITW]), f32(p[P_IE]))
-    dE, dEh, dI, dIh = f32(p[P_DA]), f32(p[P_DAH]), f32(p[P_DG]), f32(p[P_DGH])
-    fE, fEh, fI, fIh = f32(p[P_DFA]), f32(p[P_DFAH]), f32(p[P_DFG]), f32(p[P_DFGH])
-    uth, urst, b, nref = f32(p[P_VTH] - el), f32(p[P_URST]), f32(p[P_B]), f32(p[P_NREF])
-    ufine = f32(p[P_UFINE])
+    k = (h, h / f32(nf), f32(p[P_DA]), f32(p[P_DAH]), f32(p[P_DG]), f32(p[P_DGH]), f32(p[P_DFA]), f32(p[P_DFAH]),
+         f32(p[P_DFG]), f32(p[P_DFGH]), f32(p[P_VTH] - el), f32(p[P_URST]), f32(p[P_B]), f32(p[P_NREF]),
+         f32(p[P_UFINE]), nf)
     method = int(p[P_METHOD])
-    zero, one = f32(0.0), f32(1.0)
-    cnt = 0
-    for i in range(u.shape[0]):
-        x, wi, ge, gi, r = u[i], w[i], gE[i], gI[i], ref[i]
-        live = one if r <= zero else zero
-        un, wn = _adex_rk(x, wi, ge, gi, live, h, dE, dEh, dI, dIh, method, c)
-        if nf > 1 and ((x > ufine) | (un > ufine)):
-            un, wn = x, wi
-            for _ in range(nf):
-                un, wn = _adex_rk(un, wn, ge, gi, live, hf, fE, fEh, fI, fIh, method, c)
-                ge, gi = ge * fE, gi * fI
-        spk = (un >= uth) & (r <= zero)
-        if spk:
-            un = urst
-            wn += b
-            cnt += 1
-        u[i] = un
-        w[i] = wn if abs(wn) >= W_FLOOR else zero
-        ref[i] = nref if spk else max(r - one, zero)
-        flag[i] = np.uint8(spk)
-    _decay(gE, dE)
-    _decay(gI, dI)
+    if nf > 1:
+        cnt = _adex_loop(u, w, gE, gI, ref, flag, c, k, method, True)
+    elif method == 2:
+        cnt = _adex_loop(u, w, gE, gI, ref, flag, c, k, 2, False)
+    elif method == 1:
+        cnt = _adex_loop(u, w, gE, gI, ref, flag, c, k, 1, False)
+    else:
+        cnt = _adex_loop(u, w, gE, gI, ref, flag, c, k, 0, False)
+    _decay(gE, f32(p[P_DA]))
+    _decay(gI, f32(p[P_DG]))
     return cnt
 
 
