@@ -248,3 +248,36 @@ def test_the_kernel_exponential_is_accurate_over_the_adex_range():
     rel = kernels.exp32(y).astype(np.float64) / np.exp(y.astype(np.float64)) - 1.0
     assert np.abs(rel).max() < 5e-5
     assert kernels.exp32(np.array([-1000.0]))[0] < 1e-34
+
+
+def test_adex_takes_every_role_of_the_cerebellar_network():
+    """The granule, Purkinje and nuclear cells of the small ``full`` network all adex_cond (the CF->DCN NMDA
+    projection made AMPA, which AdEx takes): every population spikes under the MF/CF drive, V stays finite, the
+    PF->PC weights learn, and the integrators say so."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_snn_neuron import _drive
+
+    from cerebx.snn.presets import network_dict
+
+    d = network_dict(fibers=5, per_joint=20)
+    gc = {"kind": "adex_cond", "C_m_pF": 2.0, "g_L_nS": 1.0, "E_L_mV": -65.0, "V_th_mV": -50.0, "V_peak_mV": -30.0,
+          "V_reset_mV": -65.0, "a_nS": 0.1, "b_pA": 1.0, "tau_w_ms": 50.0, "tau_syn_ex_ms": 1.0, "t_ref_ms": 1.0}
+    d["populations"]["gc"]["neuron"] = gc
+    d["populations"]["pc"]["neuron"] = {**gc, "C_m_pF": 100.0, "g_L_nS": 6.0, "E_L_mV": -70.0, "V_reset_mV": -70.0,
+                                        "tau_syn_ex_ms": 1.2, "t_ref_ms": 2.0}
+    d["populations"]["dcn"]["neuron"] = {**gc, "g_L_nS": 0.2, "E_L_mV": -70.0, "V_th_mV": -45.0,
+                                         "V_reset_mV": -70.0, "tau_syn_ex_ms": 0.5, "tau_syn_in_ms": 10.0,
+                                         "E_in_mV": -80.0}
+    d["projections"]["cf_dcn_nmda"]["receptor"] = "ampa"
+    net = Network(NetworkConfig.model_validate(d), parallel=False)
+    w0 = net.weights("pf_pc").copy()
+    spikes = np.concatenate([i for i, _ in _drive(net, 300)])
+    for pop in ("gc", "pc", "dcn"):
+        sl = net.index(pop)
+        assert ((spikes >= sl.start) & (spikes < sl.stop)).sum() > 10, pop
+        assert net.integrators()[pop]["kind"] == "adex_cond"
+    assert np.isfinite(net.V).all() and np.isfinite(net.w).all()
+    assert not np.array_equal(net.weights("pf_pc"), w0)
