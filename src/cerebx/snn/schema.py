@@ -18,8 +18,9 @@ from cerebx.schema.controller import GivenRanges, TaskRanges
 
 
 class Integration(Strict):
-    """How a LIF population's membrane equation is integrated. Conductances always decay exactly
-    (g <- g e^(-h/tau)); the integrator sees the exact conductance at its stage times."""
+    """How a population's membrane equation is integrated (lif_cond, adex_cond: V_thr reads V_th for AdEx).
+    Conductances always decay exactly (g <- g e^(-h/tau)); the integrator sees the exact conductance at its
+    stage times."""
 
     method: Literal["rk4", "rk2", "euler"] = Field(
         "rk4", description="rk4: classical Runge-Kutta; rk2: Heun (explicit trapezoid, EDLUT RK2); "
