@@ -117,11 +117,13 @@ class MossyEncoder:
 
 
 @numba.njit(cache=True)
-def _poisson_active(q_des, q, qd_des, qd, lo, hi, centres, inv_width, gaussian, r_min, r_span, u,
-                    out):  # pragma: no cover - numba
-    """Rate coding of the four signals of the first n_joints = ``lo.shape[0]`` joints: fibre i (local index
-    4F j + F s + k) fires when u[i] < (r_min + r_span RF(z)) x 2 ms, z = (x - centre) inv_width, x clipped to
-    the signal's range. Returns the number of spiking fibres written (in index order) to ``out``."""
+def _poisson_active(signals, lo, hi, centres, inv_width, rf_rates, u, out):  # pragma: no cover - numba
+    """Rate coding of the four signals (q_des, q, qd_des, qd) of the first n_joints = ``lo.shape[0]`` joints:
+    fibre i (local index 4F j + F s + k) fires when u[i] < (r_min + r_span RF(z)) x 2 ms, z = (x - centre)
+    inv_width, x clipped to the signal's range; rf_rates = (gaussian, r_min, r_span). Returns the number of
+    spiking fibres written (in index order) to ``out``."""
+    q_des, q, qd_des, qd = signals
+    gaussian, r_min, r_span = rf_rates
     n = 0
     F = centres.shape[2]
     for j in range(lo.shape[0]):
@@ -175,9 +177,10 @@ class PoissonMossyEncoder:
         _require("mossy encoder", self.n_joints, q_des, q, qd_des, qd)
         c = self.cfg
         u = self.rng.random(out=self._u)
-        n = _poisson_active(np.asarray(q_des, float), np.asarray(q, float), np.asarray(qd_des, float),
-                            np.asarray(qd, float), self.lo, self.hi, self.centres, self.inv_width,
-                            c.field == "gaussian", c.rate_min_hz, c.rate_max_hz - c.rate_min_hz, u, self._out)
+        signals = tuple(np.ascontiguousarray(x, dtype=np.float64) for x in (q_des, q, qd_des, qd))
+        n = _poisson_active(signals, self.lo, self.hi, self.centres, self.inv_width,
+                            (c.field == "gaussian", float(c.rate_min_hz), float(c.rate_max_hz - c.rate_min_hz)), u,
+                            self._out)
         return self._out[:n].copy()
 
 

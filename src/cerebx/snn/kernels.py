@@ -429,8 +429,12 @@ def _lif_full(u, gA, gN, gG, ref, flag, p):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _full_rk(x, a0, n0, b0, h, dA, dAh, dN, dNh, dG, dGh, method, gL, EL, EAL, EGL, invC):
-    """One step of :func:`_lif_full`'s method from u = x with conductances (a0, n0, b0) at its start."""
+def _full_rk(x, g0, h, dec, method, m):
+    """One step of :func:`_lif_full`'s method from u = x with conductances g0 = (AMPA, NMDA, GABA) at its start;
+    dec: their decays over h and h/2 (dA, dAh, dN, dNh, dG, dGh); m: (gL, EL, EAL, EGL, invC)."""
+    a0, n0, b0 = g0
+    dA, dAh, dN, dNh, dG, dGh = dec
+    gL, EL, EAL, EGL, invC = m
     if method == 2:
         k1 = _du(x, a0, n0, b0, gL, EL, EAL, EGL, invC)
         k2 = _du(x + np.float32(0.5) * h * k1, a0 * dAh, n0 * dNh, b0 * dGh, gL, EL, EAL, EGL, invC)
@@ -464,14 +468,16 @@ def _lif_full_fine(u, gA, gN, gG, ref, flag, p, nf):
     method = int(p[P_METHOD])
     lo_u = f32(0.0) if p[P_CLAMP] > 0.5 else f32(-3.0e38)
     zero = f32(0.0)
+    m = (gL, EL, EAL, EGL, invC)
+    dec, fdec = (dA, dAh, dN, dNh, dG, dGh), (fA, fAh, fN, fNh, fG, fGh)
     for i in range(u.shape[0]):
         x = u[i]
         a0, n0, b0 = gA[i], gN[i], gG[i]
-        un = _full_rk(x, a0, n0, b0, h, dA, dAh, dN, dNh, dG, dGh, method, gL, EL, EAL, EGL, invC)
+        un = _full_rk(x, (a0, n0, b0), h, dec, method, m)
         if (x > ufine) | (un > ufine):
             un = x
             for _ in range(nf):
-                un = _full_rk(un, a0, n0, b0, hf, fA, fAh, fN, fNh, fG, fGh, method, gL, EL, EAL, EGL, invC)
+                un = _full_rk(un, (a0, n0, b0), hf, fdec, method, m)
                 a0, n0, b0 = a0 * fA, n0 * fN, b0 * fG
         un = max(un, lo_u)
         u[i] = un if abs(un) >= U_FLOOR else zero
@@ -533,8 +539,10 @@ def _adex_rhs(x, w, ge, gi, live, c):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _adex_rk(x, w, ge, gi, live, h, dE, dEh, dI, dIh, method, c):
-    """One step of the method from (x, w) with the conductances exact at every stage time."""
+def _adex_rk(x, w, ge, gi, live, h, dec, method, c):
+    """One step of the method from (x, w) with the conductances exact at every stage time (dec: their decays
+    over h and h/2, (dE, dEh, dI, dIh))."""
+    dE, dEh, dI, dIh = dec
     half = np.float32(0.5)
     if method == 2:
         k1, l1 = _adex_rhs(x, w, ge, gi, live, c)
@@ -562,11 +570,11 @@ def _adex_loop(u, w, gE, gI, ref, flag, c, k, method, fine):
     for i in range(u.shape[0]):
         x, wi, ge, gi, r = u[i], w[i], gE[i], gI[i], ref[i]
         live = one if r <= zero else zero
-        un, wn = _adex_rk(x, wi, ge, gi, live, h, dE, dEh, dI, dIh, method, c)
+        un, wn = _adex_rk(x, wi, ge, gi, live, h, (dE, dEh, dI, dIh), method, c)
         if fine and ((x > ufine) | (un > ufine)):
             un, wn = x, wi
             for _ in range(nf):
-                un, wn = _adex_rk(un, wn, ge, gi, live, hf, fE, fEh, fI, fIh, method, c)
+                un, wn = _adex_rk(un, wn, ge, gi, live, hf, (fE, fEh, fI, fIh), method, c)
                 ge, gi = ge * fE, gi * fI
         spk = (un >= uth) & (r <= zero)
         u[i] = urst if spk else un
