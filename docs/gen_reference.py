@@ -68,6 +68,26 @@ def preset_comment(path: Path) -> str:
     return " ".join(lines[:2])
 
 
+def neuron_kinds() -> list[str]:
+    """The neuron models a network population can use (``populations.NAME.neuron.kind``): the members of the
+    network schema's ``Neuron`` union, which is closed (not a registry)."""
+    from cerebx.snn.schema import Neuron
+
+    members = typing.get_args(typing.get_args(Neuron)[0])
+    out = ["## Kinds: network neuron models", "",
+           "`populations.NAME.neuron.kind` of a spiking network (the [model reference](../models.md#neuron-models) "
+           "has the equations).", "", "| kind | what it is |", "|---|---|"]
+    for m in members:
+        kind = m.model_fields["kind"].default
+        out.append(f"| [`{kind}`](#network-neuron-{kind}) | {summary(m).replace('|', '/')} |")
+    out.append("")
+    for m in members:
+        kind = m.model_fields["kind"].default
+        out += [f"### network neuron: `{kind}` {{#network-neuron-{kind}}}", "", summary(m), "",
+                f"Schema `{m.__module__}.{m.__qualname__}`.", "", *fields_table(m), ""]
+    return out
+
+
 def options_page() -> str:
     registry.load_plugins()
     out = ["# Options (generated)", "",
@@ -91,6 +111,7 @@ def options_page() -> str:
             out += [f"### {group}: `{kind}` {{#{group}-{kind}}}", "", summary(entry.schema), "",
                     f"Plugin `{entry.plugin}`; schema `{entry.schema.__module__}.{entry.schema.__qualname__}`.", "",
                     *fields_table(entry.schema), ""]
+    out += neuron_kinds()
     out += ["## Presets of the config groups", "",
             "Chosen on the command line as `group=NAME` (`+task=NAME`, `+experiment=NAME`).", ""]
     groups: dict[str, list[tuple[str, str, Path]]] = {}

@@ -15,6 +15,7 @@ from cerebx.schema import plant as p
 from cerebx.schema import spinal as sp
 from cerebx.schema import stages as s
 from cerebx.schema import task as t
+from cerebx.snn.schema import PoissonEncoder
 
 
 def register() -> None:
@@ -66,6 +67,7 @@ def register() -> None:
     # MossyEncoderBuilder (cfg, lo, hi); ClimbingEncoderBuilder (cfg, n_joints, fibres_per_joint, kpos, kvel, rng)
     registry.encoders.register(snn.BoxEncoder, "cerebx.snn.encoders:MossyEncoder")
     registry.encoders.register(snn.CFEncoder, "cerebx.snn.encoders:ClimbingEncoder")
+    registry.encoders.register(PoissonEncoder, "cerebx.snn.encoders:PoissonMossyEncoder")
 
     # links: the tick-grid one of simulated time, and transports between processes (LinkBuilder: cfg, role, via_relay)
     registry.links.register(lk.SimLink, "cerebx.link.transport:build_sim")

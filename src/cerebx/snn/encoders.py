@@ -16,7 +16,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from cerebx.snn.schema import BoxEncoder, CFEncoder
+from cerebx.snn.schema import BoxEncoder, CFEncoder, PoissonEncoder
 
 STEP_S = 0.002
 
@@ -113,6 +113,74 @@ class MossyEncoder:
         box boundary, as in the original), in increasing order (int32)."""
         _require("mossy encoder", self.n_joints, q_des, q, qd_des, qd)
         n = _mf_active(q_des, q, qd_des, qd, self.lo, self.hi, self.step, self.half_width, self.F, self._out)
+        return self._out[:n].copy()
+
+
+@numba.njit(cache=True)
+def _poisson_active(signals, lo, hi, centres, inv_width, rf_rates, u, out):  # pragma: no cover - numba
+    """Rate coding of the four signals (q_des, q, qd_des, qd) of the first n_joints = ``lo.shape[0]`` joints:
+    fibre i (local index 4F j + F s + k) fires when u[i] < (r_min + r_span RF(z)) x 2 ms, z = (x - centre)
+    inv_width, x clipped to the signal's range; rf_rates = (gaussian, r_min, r_span). Returns the number of
+    spiking fibres written (in index order) to ``out``."""
+    q_des, q, qd_des, qd = signals
+    gaussian, r_min, r_span = rf_rates
+    n = 0
+    F = centres.shape[2]
+    for j in range(lo.shape[0]):
+        for s in range(4):
+            x = q_des[j] if s == 0 else q[j] if s == 1 else qd_des[j] if s == 2 else qd[j]
+            x = min(max(x, lo[j, s]), hi[j, s])
+            base = (j * 4 + s) * F
+            for k in range(F):
+                z = (x - centres[j, s, k]) * inv_width[j, s]
+                rf = np.exp(-0.5 * z * z) if gaussian else (1.0 if abs(z) < 1.0 else 0.0)
+                if u[base + k] < (r_min + r_span * rf) * STEP_S:
+                    out[n] = base + k
+                    n += 1
+    return n
+
+
+class PoissonMossyEncoder:
+    """Rate (Poisson) coding of the four signals of every joint: the same fibre layout as :class:`MossyEncoder`
+    (local index 4F j + F s + k, centres evenly spaced over [lo, hi]), each fibre a Bernoulli draw per 2 ms step
+    with its receptive field's rate. ``rng``: the generator (the controller gives one from the run's seed)."""
+
+    def __init__(self, cfg: PoissonEncoder, lo: np.ndarray, hi: np.ndarray, rng: np.random.Generator | None = None):
+        self.cfg = cfg
+        self.F = F = cfg.fibers_per_signal
+        self.lo = np.asarray(lo, dtype=np.float64)
+        self.hi = np.asarray(hi, dtype=np.float64)
+        self.n_joints = self.lo.shape[0]
+        step = (self.hi - self.lo) / (F - 1)
+        self.centres = self.lo[:, :, None] + step[:, :, None] * np.arange(F)
+        self.inv_width = 1.0 / (step * cfg.width_factor)
+        self.rng = rng if rng is not None else np.random.default_rng(0)
+        self._u = np.zeros(self.n_fibers)
+        self._out = np.zeros(self.n_fibers, dtype=np.int32)
+
+    @property
+    def n_fibers(self) -> int:
+        return self.n_joints * 4 * self.F
+
+    def rates(self, q_des, q, qd_des, qd) -> np.ndarray:
+        """Rate (Hz) of every fibre, by local index."""
+        x = np.stack([q_des, q, qd_des, qd], axis=1)[: self.n_joints]
+        x = np.clip(x, self.lo, self.hi)
+        z = (x[:, :, None] - self.centres) * self.inv_width[:, :, None]
+        rf = np.exp(-0.5 * z * z) if self.cfg.field == "gaussian" else (np.abs(z) < 1.0).astype(float)
+        c = self.cfg
+        return (c.rate_min_hz + (c.rate_max_hz - c.rate_min_hz) * rf).ravel()
+
+    def active(self, q_des, q, qd_des, qd) -> np.ndarray:
+        """Local indices of the fibres firing this step, in increasing order (int32); one uniform draw per fibre
+        per step, so the random stream does not depend on the signals."""
+        _require("mossy encoder", self.n_joints, q_des, q, qd_des, qd)
+        c = self.cfg
+        u = self.rng.random(out=self._u)
+        signals = tuple(np.ascontiguousarray(x, dtype=np.float64) for x in (q_des, q, qd_des, qd))
+        n = _poisson_active(signals, self.lo, self.hi, self.centres, self.inv_width,
+                            (c.field == "gaussian", float(c.rate_min_hz), float(c.rate_max_hz - c.rate_min_hz)), u,
+                            self._out)
         return self._out[:n].copy()
 
 

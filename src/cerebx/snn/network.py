@@ -20,6 +20,7 @@ from cerebx.snn.topology import (
     Topology,
     build_topology,
     fill_dense,
+    integrators,
 )
 from cerebx.snn.weight_stats import Beside, RunCache, weight_stats
 
@@ -65,7 +66,7 @@ class Network:
     write into an array, never replace one.
     """
 
-    STATE_KEYS = ("V", "g", "ref", "ring_idx", "ring_n", "pf_t", "pf_j", "pf_head", "pf_lost", "dense_w")
+    STATE_KEYS = ("V", "g", "ref", "ring_idx", "ring_n", "pf_t", "pf_j", "pf_head", "pf_lost", "dense_w", "w")
 
     def __init__(self, cfg: NetworkConfig, parallel: bool = True, pf_ring: int = PF_RING,
                  compact_min: int = COMPACT_MIN):
@@ -107,6 +108,7 @@ class Network:
         self.u = np.zeros(n, dtype=np.float32)
         self._g = np.zeros((3, n), dtype=np.float32)
         self._ref = np.zeros(n, dtype=np.float32)
+        self.w = np.zeros(n, dtype=np.float32)  # adex_cond adaptation currents (pA), global index order
         self.flag = np.zeros(n, dtype=np.uint8)
         self.cid = np.arange(n, dtype=np.int32)
         self.slot = np.arange(n, dtype=np.int32)
@@ -184,7 +186,7 @@ class Network:
         written in place, so it stays valid for the network's life)."""
         return kernels.NetworkArrays(
             neurons=kernels.Neurons(self.u, self._g, self._ref, self.flag, self.cid, self.slot, self.n_act,
-                                    self.n_rest, self.pop_ep),
+                                    self.n_rest, self.pop_ep, self.w),
             populations=kernels.Populations(self.pop_i, self.pop_par, self.poly),
             delivery=kernels.Delivery(self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
                                       self.sp_c, self.c_k, self.c_q, self.c_l, self.de_i, self.dense_w),
@@ -249,6 +251,7 @@ class Network:
     def reset_state(self) -> None:
         """Neurons at rest, no conductances, nothing in flight; weights are kept."""
         self._set_neurons(self.el, np.zeros_like(self._g), np.zeros_like(self._ref))
+        self.w[:] = 0
         self.ring_n[:] = 0
         self.pf_head[:] = 0
         self.pf_lost[:] = 0
@@ -262,6 +265,10 @@ class Network:
         return d
 
     def load_arrays(self, arrays: dict[str, np.ndarray]) -> None:
+        """Set the state from :meth:`state_arrays`' output (one saved before the adaptation currents ``w`` were
+        kept comes from a network without adex_cond populations: its ``w`` is all zeros)."""
+        if "w" not in arrays:
+            arrays = {**arrays, "w": np.zeros_like(self.w)}
         cur = self.state_arrays()
         for k in self.STATE_KEYS:
             dst, src = cur[k], arrays[k]
@@ -333,6 +340,8 @@ class Network:
                 state[name] = np.zeros(v[2], np.dtype(v[1]))
                 stale = stale or name in _CACHES
         self.__dict__.update(state)
+        if "w" not in state:  # pickled before adex_cond (no adaptation currents)
+            self.w = np.zeros_like(self._ref)
         if "_stats_dirty" not in state:  # pickled by earlier code
             self._stats_dirty, self._stats_cache = np.zeros_like(self.pl_dirty), {}
         if stale:
@@ -367,6 +376,10 @@ class Network:
         rows = np.flatnonzero(self._stats_dirty[r, :n_pre] | self.pl_dirty[r, :n_pre])
         self._stats_dirty[r] = 0
         return weight_stats(w, beside, cache, cache.runs_of(rows * n_post, n_post))
+
+    def integrators(self) -> dict[str, dict]:
+        """The integrator each neuron population uses (:func:`~cerebx.snn.topology.integrators`)."""
+        return integrators(self.topo)
 
     @property
     def plastic_projections(self) -> list[str]:

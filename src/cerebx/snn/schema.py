@@ -18,8 +18,9 @@ from cerebx.schema.controller import GivenRanges, TaskRanges
 
 
 class Integration(Strict):
-    """How a LIF population's membrane equation is integrated. Conductances always decay exactly
-    (g <- g e^(-h/tau)); the integrator sees the exact conductance at its stage times."""
+    """How a population's membrane equation is integrated (lif_cond, adex_cond: V_thr reads V_th for AdEx).
+    Conductances always decay exactly (g <- g e^(-h/tau)); the integrator sees the exact conductance at its
+    stage times."""
 
     method: Literal["rk4", "rk2", "euler"] = Field(
         "rk4", description="rk4: classical Runge-Kutta; rk2: Heun (explicit trapezoid, EDLUT RK2); "
@@ -65,13 +66,65 @@ class LIFNeuron(Strict):
         return self
 
 
+class AdExNeuron(Strict):
+    """Adaptive exponential integrate-and-fire neuron with exponential conductances, NEST ``aeif_cond_exp``'s
+    definition (docs/models.md#adex). Excitatory input (``ampa`` projections) opens g_ex, inhibitory input
+    (``gaba``) g_in; ``nmda`` projections are refused."""
+
+    kind: Literal["adex_cond"] = "adex_cond"
+    C_m_pF: PositiveFloat = Field(281.0, description="membrane capacitance")
+    g_L_nS: PositiveFloat = Field(30.0, description="leak conductance")
+    E_L_mV: float = Field(-70.6, description="leak reversal (resting) potential")
+    V_th_mV: float = Field(-50.4, description="spike initiation threshold (centre of the exponential term)")
+    Delta_T_mV: NonNegFloat = Field(2.0, description="slope factor of the exponential term; 0 = plain LIF with "
+                                    "spikes at V_th_mV")
+    V_peak_mV: float = Field(0.0, description="spike detection threshold (used when Delta_T_mV > 0)")
+    V_reset_mV: float = Field(-60.0, description="reset potential after a spike (V held there for t_ref)")
+    t_ref_ms: NonNegFloat = Field(0.0, description="refractory period, rounded to whole integration steps")
+    a_nS: float = Field(4.0, description="subthreshold adaptation conductance")
+    b_pA: float = Field(80.5, description="spike-triggered adaptation increment of w")
+    tau_w_ms: PositiveFloat = Field(144.0, description="adaptation time constant")
+    E_ex_mV: float = Field(0.0, description="excitatory reversal potential")
+    E_in_mV: float = Field(-85.0, description="inhibitory reversal potential")
+    tau_syn_ex_ms: PositiveFloat = Field(0.2, description="excitatory conductance decay time constant")
+    tau_syn_in_ms: PositiveFloat = Field(2.0, description="inhibitory conductance decay time constant")
+    I_e_pA: float = Field(0.0, description="constant external input current")
+    integration: Integration = Field(
+        default_factory=Integration,
+        description="integration method and step, as for lif_cond (bifixed refinement above (E_L + V_th)/2)",
+    )
+
+    EXP_MAX: ClassVar[float] = 60.0
+    """Largest (V_peak - V_th) / Delta_T: e^60 times g_L Delta_T stays far inside float32 at any stage value."""
+
+    @model_validator(mode="after")
+    def _thresholds(self) -> AdExNeuron:
+        if self.V_th_mV <= self.E_L_mV:
+            raise ValueError(f"V_th_mV ({self.V_th_mV}) must be above E_L_mV ({self.E_L_mV})")
+        if self.Delta_T_mV > 0:
+            if self.V_peak_mV <= self.V_th_mV:
+                raise ValueError(f"V_peak_mV ({self.V_peak_mV}) must be above V_th_mV ({self.V_th_mV})")
+            ratio = (self.V_peak_mV - self.V_th_mV) / self.Delta_T_mV
+            if ratio > self.EXP_MAX:
+                raise ValueError(f"(V_peak_mV - V_th_mV) / Delta_T_mV is {ratio:.4g}, above {self.EXP_MAX:g}: the "
+                                 "exponential term overflows at the peak (raise Delta_T_mV or lower V_peak_mV)")
+        spike = self.V_peak_mV if self.Delta_T_mV > 0 else self.V_th_mV
+        if self.V_reset_mV >= spike:
+            raise ValueError(f"V_reset_mV ({self.V_reset_mV}) must be below the spike threshold ({spike})")
+        return self
+
+
 class InputFiber(Strict):
     """A fibre whose spikes are produced by an encoder (mossy or climbing fibre), not integrated."""
 
     kind: Literal["input"] = "input"
 
 
-Neuron = Annotated[LIFNeuron | InputFiber, Field(discriminator="kind")]
+Neuron = Annotated[LIFNeuron | AdExNeuron | InputFiber, Field(discriminator="kind")]
+
+
+RECEPTORS_OF: dict[str, set[str]] = {"adex_cond": {"ampa", "gaba"}}
+"""Receptors a neuron kind takes when it does not take all three (ampa -> g_ex, gaba -> g_in)."""
 
 
 class Population(Strict):
@@ -227,6 +280,17 @@ class NetworkConfig(Strict):
             raise ValueError("; ".join(problems))
         return self
 
+    @model_validator(mode="after")
+    def _receptors_of_the_model(self) -> NetworkConfig:
+        """A neuron model takes only the receptors it has (adex_cond: no NMDA)."""
+        for name, p in self.projections.items():
+            post = self.populations.get(p.post)
+            takes = RECEPTORS_OF.get(post.neuron.kind) if post is not None else None
+            if takes is not None and not p.teaching and p.receptor not in takes:
+                raise ValueError(f"projections.{name}.receptor: {p.post!r} is a {post.neuron.kind} population, "
+                                 f"which takes {' or '.join(sorted(takes))}, not {p.receptor!r}")
+        return self
+
     def fingerprint(self) -> str:
         """Hash of what shapes the state arrays (sizes, rules, receptors), not of weights or kernels,
         so a learned state can be reloaded under a different learning-rule setting."""
@@ -306,6 +370,31 @@ class BoxEncoder(Strict):
     fibers_per_signal: int = Field(10, gt=1)
     width_factor: PositiveFloat = Field(0.500000000001, description="half-width in units of the centre step")
     ranges: Annotated[GivenRanges | TaskRanges, Field(discriminator="kind")] = TaskRanges()
+
+
+class PoissonEncoder(Strict):
+    """MF rate coding (docs/models.md#mf-poisson-coding): per joint and signal, fibres with Gaussian (or box)
+    receptive fields over the signal's range; each fires in a 2 ms step with probability rate x 2 ms,
+    rate = rate_min_hz + (rate_max_hz - rate_min_hz) RF(value), from the run's seeded generator."""
+
+    role: ClassVar[str] = "mossy"
+
+    kind: Literal["poisson"] = "poisson"
+    fibers_per_signal: int = Field(10, gt=1)
+    field: Literal["gaussian", "box"] = Field(
+        "gaussian", description="receptive field: gaussian exp(-z^2/2), or box 1 for |z| < 1, with z = "
+        "(value - centre) / (width_factor x centre step)")
+    width_factor: PositiveFloat = Field(1.0, description="gaussian sigma, or box half-width, in centre steps")
+    rate_min_hz: NonNegFloat = Field(0.0, description="rate far from the receptive field")
+    rate_max_hz: float = Field(100.0, gt=0, le=500, description="rate at the centre (at most one spike per "
+                               "2 ms step: 500 Hz)")
+    ranges: Annotated[GivenRanges | TaskRanges, Field(discriminator="kind")] = TaskRanges()
+
+    @model_validator(mode="after")
+    def _rates(self) -> PoissonEncoder:
+        if self.rate_min_hz >= self.rate_max_hz:
+            raise ValueError(f"rate_min_hz ({self.rate_min_hz}) must be below rate_max_hz ({self.rate_max_hz})")
+        return self
 
 
 class CFEncoder(Strict):

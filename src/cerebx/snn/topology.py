@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.polynomial import Polynomial as Pn
 
-from cerebx.snn.schema import AllToAll, JointCombinations, LIFNeuron, NetworkConfig, OneToOne
+from cerebx.snn.schema import AdExNeuron, AllToAll, Integration, JointCombinations, LIFNeuron, NetworkConfig, OneToOne
 
 RECEPTORS = {"ampa": 0, "nmda": 1, "gaba": 2}
 
@@ -23,9 +23,19 @@ RECEPTORS = {"ampa": 0, "nmda": 1, "gaba": 2}
 # population integrated with a longer step); P_DFA over one bifixed sub-step.
 (P_CM, P_GL, P_EL, P_EA, P_EG, P_DA, P_DAH, P_DN, P_DNH, P_DG, P_DGH, P_VTH, P_NREF, P_CLAMP, P_H,
  P_D1A, P_D1N, P_D1G, P_DFA, P_UFINE, P_METHOD) = range(21)
-N_PAR = 21
+# P_DFAH .. P_DFGH: the other decays over one bifixed sub-step hf and hf/2 (P_DFA: AMPA over hf). AdEx rows
+# (KIND_ADEX) use AMPA's columns for g_ex, GABA's for g_in, P_VTH for the spike threshold (V_peak, or V_th
+# without the exponential term), and: P_DT Delta_T, P_INVDT 1/Delta_T (0 without the term), P_VT V_th - E_L,
+# P_UPK V_peak - E_L, P_URST V_reset - E_L, P_A a, P_B b, P_ITW 1/tau_w, P_IE I_e.
+(P_DFAH, P_DFN, P_DFNH, P_DFG, P_DFGH, P_DT, P_INVDT, P_VT, P_UPK, P_URST, P_A, P_B, P_ITW,
+ P_IE) = range(21, 35)
+N_PAR = 35
 
-KIND_INPUT, KIND_LIF_AMPA, KIND_LIF_FULL = 0, 1, 2
+KIND_INPUT, KIND_LIF_AMPA, KIND_LIF_FULL, KIND_ADEX = 0, 1, 2, 3
+KIND_NAMES = {KIND_INPUT: "input", KIND_LIF_AMPA: "lif_cond", KIND_LIF_FULL: "lif_cond", KIND_ADEX: "adex_cond"}
+INTEGRATOR_PATHS = {KIND_LIF_AMPA: "ampa_polynomial", KIND_LIF_FULL: "rk_stages", KIND_ADEX: "rk_stages"}
+"""How each kind's step is computed (docs/models.md#lif-integration): the AMPA-only polynomial form, or the
+Runge-Kutta stages evaluated neuron by neuron. Both honour method, dt_ms and bifixed_substeps."""
 METHODS = {"euler": 0, "rk2": 1, "rk4": 2}
 
 # Columns of the per-population integer table.
@@ -76,6 +86,56 @@ def step_polynomials(method: str, h: float, C: float, gL: float, E: float, d: fl
         c = poly.coef
         res[r, : len(c)] = c
     return res
+
+
+def _step_ratio(integ: Integration, name: str, dt: float, n_sub: int) -> tuple[int, float]:
+    """(network steps per integration step, the step h in ms) of a population, checked."""
+    h = integ.dt_ms if integ.dt_ms is not None else dt
+    ratio = int(round(h / dt))
+    if abs(h / dt - ratio) > 1e-9 or ratio < 1 or n_sub % ratio:
+        raise ValueError(f"populations.{name}.neuron.integration.dt_ms: {h} must be a multiple of the "
+                         f"network dt_ms ({dt}) that divides 2 ms")
+    return ratio, ratio * dt
+
+
+def _adex_row(nrn: AdExNeuron, name: str, dt: float, n_sub: int, par: np.ndarray, ipar: np.ndarray) -> None:
+    """Fill one population's parameter rows for ``adex_cond`` (column meanings at N_PAR); g_ex lives in the
+    AMPA conductance, g_in in the GABA one."""
+    integ = nrn.integration
+    ratio, h = _step_ratio(integ, name, dt, n_sub)
+    nf = integ.bifixed_substeps
+    hf = h / nf
+    ipar[I_KIND], ipar[I_RATIO], ipar[I_NFINE] = KIND_ADEX, ratio, nf
+    el = nrn.E_L_mV
+    par[P_CM], par[P_GL], par[P_EL], par[P_EA], par[P_EG] = nrn.C_m_pF, nrn.g_L_nS, el, nrn.E_ex_mV, nrn.E_in_mV
+    te, ti = nrn.tau_syn_ex_ms, nrn.tau_syn_in_ms
+    for tau, cols in ((te, (P_DA, P_DAH, P_D1A, P_DFA, P_DFAH)), (te, (P_DN, P_DNH, P_D1N, P_DFN, P_DFNH)),
+                      (ti, (P_DG, P_DGH, P_D1G, P_DFG, P_DFGH))):
+        for col, span in zip(cols, (h, h / 2, dt, hf, hf / 2), strict=True):
+            par[col] = np.exp(-span / tau)
+    exp_term = nrn.Delta_T_mV > 0
+    par[P_VTH] = nrn.V_peak_mV if exp_term else nrn.V_th_mV
+    par[P_NREF] = round(nrn.t_ref_ms / h)
+    par[P_H] = h
+    par[P_METHOD] = METHODS[integ.method]
+    par[P_UFINE] = 0.5 * (nrn.V_th_mV - el) if nf > 1 else np.inf
+    par[P_DT], par[P_INVDT] = nrn.Delta_T_mV, (1.0 / nrn.Delta_T_mV if exp_term else 0.0)
+    par[P_VT], par[P_UPK], par[P_URST] = nrn.V_th_mV - el, par[P_VTH] - el, nrn.V_reset_mV - el
+    par[P_A], par[P_B], par[P_ITW], par[P_IE] = nrn.a_nS, nrn.b_pA, 1.0 / nrn.tau_w_ms, nrn.I_e_pA
+
+
+def integrators(topo: Topology) -> dict[str, dict]:
+    """The integrator each non-input population actually uses (recorded in a run's summary.json):
+    model kind, computation path, method, step and bifixed sub-steps."""
+    out = {}
+    for i, name in enumerate(topo.names):
+        k = int(topo.kind[i])
+        if k == KIND_INPUT:
+            continue
+        nrn = topo.cfg.populations[name].neuron
+        out[name] = {"kind": KIND_NAMES[k], "path": INTEGRATOR_PATHS[k], "method": nrn.integration.method,
+                     "dt_ms": float(topo.par[i, P_H]), "bifixed_substeps": int(topo.ipar[i, I_NFINE])}
+    return out
 
 
 @dataclass
@@ -213,6 +273,10 @@ def build_topology(cfg: NetworkConfig, fill: bool = True) -> Topology:
     ipar[:, I_LO], ipar[:, I_HI], ipar[:, I_RATIO], ipar[:, I_NFINE] = lo, hi, 1, 1
     for i, n in enumerate(names):
         nrn = cfg.populations[n].neuron
+        if isinstance(nrn, AdExNeuron):
+            kind[i] = KIND_ADEX
+            _adex_row(nrn, n, dt, n_sub, par[i], ipar[i])
+            continue
         if not isinstance(nrn, LIFNeuron):
             kind[i] = KIND_INPUT
             continue
@@ -238,6 +302,9 @@ def build_topology(cfg: NetworkConfig, fill: bool = True) -> Topology:
                                                        (nrn.tau_AMPA_ms, nrn.tau_NMDA_ms, nrn.tau_GABA_ms))
         hf = h / integ.bifixed_substeps
         par[i, P_DFA] = np.exp(-hf / nrn.tau_AMPA_ms)
+        par[i, P_DFAH] = np.exp(-0.5 * hf / nrn.tau_AMPA_ms)
+        par[i, P_DFN], par[i, P_DFNH] = np.exp(-hf / nrn.tau_NMDA_ms), np.exp(-0.5 * hf / nrn.tau_NMDA_ms)
+        par[i, P_DFG], par[i, P_DFGH] = np.exp(-hf / nrn.tau_GABA_ms), np.exp(-0.5 * hf / nrn.tau_GABA_ms)
         par[i, P_UFINE] = 0.5 * (nrn.V_thr_mV - nrn.E_L_mV) if integ.bifixed_substeps > 1 else np.inf
         par[i, P_METHOD] = METHODS[integ.method]
         par[i, P_VTH] = nrn.V_thr_mV

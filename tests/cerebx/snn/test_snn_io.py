@@ -157,6 +157,10 @@ def test_controller_runs_and_reports():
     assert summ["dcn_rate_hz"] > 0 and 0 <= summ["w_pf_pc_min"] <= summ["w_pf_pc_max"] <= 5
     d = ctrl.describe()
     assert d["neurons"] == 120 + 60 + 3750 + 60 + 60
+    # the runner writes describe() into summary.json as controller_info: the integrator of every population
+    assert d["integrators"]["gc"] == {"kind": "lif_cond", "path": "ampa_polynomial", "method": "rk2", "dt_ms": 1.0,
+                                      "bifixed_substeps": 3}
+    assert d["integrators"]["dcn"]["path"] == "rk_stages" and set(d["integrators"]) == {"gc", "pc", "dcn"}
     lo, hi = ctrl.position_bounds()
     np.testing.assert_allclose(lo, -0.5 - 0.1)
     np.testing.assert_allclose(hi, 0.5 + 0.1)

@@ -184,6 +184,8 @@ class SNNControllerImpl(Controller):
                              f"evenly into {nj} joints")
         lo, hi = encoder_ranges(cfg, nj, getattr(ctx, "task", None))
         self.mf = registry.encoders.build(cfg.mf, lo, hi)
+        if isinstance(getattr(self.mf, "rng", None), np.random.Generator):  # a stochastic MF encoder (poisson)
+            self.mf.rng = ctx.rng("controller.snn.mf")
         if self.mf.n_fibers != self.sl_mf.stop - self.sl_mf.start:
             raise ValueError(f"network: {io.mossy} has {self.sl_mf.stop - self.sl_mf.start} fibres, the "
                              f"encoder needs {self.mf.n_fibers} ({nj} joints x 4 signals x "
@@ -405,7 +407,7 @@ class SNNControllerImpl(Controller):
         the pathway delay leaves between two ticks; the learned state is still saved at the end)."""
         self._simulate_packed(*pack([]), self._net_step)  # a chunk of no steps: the network's kernels, decoding
         z = np.zeros(self.n_ctrl)
-        self.mf.active(z, z, z, z)
+        copy.deepcopy(self.mf).active(z, z, z, z)
         self.cf.error(z, z, z, z)
         copy.deepcopy(self.cf).active(z)
         pair = EncoderPair.of(copy.deepcopy(self.mf), copy.deepcopy(self.cf), self.sl_mf.start, self.sl_cf.start)
@@ -526,6 +528,7 @@ class SNNControllerImpl(Controller):
             "pathway_delay_steps": self.k_delay,
             "cf_pathway_delay_steps": self.k_cf,
             "fingerprint": self.fingerprint,
+            "integrators": self.net.integrators(),
         }
 
     # ------------------------------------------------------------------ state
@@ -537,6 +540,8 @@ class SNNControllerImpl(Controller):
         arrays["out_fifo"] = np.array(list(self._ready)).reshape(len(self._ready), self.width)
         meta = {"version": STATE_VERSION, "fingerprint": self.fingerprint, "config": self.config_hash,
                 "network": self.net_cfg.name, "rng": self.cf.rng.bit_generator.state}
+        if isinstance(getattr(self.mf, "rng", None), np.random.Generator):
+            meta["mf_rng"] = self.mf.rng.bit_generator.state
         arrays["in_fifo"] = np.array(json.dumps([a.tolist() for a in self._pending]))
         arrays["lag_fifos"] = np.array(json.dumps([[a.tolist() for a in self._mf_lag],
                                                    [a.tolist() for a in self._cf_lag]]))
@@ -557,6 +562,8 @@ class SNNControllerImpl(Controller):
             raise StateMismatchError(f"{path}: {exc}") from None
         self.cf.burst_left[:] = data["cf_burst_left"]
         self.cf.rng.bit_generator.state = meta["rng"]
+        if "mf_rng" in meta and isinstance(getattr(self.mf, "rng", None), np.random.Generator):
+            self.mf.rng.bit_generator.state = meta["mf_rng"]
         fifo = json.loads(str(data["in_fifo"]))
         self._join()
         lags = json.loads(str(data["lag_fifos"])) if "lag_fifos" in data.files else [[], []]
