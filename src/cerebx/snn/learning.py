@@ -19,7 +19,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 FAM_TRACE, FAM_PAIRING = 0, 1
 
@@ -47,6 +48,16 @@ class SparseLearning(NamedTuple):
     hs_n: np.ndarray  # int64 [rows]: spikes recorded so far
     lost: np.ndarray  # int64 [rule]: history entries overwritten while still inside the kernel window
     ev: np.ndarray  # int64: scratch, the partner events of one substep (local post index)
+
+
+class NoLearning(NamedTuple):
+    """What the kernels get for a network without sparse rules: a type of its own, so :func:`run_rules` compiles to
+    nothing and the step kernel is the same code as without this module."""
+
+    none: np.ndarray
+
+
+NO_LEARNING = NoLearning(np.zeros(0, np.int64))
 
 
 def empty() -> SparseLearning:
@@ -179,3 +190,21 @@ def sparse_learning(t, learn, sl, dl):
                         dw = fixed + _kernel_sum(sl, post_row + sp_post[q] - post_lo, t, k0, klen)
                         w[q] = min(max(w[q] + dw, w_lo), w_hi)
                 _remember(sl, r, pre_row + j, t, klen)
+
+
+def run_rules(t, learn, sl, dl):
+    """:func:`sparse_learning` of substep t, for the kernels (compiled away for :class:`NoLearning`)."""
+    if len(sl.sr_i):
+        sparse_learning(t, learn, sl, dl)
+
+
+@overload(run_rules)
+def _run_rules(t, learn, sl, dl):
+    if isinstance(sl, types.BaseNamedTuple) and sl.instance_class is NoLearning:
+        return lambda t, learn, sl, dl: None
+
+    def impl(t, learn, sl, dl):
+        if sl.sr_i.shape[0] > 0:
+            sparse_learning(t, learn, sl, dl)
+
+    return impl

@@ -58,7 +58,7 @@ SPARSE_STATE = ("sp_w", "sl_tr_v", "sl_tr_t", "sl_hs_t", "sl_hs_n", "sl_lost")
 """State of the sparse learning rules: the weights they write, their traces and spike histories."""
 
 
-def _sparse_learning(topo: Topology, sp_i: np.ndarray, sp_ptr: np.ndarray) -> learning.SparseLearning:
+def _sparse_learning(topo: Topology) -> learning.SparseLearning:
     """The kernels' arrays of ``topo.sparse_rules`` (:mod:`cerebx.snn.learning`)."""
     rules = topo.sparse_rules
     if not rules:
@@ -72,8 +72,7 @@ def _sparse_learning(topo: Topology, sp_i: np.ndarray, sp_ptr: np.ndarray) -> le
     teach_syn = 0
     for r, rule in enumerate(rules):
         s = topo.sparse[rule.piece]
-        post_pop = int(np.searchsorted(topo.hi, s.post[0], side="right")) if len(s.post) else 0
-        post_lo = int(topo.lo[post_pop])
+        post_lo = int(topo.lo[topo.index[topo.cfg.projections[rule.proj].post]])
         n_post = len(rule.csc_ptr) - 1
         spec = rule.spec
         if isinstance(spec, TraceSpec):
@@ -228,7 +227,7 @@ class Network:
         self.pop_ep = np.ones(len(topo.names), dtype=np.int64)
         self.scr_f = np.zeros((3, n), dtype=np.float32)
         self.scr_i = np.zeros(n, dtype=np.int64)
-        self.sl = _sparse_learning(topo, sp_i, self.sp_ptr)
+        self.sl = _sparse_learning(topo)
         self.learn = True
         self.t_sub = 0
         self._all_changed = True  # every weight counts as changed until the first changed_ranges()
@@ -248,7 +247,7 @@ class Network:
                                           self.pf_lost, self.pl_dirty),
             buffers=kernels.Buffers(self.col_buf, self.acc, self.acc_j, self.out_idx, self.out_t, self.scr_f,
                                     self.scr_i),
-            learning=self.sl,
+            learning=self.sl if len(self.sl.sr_i) else learning.NO_LEARNING,
         )
 
     # ------------------------------------------------------------------ state
@@ -346,16 +345,18 @@ class Network:
         the plastic projections the kernels marked (LTP, LTD), or all of ``dense_w`` after a load. Lets a
         checkpoint rewrite only those (``persistence/checkpoint.py``); the call starts a new interval.
 
-        The arrays the network never writes after its build (:meth:`_fixed`) are reported too, whole after a
-        load and with no range since: a checkpoint then keeps them in its arrays file, written once per
-        process, instead of in every pickle (4.1 of the full network's 9.2 MB)."""
+        With sparse learning rules, their weights (``sp_w``) are reported whole every time. The arrays the network
+        never writes after its build (:meth:`_fixed`) are reported too, whole after a load and with no range
+        since: a checkpoint then keeps them in its arrays file, written once per process, instead of in every
+        pickle (4.1 of the full network's 9.2 MB)."""
         fixed = [a for a in self._fixed() if a.size]
         np.bitwise_or(self._stats_dirty, self.pl_dirty, out=self._stats_dirty)
         if self._all_changed:
             self._all_changed = False
             self.pl_dirty[:] = 0
             whole = np.zeros(1, np.int64)
-            return [(self.dense_w, whole, self.dense_w.size), *((a, whole, a.size) for a in fixed)]
+            learned = [(self.sp_w, whole, self.sp_w.size)] if len(self.sl.sr_i) else []
+            return [(self.dense_w, whole, self.dense_w.size), *learned, *((a, whole, a.size) for a in fixed)]
         out = [(self.sp_w, np.zeros(1, np.int64), self.sp_w.size)] if len(self.sl.sr_i) else []
         for r, d in enumerate(self.pl_i[:, 0]):
             n_pre, n_post, w_off = (int(x) for x in self.de_i[d, [1, 3, 4]])
@@ -398,6 +399,8 @@ class Network:
                 state[name] = np.zeros(v[2], np.dtype(v[1]))
                 stale = stale or name in _CACHES
         self.__dict__.update(state)
+        if "sl" not in state:  # pickled before sparse learning rules existed
+            self.sl = learning.empty()
         if "_stats_dirty" not in state:  # pickled by earlier code
             self._stats_dirty, self._stats_cache = np.zeros_like(self.pl_dirty), {}
         if stale:

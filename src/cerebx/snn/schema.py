@@ -274,8 +274,10 @@ def _plasticity_problems(where: str, p: Projection, projections: dict[str, Proje
     if not isinstance(p.plasticity, KernelSTDP):
         return _sparse_rule_problems(where, p, projections)
     out = []
-    if not isinstance(p.rule, AllToAll) or not isinstance(p.delay_ms, float):
+    if not isinstance(p.rule, AllToAll):
         out.append(f"{where}: plasticity is supported on all_to_all projections only")
+    elif not isinstance(p.delay_ms, float):
+        out.append(f"{where}.delay_ms: kernel_stdp needs one delay (a constant delay_ms)")
     elif p.teaching:
         out.append(f"{where}: plasticity is supported on all_to_all projections only, not on a teaching one")
     name = p.plasticity.teacher  # type: ignore[union-attr]
