@@ -23,6 +23,10 @@ GROUP_TEXT = {
     "delay": "link delay models (`delay=NAME`)",
     "event": "plant events scheduled in `events`",
     "encoder": "cerebellar input encoders (`controller.mf`, `controller.cf`)",
+    "connector": "connection rules of a spiking network's projections (`rule` of a projection; "
+                 "[connectors](../models.md#connectors))",
+    "plasticity": "learning rules of a spiking network's projections (`plasticity` of a projection; "
+                  "[plasticity](../models.md#plasticity))",
 }
 
 

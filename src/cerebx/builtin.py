@@ -15,6 +15,9 @@ from cerebx.schema import plant as p
 from cerebx.schema import spinal as sp
 from cerebx.schema import stages as s
 from cerebx.schema import task as t
+from cerebx.snn import connectors as cn
+from cerebx.snn import plasticity as pl
+from cerebx.snn import schema as net
 from cerebx.snn.schema import PoissonEncoder
 
 
@@ -73,3 +76,18 @@ def register() -> None:
     registry.links.register(lk.SimLink, "cerebx.link.transport:build_sim")
     registry.links.register(lk.ZenohLink, "cerebx.link.zenoh_link:ZenohTransport")
     registry.links.register(lk.UdpLink, "cerebx.link.udp:UdpTransport")
+
+    # network connectors take (rule, n_pre, n_post, same population, rng) and return the drawn synapses
+    registry.connectors.register(net.AllToAll, "cerebx.snn.topology:all_to_all")
+    registry.connectors.register(net.OneToOne, "cerebx.snn.topology:one_to_one")
+    registry.connectors.register(net.JointCombinations, "cerebx.snn.topology:joint_combinations")
+    registry.connectors.register(cn.FixedIndegree, cn.fixed_indegree)
+    registry.connectors.register(cn.FixedOutdegree, cn.fixed_outdegree)
+    registry.connectors.register(cn.FixedProbability, cn.fixed_probability)
+    registry.connectors.register(cn.FromFile, cn.from_file)
+
+    # plasticity builders take (rule, dt_ms) and return the engine's form of the rule (snn/plasticity.py)
+    registry.plasticity_rules.register(net.KernelSTDP, "cerebx.snn.topology:kernel_stdp")
+    registry.plasticity_rules.register(pl.PairSTDP, pl.pair_stdp)
+    registry.plasticity_rules.register(pl.SymmetricCos, pl.symmetric_cos)
+    registry.plasticity_rules.register(pl.SymmetricCosSTDP, pl.symmetric_cos)

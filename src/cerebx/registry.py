@@ -2,12 +2,13 @@
 
 Groups: ``task``, ``plant``, ``controller`` (brain-side parts), ``stage`` (brain- or robot-side
 stages: torque filters, the supervisor, muscles, ...), ``delay`` (link delay models), ``event``
-(plant events), ``encoder`` (cerebellar input codes) and ``link`` (transports between the brain side and
-the robot side). Every kind arrives through a plugin: a callable
-taking no arguments, exposed as a ``cerebx.plugins`` entry point, that registers its kinds here. The
-platform's own kinds come the same way (entry point ``core``, ``cerebx.builtin:register``). A plugin may
-also add a folder of Hydra presets (:func:`add_config_source`) and a report module with its figures and
-studies (:func:`add_report`). Configuration only ever names a ``kind``: it cannot import anything.
+(plant events), ``encoder`` (cerebellar input codes), ``link`` (transports between the brain side and
+the robot side), ``connector`` (spiking-network connection rules) and ``plasticity`` (their learning rules).
+Every kind arrives through a plugin: a callable taking no arguments, exposed as a ``cerebx.plugins`` entry
+point, that registers its kinds here. The platform's own kinds come the same way (entry point ``core``,
+``cerebx.builtin:register``). A plugin may also add a folder of Hydra presets (:func:`add_config_source`)
+and a report module with its figures and studies (:func:`add_report`). Configuration only ever names a
+``kind``: it cannot import anything.
 
 A config field that holds "any registered kind of group G" is typed ``Plugin("G")``: the kind is
 looked up when the config is validated, so a plugin's kinds are accepted everywhere the built-in
@@ -133,8 +134,11 @@ delays: Registry[DelayBuilder] = Registry("delay")
 events: Registry[EventBuilder] = Registry("event")
 encoders: Registry[MossyEncoderBuilder | ClimbingEncoderBuilder] = Registry("encoder")
 links: Registry[LinkBuilder] = Registry("link")
+connectors = Registry("connector")
+plasticity_rules = Registry("plasticity")
 
-GROUPS = {r.group: r for r in (tasks, plants, controllers, stages, delays, events, encoders, links)}
+GROUPS = {r.group: r for r in (tasks, plants, controllers, stages, delays, events, encoders, links, connectors,
+                               plasticity_rules)}
 
 
 def Plugin(group: str) -> Any:  # noqa: N802 - reads as a type in schemas

@@ -6,7 +6,8 @@ validated without MuJoCo or numba). The runtime names (stages, plants, tasks, th
 import contract in ``pyproject.toml`` holds it to that).
 
 Registering kinds: each group is a :class:`~cerebx.registry.Registry` (``controllers``, ``stages``,
-``plants``, ``tasks``, ``delays``, ``events``, ``encoders``, ``links``) whose ``register(schema, builder)``
+``plants``, ``tasks``, ``delays``, ``events``, ``encoders``, ``links``, and for spiking networks ``connectors``
+and ``plasticity_rules``) whose ``register(schema, builder)``
 takes the kind's schema (its ``kind`` field's default names it) and its builder (a callable, or
 ``"module:function"`` imported on first use). A field holding any kind of a group is typed ``Plugin(group)``.
 """
@@ -19,12 +20,14 @@ from cerebx.registry import (
     add_bench_run,
     add_config_source,
     add_report,
+    connectors,
     controllers,
     delays,
     encoders,
     events,
     links,
     plants,
+    plasticity_rules,
     stages,
     tasks,
 )
@@ -33,6 +36,8 @@ from cerebx.schema.controller import VELOCITY_ERROR, ControllerConfig, GivenRang
 from cerebx.schema.muscles import EkebergConfig
 from cerebx.schema.stages import StageConfig
 from cerebx.signals import Signal, StageIO, joint_signals
+from cerebx.snn.connectors import Synapses, projection_rng
+from cerebx.snn.plasticity import PairingSpec, TraceSpec
 from cerebx.snn.schema import KernelSTDP
 
 __all__ = [
@@ -48,6 +53,7 @@ __all__ = [
     "NonNegFloat",
     "PerJoint",
     "PhysicsStepMs",
+    "PairingSpec",
     "PlantSchema",
     "Plugin",
     "PositiveFloat",
@@ -57,10 +63,13 @@ __all__ = [
     "StageIO",
     "StateMismatchError",
     "Strict",
+    "Synapses",
     "TaskRanges",
+    "TraceSpec",
     "add_bench_run",
     "add_config_source",
     "add_report",
+    "connectors",
     "controllers",
     "delays",
     "encoders",
@@ -69,6 +78,8 @@ __all__ = [
     "links",
     "periodic_part_problems",
     "plants",
+    "plasticity_rules",
+    "projection_rng",
     "stages",
     "tasks",
 ]

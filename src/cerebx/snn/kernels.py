@@ -51,6 +51,7 @@ import numpy as np
 from numba import njit, prange, types
 from numba.experimental import structref
 
+from cerebx.snn.learning import NoLearning, SparseLearning, run_rules
 from cerebx.snn.topology import (
     I_COMPACT,
     I_HI,
@@ -181,6 +182,7 @@ class NetworkArrays(NamedTuple):
     delivery: Delivery
     plasticity: Plasticity
     buffers: Buffers
+    learning: SparseLearning | NoLearning  # the sparse projections' rules (snn/learning.py), if any
 
 
 @structref.register
@@ -821,6 +823,7 @@ def run_step(t0, n_sub, inputs, learn, par, net):
     n_out = 0
     for s in range(n_sub):
         t = t0 + s
+        run_rules(t, learn, net.learning, dl)
         # sparse projections (CSR by presynaptic neuron); teaching ones carry no current
         for p in range(sp_i.shape[0]):
             if sp_i[p, 5] != 0:

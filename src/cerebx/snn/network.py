@@ -9,7 +9,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from cerebx.snn import kernels
+from cerebx.snn import kernels, learning
+from cerebx.snn.plasticity import HISTORY_MAX, TraceSpec
 from cerebx.snn.schema import NetworkConfig
 from cerebx.snn.topology import (
     I_COMPACT,
@@ -54,12 +55,65 @@ _CACHES = ("c_k", "c_q", "c_l")
 _LEFT_OUT = "cerebx.left-out"
 
 
+SPARSE_STATE = ("sp_w", "sl_tr_v", "sl_tr_t", "sl_hs_t", "sl_hs_n", "sl_lost")
+"""State of the sparse learning rules: the weights they write, their traces and spike histories."""
+
+
+def _sparse_learning(topo: Topology) -> learning.SparseLearning:
+    """The kernels' arrays of ``topo.sparse_rules`` (:mod:`cerebx.snn.learning`)."""
+    rules = topo.sparse_rules
+    if not rules:
+        return learning.empty()
+    L = learning
+    base = np.concatenate([[0], np.cumsum([len(s.post) for s in topo.sparse])])
+    sr_i = np.zeros((len(rules), L.N_RI), np.int64)
+    sr_f = np.zeros((len(rules), L.N_RF))
+    ptrs, qs, js, kerns = [], [], [], []
+    rows = csc = k_off = n_q = 0
+    teach_syn = 0
+    for r, rule in enumerate(rules):
+        s = topo.sparse[rule.piece]
+        post_lo = int(topo.lo[topo.index[topo.cfg.projections[rule.proj].post]])
+        n_post = len(rule.csc_ptr) - 1
+        spec = rule.spec
+        if isinstance(spec, TraceSpec):
+            fam, klen = L.FAM_TRACE, 0
+            sr_f[r, [L.R_LAM, L.R_ALPHA, L.R_MUP, L.R_MUM]] = spec.lam, spec.alpha, spec.mu_plus, spec.mu_minus
+            sr_f[r, L.R_RATEP] = topo.dt_ms / spec.tau_plus_ms
+            sr_f[r, L.R_RATEM] = topo.dt_ms / spec.tau_minus_ms
+        else:
+            fam, klen = L.FAM_PAIRING, max(len(spec.k_pre), len(spec.k_post))
+            for table in (spec.k_pre, spec.k_post):
+                kerns.append(np.pad(np.asarray(table, float), (0, klen - len(table))))
+            sr_f[r, L.R_FIXED] = spec.fixed_nS
+        t_lo, t_hi = rule.teachers
+        teach_syn = max(teach_syn, sum(len(topo.sparse[k].post) for k in range(t_lo, t_hi)))
+        sr_i[r] = (fam, rule.piece, t_lo, t_hi, post_lo, n_post, csc, k_off, klen, rows, rows + s.n_pre)
+        sr_f[r, L.R_WLO], sr_f[r, L.R_WHI] = rule.w_lo, rule.w_hi
+        ptrs.append(rule.csc_ptr + n_q)
+        qs.append(rule.csc_q + base[rule.piece])
+        n_q += len(rule.csc_q)
+        js.append(rule.csc_j)
+        rows += s.n_pre + n_post
+        csc += n_post + 1
+        k_off += 2 * klen
+    klen_max = int(sr_i[:, L.R_KLEN].max())
+    H = max(1, min(klen_max, HISTORY_MAX))  # at most one spike per neuron and substep fits the window
+    return L.SparseLearning(
+        sr_i, sr_f, np.concatenate(ptrs), np.concatenate(qs), np.concatenate(js).astype(np.int64),
+        np.concatenate(kerns) if kerns else np.zeros(1), np.zeros(rows), np.zeros(rows, np.int64),
+        np.zeros((rows, H), np.int64), np.zeros(rows, np.int64), np.zeros(len(rules), np.int64),
+        np.zeros(max(teach_syn, topo.n_neurons, 1), np.int64))
+
+
 class Network:
     """Flat-array spiking network (see :mod:`cerebx.snn.kernels` for the numerics).
 
     ``parallel``: integrate the large populations with numba threads (omp); otherwise everything
     runs on the calling thread. ``compact_min``: AMPA-only populations at least this large keep
     only their non-resting neurons in the integration loop (exact; see kernels).
+    ``seed``: the run's seed, which random connectors, weights and delays draw from (``snn/connectors.py``;
+    networks without them do not depend on it).
     ``V``, ``g`` and ``ref`` are assembled from the kernel state on access (read-only views of
     the state; use :meth:`load_arrays` to set it). ``arrays`` groups the same array objects for the
     kernels (:class:`~cerebx.snn.kernels.NetworkArrays`, handed to them as one ``KernelState``):
@@ -69,7 +123,7 @@ class Network:
     STATE_KEYS = ("V", "g", "ref", "ring_idx", "ring_n", "pf_t", "pf_j", "pf_head", "pf_lost", "dense_w", "w")
 
     def __init__(self, cfg: NetworkConfig, parallel: bool = True, pf_ring: int = PF_RING,
-                 compact_min: int = COMPACT_MIN):
+                 compact_min: int = COMPACT_MIN, seed: int = 0):
         t_start = time.perf_counter()
         self.cfg = cfg
         self.parallel = parallel
@@ -78,7 +132,7 @@ class Network:
         # without it (numba issue 8578)
         threads = numba.get_num_threads()
         self.n_threads = threads if parallel else 1
-        self.topo = topo = build_topology(cfg, fill=False)
+        self.topo = topo = build_topology(cfg, fill=False, seed=seed)
         # the weights' first touch beside the rest of the set-up (mostly the kernels' loading, which holds the
         # interpreter lock that the fill lets go of): joined before anything reads them
         failed: list[BaseException] = []
@@ -175,6 +229,7 @@ class Network:
         self.pop_ep = np.ones(len(topo.names), dtype=np.int64)
         self.scr_f = np.zeros((3, n), dtype=np.float32)
         self.scr_i = np.zeros(n, dtype=np.int64)
+        self.sl = _sparse_learning(topo)
         self.learn = True
         self.t_sub = 0
         self._all_changed = True  # every weight counts as changed until the first changed_ranges()
@@ -194,6 +249,7 @@ class Network:
                                           self.pf_lost, self.pl_dirty),
             buffers=kernels.Buffers(self.col_buf, self.acc, self.acc_j, self.out_idx, self.out_t, self.scr_f,
                                     self.scr_i),
+            learning=self.sl if len(self.sl.sr_i) else learning.NO_LEARNING,
         )
 
     # ------------------------------------------------------------------ state
@@ -255,12 +311,18 @@ class Network:
         self.ring_n[:] = 0
         self.pf_head[:] = 0
         self.pf_lost[:] = 0
+        self.sl.tr_v[:], self.sl.tr_t[:], self.sl.hs_n[:], self.sl.lost[:] = 0, 0, 0, 0
         self.t_sub = 0
+
+    @property
+    def state_keys(self) -> tuple[str, ...]:
+        """:attr:`STATE_KEYS`, and with sparse learning rules their weights, traces and histories."""
+        return self.STATE_KEYS + (SPARSE_STATE if len(self.sl.sr_i) else ())
 
     def state_arrays(self) -> dict[str, np.ndarray]:
         V, g, ref = self._neurons()
         d = {"V": V, "g": g, "ref": ref}
-        d.update({k: getattr(self, k) for k in self.STATE_KEYS if k not in d})
+        d.update({k: self._state_array(k) for k in self.state_keys if k not in d})
         d["t_sub"] = np.array(self.t_sub, dtype=np.int64)
         return d
 
@@ -270,14 +332,16 @@ class Network:
         if "w" not in arrays:
             arrays = {**arrays, "w": np.zeros_like(self.w)}
         cur = self.state_arrays()
-        for k in self.STATE_KEYS:
+        for k in self.state_keys:
+            if k not in arrays:
+                raise ValueError(f"state array {k}: missing from the saved state")
             dst, src = cur[k], arrays[k]
             if src.shape != dst.shape or src.dtype != dst.dtype:
                 raise ValueError(f"state array {k}: saved {src.shape} {src.dtype}, "
                                  f"network needs {dst.shape} {dst.dtype}")
-        for k in self.STATE_KEYS:
+        for k in self.state_keys:
             if k not in ("V", "g", "ref"):
-                getattr(self, k)[...] = arrays[k]
+                self._state_array(k)[...] = arrays[k]
         self._set_neurons(arrays["V"], arrays["g"], arrays["ref"])
         self.t_sub = int(arrays["t_sub"])
         self._all_changed = True
@@ -288,17 +352,19 @@ class Network:
         the plastic projections the kernels marked (LTP, LTD), or all of ``dense_w`` after a load. Lets a
         checkpoint rewrite only those (``persistence/checkpoint.py``); the call starts a new interval.
 
-        The arrays the network never writes after its build (:meth:`_fixed`) are reported too, whole after a
-        load and with no range since: a checkpoint then keeps them in its arrays file, written once per
-        process, instead of in every pickle (4.1 of the full network's 9.2 MB)."""
+        With sparse learning rules, their weights (``sp_w``) are reported whole every time. The arrays the network
+        never writes after its build (:meth:`_fixed`) are reported too, whole after a load and with no range
+        since: a checkpoint then keeps them in its arrays file, written once per process, instead of in every
+        pickle (4.1 of the full network's 9.2 MB)."""
         fixed = [a for a in self._fixed() if a.size]
         np.bitwise_or(self._stats_dirty, self.pl_dirty, out=self._stats_dirty)
         if self._all_changed:
             self._all_changed = False
             self.pl_dirty[:] = 0
             whole = np.zeros(1, np.int64)
-            return [(self.dense_w, whole, self.dense_w.size), *((a, whole, a.size) for a in fixed)]
-        out = []
+            learned = [(self.sp_w, whole, self.sp_w.size)] if len(self.sl.sr_i) else []
+            return [(self.dense_w, whole, self.dense_w.size), *learned, *((a, whole, a.size) for a in fixed)]
+        out = [(self.sp_w, np.zeros(1, np.int64), self.sp_w.size)] if len(self.sl.sr_i) else []
         for r, d in enumerate(self.pl_i[:, 0]):
             n_pre, n_post, w_off = (int(x) for x in self.de_i[d, [1, 3, 4]])
             rows = np.flatnonzero(self.pl_dirty[r, :n_pre])
@@ -310,7 +376,7 @@ class Network:
     def _fixed(self) -> list[np.ndarray]:
         """The arrays no kernel or method writes once the network is built: the sparse projections' tables
         (the network's and the topology's own) and the resting potentials."""
-        arrays = [self.sp_ptr, self.sp_post, self.sp_w, self.el]
+        arrays = [self.sp_ptr, self.sp_post, self.el] + ([] if len(self.sl.sr_i) else [self.sp_w])
         for s in self.topo.sparse:
             arrays += [s.ptr, s.post, s.w]
         return arrays
@@ -342,6 +408,8 @@ class Network:
         self.__dict__.update(state)
         if "w" not in state:  # pickled before adex_cond (no adaptation currents)
             self.w = np.zeros_like(self._ref)
+        if "sl" not in state:  # pickled before sparse learning rules existed
+            self.sl = learning.empty()
         if "_stats_dirty" not in state:  # pickled by earlier code
             self._stats_dirty, self._stats_cache = np.zeros_like(self.pl_dirty), {}
         if stale:
@@ -349,7 +417,34 @@ class Network:
         self.arrays = self._kernel_arrays()
         self._state = kernels.kernel_state(self.arrays)
 
+    def _state_array(self, key: str) -> np.ndarray:
+        return getattr(self.sl, key[3:]) if key.startswith("sl_") else getattr(self, key)
+
     # ------------------------------------------------------------------ access
+    @property
+    def built_synapses(self) -> dict[str, int]:
+        """Synapses built per projection (differs from the declared count only for random connectors)."""
+        return dict(self.topo.built)
+
+    @property
+    def pairing_lost(self) -> int:
+        """Spikes the pairing rules' histories dropped while still inside their kernel window."""
+        return int(self.sl.lost.sum())
+
+    def sparse_weights(self, projection: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(pre, post, weight) of every synapse of a sparse projection (local indices; a view of nothing: copies)."""
+        pre, post, w = [], [], []
+        base = np.concatenate([[0], np.cumsum([len(s.post) for s in self.topo.sparse])])
+        for k, s in enumerate(self.topo.sparse):
+            if s.name != projection:
+                continue
+            pre.append(np.repeat(np.arange(s.n_pre), np.diff(s.ptr)))
+            post.append(s.post - self.index(self.cfg.projections[projection].post).start)
+            w.append(self.sp_w[base[k] : base[k + 1]].copy())
+        if not pre:
+            raise KeyError(f"{projection!r} is not a sparse projection")
+        return np.concatenate(pre), np.concatenate(post), np.concatenate(w)
+
     def index(self, pop: str) -> slice:
         return self.topo.slice(pop)
 

@@ -13,8 +13,10 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, model_validator
 
+from cerebx.registry import Plugin
 from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
 from cerebx.schema.controller import GivenRanges, TaskRanges
+from cerebx.snn.connectors import Distribution, FromFile
 
 
 class Integration(Strict):
@@ -168,7 +170,8 @@ class JointCombinations(Strict):
     fibers_per_signal: int = Field(gt=0)
 
 
-Rule = Annotated[AllToAll | OneToOne | JointCombinations, Field(discriminator="kind")]
+Rule = Plugin("connector")
+"""Any registered connector kind (``registry.connectors``): the three above and those of snn/connectors.py."""
 
 
 class KernelSTDP(Strict):
@@ -202,15 +205,19 @@ class Projection(Strict):
 
     pre: str
     post: str
-    rule: Rule
+    rule: Rule = Field(description="connection rule (a registered connector kind)")
     receptor: Literal["ampa", "nmda", "gaba"]
     synapses: int = Field(gt=0, description="declared synapse count; must match the rule")
-    weight_nS: NonNegFloat = Field(description="initial weight")
+    weight_nS: NonNegFloat | Distribution = Field(
+        description="initial weight: a constant, or a distribution ({dist: normal, mean, std} ...) drawn per "
+        "synapse and clipped to weight_range_nS (else to >= 0)")
     weight_range_nS: tuple[NonNegFloat, NonNegFloat] | None = Field(
         None, description="[min, max] for plastic synapses"
     )
-    delay_ms: PositiveFloat = Field(1.0, description="synaptic delay")
-    plasticity: KernelSTDP | None = None
+    delay_ms: PositiveFloat | Distribution = Field(
+        1.0, description="synaptic delay: a constant (a multiple of dt_ms), or a distribution drawn per synapse, "
+        "rounded to whole steps of dt_ms, at least one step")
+    plasticity: Plugin("plasticity") | None = Field(None, description="learning rule (a registered kind)")
     teaching: bool = Field(False, description="carries a teaching signal only (no current)")
 
     @model_validator(mode="after")
@@ -219,7 +226,7 @@ class Projection(Strict):
             lo, hi = self.weight_range_nS
             if lo > hi:
                 raise ValueError(f"weight_range_nS min ({lo}) is greater than max ({hi})")
-            if not lo <= self.weight_nS <= hi:
+            if isinstance(self.weight_nS, float) and not lo <= self.weight_nS <= hi:
                 raise ValueError(f"initial weight_nS ({self.weight_nS}) is outside weight_range_nS {[lo, hi]}")
         if self.plasticity is not None and self.weight_range_nS is None:
             raise ValueError("a plastic projection needs weight_range_nS")
@@ -259,13 +266,19 @@ class NetworkConfig(Strict):
                 problems.append(f"{where}: unknown population {', '.join(map(repr, missing))}")
                 continue
             n_pre, n_post = pops[p.pre].size, pops[p.post].size
-            expected = _rule_count(p.rule, n_pre, n_post, where, problems)
-            if expected is not None and expected != p.synapses:
+            expected = _rule_count(p.rule, n_pre, n_post, where, problems, p.pre == p.post)
+            if isinstance(expected, tuple):
+                mean, bound = expected
+                if abs(p.synapses - mean) > bound:
+                    problems.append(
+                        f"{where}.synapses: declared {p.synapses:,} but rule {p.rule.kind} gives "
+                        f"{mean:,.1f} ± {bound:,.1f} (5 sigma) for {n_pre:,} {p.pre} -> {n_post:,} {p.post}")
+            elif expected is not None and expected != p.synapses:
                 problems.append(
                     f"{where}.synapses: declared {p.synapses:,} but rule {p.rule.kind} gives "
                     f"{expected:,} for {n_pre:,} {p.pre} -> {n_post:,} {p.post}"
                 )
-            if abs(p.delay_ms / self.dt_ms - round(p.delay_ms / self.dt_ms)) > 1e-9:
+            if isinstance(p.delay_ms, float) and abs(p.delay_ms / self.dt_ms - round(p.delay_ms / self.dt_ms)) > 1e-9:
                 problems.append(f"{where}.delay_ms: {p.delay_ms} is not a multiple of dt_ms {self.dt_ms}")
             if p.plasticity is not None:
                 problems += _plasticity_problems(where, p, self.projections)
@@ -318,11 +331,17 @@ class NetworkConfig(Strict):
 
 
 def _plasticity_problems(where: str, p: Projection, projections: dict[str, Projection]) -> list[str]:
-    """What the network engine refuses of a plastic projection (``snn/topology.py``): it learns on a dense
-    (all_to_all, current-carrying) projection, taught by a sparse one that targets the same population."""
+    """What the network engine refuses of a plastic projection (``snn/topology.py``). ``kernel_stdp`` learns on a
+    dense (all_to_all, current-carrying, constant delay and weight) projection, taught by a sparse one that targets
+    the same population; every other rule runs on any current-carrying projection (built sparse), its teacher (if
+    any) targeting the same population."""
+    if not isinstance(p.plasticity, KernelSTDP):
+        return _sparse_rule_problems(where, p, projections)
     out = []
     if not isinstance(p.rule, AllToAll):
         out.append(f"{where}: plasticity is supported on all_to_all projections only")
+    elif not isinstance(p.delay_ms, float):
+        out.append(f"{where}.delay_ms: kernel_stdp needs one delay (a constant delay_ms)")
     elif p.teaching:
         out.append(f"{where}: plasticity is supported on all_to_all projections only, not on a teaching one")
     name = p.plasticity.teacher  # type: ignore[union-attr]
@@ -334,10 +353,41 @@ def _plasticity_problems(where: str, p: Projection, projections: dict[str, Proje
     elif isinstance(teacher.rule, AllToAll) and not teacher.teaching:
         out.append(f"{where}.plasticity.teacher: {name!r} must be a one_to_one or joint_combinations projection "
                    "(or a teaching one)")
+    elif not isinstance(teacher.delay_ms, float):
+        out.append(f"{where}.plasticity.teacher: {name!r} must have one delay (a constant delay_ms)")
     return out
 
 
-def _rule_count(rule, n_pre: int, n_post: int, where: str, problems: list[str]) -> int | None:
+def _sparse_rule_problems(where: str, p: Projection, projections: dict[str, Projection]) -> list[str]:
+    out = []
+    if p.teaching:
+        out.append(f"{where}.plasticity: a teaching projection carries no current to learn (teaching: false)")
+    if p.weight_range_nS is not None and p.weight_range_nS[1] <= 0:
+        out.append(f"{where}.weight_range_nS: a plastic projection needs an upper weight bound above 0")
+    name = getattr(p.plasticity, "teacher", None)
+    if name is not None:
+        teacher = projections.get(name)
+        if teacher is None:
+            out.append(f"{where}.plasticity.teacher: unknown projection {name!r}")
+        elif teacher.post != p.post:
+            out.append(f"{where}.plasticity.teacher: {name!r} targets {teacher.post!r}, not {p.post!r}")
+        elif isinstance(teacher.plasticity, KernelSTDP):
+            out.append(f"{where}.plasticity.teacher: {name!r} learns with kernel_stdp on a dense block, which "
+                       "cannot teach a sparse rule")
+    return out
+
+
+def _rule_count(rule, n_pre: int, n_post: int, where: str, problems: list[str],
+                same: bool = False) -> int | tuple[float, float] | None:
+    """The synapse count of ``rule``: exact (int), (expectation, tolerance) for a random rule, None (a problem
+    was appended) when the rule cannot connect these sizes."""
+    if hasattr(rule, "synapse_count"):
+        try:
+            mean, bound = rule.synapse_count(n_pre, n_post, same)
+        except ValueError as err:
+            problems.append(f"{where}.rule.{err}" if isinstance(rule, FromFile) else f"{where}.rule: {err}")
+            return None
+        return int(round(mean)) if bound == 0 else (mean, bound)
     if isinstance(rule, AllToAll):
         return n_pre * n_post
     if isinstance(rule, OneToOne):
@@ -345,6 +395,9 @@ def _rule_count(rule, n_pre: int, n_post: int, where: str, problems: list[str]) 
             problems.append(f"{where}.rule: one_to_one needs equal sizes, got {n_pre} -> {n_post}")
             return None
         return n_pre
+    if not isinstance(rule, JointCombinations):
+        problems.append(f"{where}.rule: connector kind {rule.kind!r} has no synapse_count (its plugin must give one)")
+        return None
     r: JointCombinations = rule
     want_pre = r.joints * r.signals * r.fibers_per_signal
     want_post = r.joints * r.fibers_per_signal**r.signals

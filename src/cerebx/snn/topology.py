@@ -13,7 +13,19 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.polynomial import Polynomial as Pn
 
-from cerebx.snn.schema import AdExNeuron, AllToAll, Integration, JointCombinations, LIFNeuron, NetworkConfig, OneToOne
+from cerebx import registry
+from cerebx.snn.connectors import Synapses, projection_rng
+from cerebx.snn.plasticity import PairingSpec, TraceSpec
+from cerebx.snn.schema import (
+    AdExNeuron,
+    AllToAll,
+    Integration,
+    JointCombinations,
+    KernelSTDP,
+    LIFNeuron,
+    NetworkConfig,
+    OneToOne,
+)
 
 RECEPTORS = {"ampa": 0, "nmda": 1, "gaba": 2}
 
@@ -177,6 +189,21 @@ class PlasticRule:
 
 
 @dataclass
+class SparseRule:
+    """A learning rule on one piece (one delay) of a sparse projection (:mod:`cerebx.snn.plasticity`)."""
+
+    proj: str
+    piece: int  # index of the SparseProj
+    teachers: tuple[int, int]  # SparseProj index range of the teaching projection's pieces; (-1, -1): post spikes
+    spec: TraceSpec | PairingSpec
+    w_lo: float
+    w_hi: float
+    csc_ptr: np.ndarray  # int64 [n_post + 1]: the piece's synapses by post neuron (local)
+    csc_q: np.ndarray  # int64: synapse index within the piece
+    csc_j: np.ndarray  # int64: its presynaptic (local) index
+
+
+@dataclass
 class Topology:
     cfg: NetworkConfig
     n_sub: int  # integration substeps per 2 ms control step
@@ -194,6 +221,9 @@ class Topology:
     plastic: list[PlasticRule]
     max_delay: int
     index: dict[str, int] = field(default_factory=dict)
+    sparse_rules: list[SparseRule] = field(default_factory=list)
+    built: dict[str, int] = field(default_factory=dict)  # synapses built per projection
+    dense_init: dict[str, np.ndarray] = field(default_factory=dict)  # drawn initial weights of dense blocks
 
     @property
     def n_neurons(self) -> int:
@@ -241,18 +271,82 @@ def _pairs(rule, n_pre: int, n_post: int) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(pres), np.concatenate(posts)
 
 
+def all_to_all(rule: AllToAll, n_pre: int, n_post: int, same: bool, rng: np.random.Generator) -> Synapses:
+    return Synapses(np.repeat(np.arange(n_pre), n_post), np.tile(np.arange(n_post), n_pre))
+
+
+def one_to_one(rule: OneToOne, n_pre: int, n_post: int, same: bool, rng: np.random.Generator) -> Synapses:
+    return Synapses(*_pairs(rule, n_pre, n_post))
+
+
+def joint_combinations(rule: JointCombinations, n_pre: int, n_post: int, same: bool,
+                       rng: np.random.Generator) -> Synapses:
+    return Synapses(*_pairs(rule, n_pre, n_post))
+
+
+def kernel_stdp(rule: KernelSTDP, dt_ms: float) -> KernelSTDP:
+    """The PF–PC rule runs on its own dense path (:class:`PlasticRule`): its builder hands it back."""
+    return rule
+
+
+def _weights(p, n: int, rng: np.random.Generator, given: np.ndarray | None) -> np.ndarray:
+    """float32 initial weights of ``n`` synapses of projection ``p``: listed, drawn (clipped to the weight range,
+    else to >= 0) or constant."""
+    if given is not None:
+        w = given
+    elif isinstance(p.weight_nS, float):
+        return np.full(n, p.weight_nS, dtype=np.float32)
+    else:
+        w = p.weight_nS.draw(rng, n)
+    lo, hi = p.weight_range_nS if p.weight_range_nS is not None else (0.0, np.inf)
+    return np.clip(w, lo, hi).astype(np.float32)
+
+
+def _delays(p, n: int, dt: float, rng: np.random.Generator, given: np.ndarray | None) -> np.ndarray:
+    """Per-synapse delays in steps of dt (rounded, at least one step)."""
+    if given is None and isinstance(p.delay_ms, float):
+        return np.full(n, int(round(p.delay_ms / dt)), dtype=np.int64)
+    d = given if given is not None else p.delay_ms.draw(rng, n)
+    return np.maximum(np.round(np.asarray(d) / dt), 1).astype(np.int64)
+
+
+def _csr(name: str, pre_l, post_l, w, n_pre: int, pre_lo: int, post_lo: int, rec: int, delay: int,
+         teaching: bool) -> SparseProj:
+    order = np.argsort(pre_l, kind="stable")
+    pre_l, post_l = pre_l[order], post_l[order]
+    ptr = np.zeros(n_pre + 1, dtype=np.int64)
+    np.cumsum(np.bincount(pre_l, minlength=n_pre), out=ptr[1:])
+    return SparseProj(name, pre_lo, n_pre, ptr, (post_l + post_lo).astype(np.int32), w[order], rec, delay, teaching)
+
+
+def _csc(s: SparseProj, post_lo: int, n_post: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A piece's synapses grouped by post neuron: (pointers, synapse indices, pre indices)."""
+    post_l = s.post.astype(np.int64) - post_lo
+    pre_l = np.repeat(np.arange(s.n_pre), np.diff(s.ptr))
+    order = np.argsort(post_l, kind="stable")
+    ptr = np.zeros(n_post + 1, dtype=np.int64)
+    np.cumsum(np.bincount(post_l, minlength=n_post), out=ptr[1:])
+    return ptr, order.astype(np.int64), pre_l[order]
+
+
 def fill_dense(topo: Topology) -> None:
     """Write the dense blocks' initial weights (``weight_nS``) into ``topo.dense_w``. On the full network that
     is the first touch of ~145 MB, 50-350 ms on a VM whose page faults are slow; numpy lets go of the
     interpreter lock meanwhile, so :class:`~cerebx.snn.network.Network` runs it beside its own set-up."""
     for d in topo.dense:
-        topo.dense_w[d.w_off : d.w_off + d.n_pre * d.n_post] = topo.cfg.projections[d.name].weight_nS
+        drawn = topo.dense_init.get(d.name)
+        w = topo.cfg.projections[d.name].weight_nS if drawn is None else drawn
+        topo.dense_w[d.w_off : d.w_off + d.n_pre * d.n_post] = w
 
 
-def build_topology(cfg: NetworkConfig, fill: bool = True) -> Topology:
-    """``cfg`` flattened; without ``fill`` the dense weights are left unwritten (:func:`fill_dense` writes
-    them)."""
-    """Lay out populations and build every projection (a few seconds for the full network)."""
+def build_topology(cfg: NetworkConfig, fill: bool = True, seed: int = 0) -> Topology:
+    """Lay out populations and build every projection (a few seconds for the full network): ``cfg`` flattened;
+    without ``fill`` the dense weights are left unwritten (:func:`fill_dense` writes them). Random connectors,
+    weights and delays of projection P draw from :func:`~cerebx.snn.connectors.projection_rng` (seed, P).
+
+    A projection is a dense block when it is all_to_all, carries current, has one delay and a dense rule (none or
+    kernel_stdp) and teaches no sparse rule; every other one is CSR, split into one SparseProj per distinct delay
+    (its pieces, consecutive in ``sparse``), so the kernels deliver each piece with one delay."""
     dt = cfg.dt_ms
     n_sub = int(round(2.0 / dt))
     names = list(cfg.populations)
@@ -320,36 +414,43 @@ def build_topology(cfg: NetworkConfig, fill: bool = True) -> Topology:
 
     sparse: list[SparseProj] = []
     dense: list[DenseProj] = []
+    pieces: dict[str, tuple[int, int]] = {}
+    built: dict[str, int] = {}
+    dense_init: dict[str, np.ndarray] = {}
+    sparse_rule = {n for n, p in cfg.projections.items()
+                   if p.plasticity is not None and not isinstance(p.plasticity, KernelSTDP)}
+    teachers = {getattr(cfg.projections[n].plasticity, "teacher", None) for n in sparse_rule}
     w_off = 0
     for name, p in cfg.projections.items():
         a, b = index[p.pre], index[p.post]
         n_pre, n_post = int(sizes[a]), int(sizes[b])
-        delay = int(round(p.delay_ms / dt))
         rec = RECEPTORS[p.receptor]
-        if isinstance(p.rule, AllToAll) and not p.teaching:
+        rng = projection_rng(seed, name)
+        if (isinstance(p.rule, AllToAll) and not p.teaching and isinstance(p.delay_ms, float)
+                and name not in sparse_rule and name not in teachers):
+            delay = int(round(p.delay_ms / dt))
             d = DenseProj(name, int(lo[a]), n_pre, int(lo[b]), n_post, w_off, rec, delay, -1)
             dense.append(d)
+            if not isinstance(p.weight_nS, float):
+                dense_init[name] = _weights(p, n_pre * n_post, rng, None)
             w_off += n_pre * n_post
+            built[name] = n_pre * n_post
             continue
-        if isinstance(p.rule, AllToAll):
-            pre_l = np.repeat(np.arange(n_pre), n_post)
-            post_l = np.tile(np.arange(n_post), n_pre)
-        else:
-            pre_l, post_l = _pairs(p.rule, n_pre, n_post)
-        order = np.argsort(pre_l, kind="stable")
-        pre_l, post_l = pre_l[order], post_l[order]
-        ptr = np.zeros(n_pre + 1, dtype=np.int64)
-        np.cumsum(np.bincount(pre_l, minlength=n_pre), out=ptr[1:])
-        sparse.append(
-            SparseProj(
-                name, int(lo[a]), n_pre, ptr, (post_l + lo[b]).astype(np.int32),
-                np.full(len(post_l), p.weight_nS, dtype=np.float32), rec, delay, p.teaching,
-            )
-        )
+        syn = registry.connectors[p.rule.kind].resolve()(p.rule, n_pre, n_post, p.pre == p.post, rng)
+        pre_l, post_l = np.asarray(syn.pre, dtype=np.int64), np.asarray(syn.post, dtype=np.int64)
+        w = _weights(p, len(pre_l), rng, syn.weight_nS)
+        steps = _delays(p, len(pre_l), dt, rng, syn.delay_ms)
+        built[name] = len(pre_l)
+        first = len(sparse)
+        for delay in np.unique(steps) if len(steps) else [int(round(1.0 / dt))]:
+            keep = steps == delay
+            sparse.append(_csr(name, pre_l[keep], post_l[keep], w[keep], n_pre, int(lo[a]), int(lo[b]), rec,
+                               int(delay), p.teaching))
+        pieces[name] = (first, len(sparse))
 
     dense_w = np.empty(w_off, dtype=np.float32)
 
-    sparse_index = {s.name: i for i, s in enumerate(sparse)}
+    sparse_index = {n: i for n, (i, _) in pieces.items()}
     plastic: list[PlasticRule] = []
     for di, d in enumerate(dense):
         p = cfg.projections[d.name]
@@ -368,12 +469,28 @@ def build_topology(cfg: NetworkConfig, fill: bool = True) -> Topology:
             )
         )
     for name, p in cfg.projections.items():
-        if p.plasticity is not None and name not in {d.name for d in dense}:
+        if isinstance(p.plasticity, KernelSTDP) and name not in {d.name for d in dense}:
             raise ValueError(f"projections.{name}: plasticity is supported on all_to_all projections only")
+
+    sparse_rules: list[SparseRule] = []
+    for name, p in cfg.projections.items():
+        if name not in sparse_rule:
+            continue
+        spec = registry.plasticity_rules[p.plasticity.kind].resolve()(p.plasticity, dt)
+        if not isinstance(spec, (TraceSpec, PairingSpec)):
+            raise ValueError(f"projections.{name}.plasticity: the builder of kind {p.plasticity.kind!r} returned "
+                             f"{type(spec).__name__}, not a TraceSpec or PairingSpec")
+        teacher = getattr(spec, "teacher", None)
+        span = pieces[teacher] if teacher is not None else (-1, -1)
+        w_lo, w_hi = p.weight_range_nS
+        b = index[p.post]
+        for k in range(*pieces[name]):
+            ptr, q, j = _csc(sparse[k], int(lo[b]), int(sizes[b]))
+            sparse_rules.append(SparseRule(name, k, span, spec, w_lo, w_hi, ptr, q, j))
 
     max_delay = max([s.delay for s in sparse] + [d.delay for d in dense] + [1])
     topo = Topology(cfg, n_sub, dt, names, lo, hi, kind, par, ipar, poly, sparse, dense, dense_w, plastic,
-                    max_delay, index)
+                    max_delay, index, sparse_rules, built, dense_init)
     if fill:
         fill_dense(topo)
     return topo

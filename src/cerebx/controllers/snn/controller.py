@@ -169,7 +169,8 @@ class SNNControllerImpl(Controller):
         self.pipeline = cfg.pipeline and slack >= 2
         self._in_flight = 0  # chunks handed to the network thread and not yet collected (at most 2)
         self._thread: NetworkThread | None = None
-        self.net = Network(self.net_cfg, parallel=cfg.parallel and not self.pipeline)
+        seed = getattr(getattr(ctx, "cfg", None), "seed", 0)  # random connectors draw from the run's seed
+        self.net = Network(self.net_cfg, parallel=cfg.parallel and not self.pipeline, seed=seed)
         self.net.learn = cfg.plasticity
         io = self.net_cfg.io
         self.sl_mf, self.sl_cf, self.sl_dcn = (self.net.index(p) for p in (io.mossy, io.climbing, io.output))
@@ -529,7 +530,14 @@ class SNNControllerImpl(Controller):
             "cf_pathway_delay_steps": self.k_cf,
             "fingerprint": self.fingerprint,
             "integrators": self.net.integrators(),
+            **self._built(),
         }
+
+    def _built(self) -> dict[str, Any]:
+        """The synapses built per projection, where a random connector made another count than declared."""
+        declared = {k: p.synapses for k, p in self.net_cfg.projections.items()}
+        built = self.net.built_synapses
+        return {"built_synapses": built} if built != declared else {}
 
     # ------------------------------------------------------------------ state
     def save_state(self, path: Path) -> bool:

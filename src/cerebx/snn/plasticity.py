@@ -1,0 +1,112 @@
+"""Learning rules of sparse (CSR) projections (docs/models.md#plasticity) and the two rule families the engine
+runs on them.
+
+A plasticity kind is registered (``registry.plasticity_rules``) with a builder ``builder(rule, dt_ms) -> spec``
+that turns its parameters into one of the engine's families, so a plugin's rule runs in the compiled kernels
+without code of its own in them:
+
+- :class:`TraceSpec`: pair-based STDP with all-to-all pairing through exponential traces, NEST
+  ``stdp_synapse``'s update (multiplicative with exponents mu_plus, mu_minus; additive at 0).
+- :class:`PairingSpec`: a per-pre-spike increment plus two kernel tables over the age of the partner's
+  spikes (a teaching projection's arrivals at the post neuron, or the post neuron's own spikes): at a pre
+  arrival Δw = fixed + Σ k_pre(t − t_partner), at a partner event Δw = Σ k_post(t − t_pre). EDLUT's
+  symmetric-cosine rules (MF–DCN, PC–DCN) are of this form; a kernel with a bounded window is exact.
+
+The PF–PC rule (:class:`~cerebx.snn.schema.KernelSTDP`) keeps its own dense path. Only numpy is used here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from pydantic import Field
+
+from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
+
+HISTORY_MAX = 64
+"""Spikes kept per neuron for a pairing rule: enough for a window of 64 spikes (e.g. 100 ms at 640 Hz); older
+spikes still inside the window are dropped and counted (``Network.pairing_lost``)."""
+
+
+@dataclass(frozen=True)
+class TraceSpec:
+    """Pair STDP with traces (NEST ``stdp_synapse``). At a post spike: w/W += lam (1 − w/W)^mu_plus · x_pre;
+    at a pre arrival: w/W −= alpha · lam (w/W)^mu_minus · y_post; x_pre (y_post) decays with tau_plus_ms
+    (tau_minus_ms) and jumps by 1 at each pre arrival (post spike). W: the projection's upper weight bound."""
+
+    lam: float
+    alpha: float
+    mu_plus: float
+    mu_minus: float
+    tau_plus_ms: float
+    tau_minus_ms: float
+
+
+@dataclass(frozen=True)
+class PairingSpec:
+    """Kernel pairing. ``k_pre[m]``: added (nS) at a pre arrival per partner event m steps of dt earlier (m = 0:
+    the same step); ``k_post[m]``: added at a partner event per pre arrival m steps earlier (m >= 1: a same-step
+    pair counts once, at the pre arrival). ``teacher``: the projection whose arrivals at the post neuron are the
+    partner events, or None for the post neuron's own spikes."""
+
+    fixed_nS: float
+    k_pre: np.ndarray
+    k_post: np.ndarray
+    teacher: str | None
+
+
+class PairSTDP(Strict):
+    """Pair-based STDP, NEST ``stdp_synapse`` (Gütig et al. 2003 form; docs/models.md#pair-stdp): all-to-all
+    pairing through a presynaptic trace (tau_plus) and a postsynaptic one (tau_minus, in NEST a parameter of the
+    post neuron). Weights bounded by the projection's ``weight_range_nS`` (W = its upper end)."""
+
+    kind: Literal["pair_stdp"] = "pair_stdp"
+    lam: PositiveFloat = Field(0.01, description="NEST lambda: step size of potentiation")
+    alpha: NonNegFloat = Field(1.0, description="depression / potentiation ratio")
+    mu_plus: NonNegFloat = Field(1.0, description="weight dependence exponent of potentiation (0: additive)")
+    mu_minus: NonNegFloat = Field(1.0, description="weight dependence exponent of depression (0: additive)")
+    tau_plus_ms: PositiveFloat = Field(20.0, description="presynaptic trace time constant")
+    tau_minus_ms: PositiveFloat = Field(20.0, description="postsynaptic trace time constant (NEST: the neuron's)")
+
+
+class SymmetricCos(Strict):
+    """MF–DCN rule of the distributed-plasticity models (docs/models.md#symmetric-cos): a fixed change per pre
+    spike, and a change scaled by a symmetric cosine kernel of the time to each teaching spike (PC spikes
+    arriving at the DCN): EDLUT SimetricCosAdditiveKernel, NEST stdp_cos_synapse."""
+
+    kind: Literal["symmetric_cos"] = "symmetric_cos"
+    fixed_nS: float = Field(0.001, description="change at each pre spike (EDLUT fixed_change; > 0: LTP)")
+    kernel_nS: float = Field(-0.010, description="scale of the kernel term (EDLUT kernel_change; < 0: LTD)")
+    tau_ms: PositiveFloat = Field(100.0, description="kernel half-width: k = 0 at |Δ| >= tau")
+    n: NonNegFloat = Field(2.0, description="exponential sharpening of the kernel")
+    teacher: str = Field(description="projection whose arrivals at the post neuron pair with the pre spikes")
+
+
+class SymmetricCosSTDP(Strict):
+    """PC–DCN rule of the distributed-plasticity models (docs/models.md#symmetric-cos): as ``symmetric_cos``
+    with the post neuron's own spikes as the partner (EDLUT SimetricCosSTDPAdditiveKernel)."""
+
+    kind: Literal["symmetric_cos_stdp"] = "symmetric_cos_stdp"
+    fixed_nS: float = Field(0.001, description="change at each pre spike (EDLUT fixed_change)")
+    kernel_nS: float = Field(-0.010, description="scale of the kernel term (EDLUT kernel_change)")
+    tau_ms: PositiveFloat = Field(100.0, description="kernel half-width: k = 0 at |Δ| >= tau")
+    n: NonNegFloat = Field(2.0, description="exponential sharpening of the kernel")
+
+
+def cos_kernel(tau_ms: float, n: float, dt_ms: float) -> np.ndarray:
+    """k(Δ) = exp(−n|Δ|/τ) cos²(π|Δ|/(2τ)) for |Δ| < τ (0 beyond), sampled at Δ = m dt."""
+    d = np.arange(int(np.ceil(tau_ms / dt_ms))) * dt_ms
+    return np.where(d < tau_ms, np.exp(-n * d / tau_ms) * np.cos(np.pi * d / (2 * tau_ms)) ** 2, 0.0)
+
+
+def pair_stdp(rule: PairSTDP, dt_ms: float) -> TraceSpec:
+    return TraceSpec(rule.lam, rule.alpha, rule.mu_plus, rule.mu_minus, rule.tau_plus_ms, rule.tau_minus_ms)
+
+
+def symmetric_cos(rule: SymmetricCos | SymmetricCosSTDP, dt_ms: float) -> PairingSpec:
+    k = rule.kernel_nS * cos_kernel(rule.tau_ms, rule.n, dt_ms)
+    k_post = k.copy()
+    k_post[0] = 0.0  # a same-step pair is counted at the pre arrival
+    return PairingSpec(rule.fixed_nS, k, k_post, getattr(rule, "teacher", None))
