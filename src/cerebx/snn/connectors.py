@@ -31,7 +31,17 @@ CHUNK = 1 << 22  # random numbers drawn at a time by the dense draws (memory bou
 @dataclass(frozen=True)
 class Synapses:
     """Drawn synapses, local indices (pre, post), with per-synapse weight (nS) and delay (ms) when the rule
-    gives them (``from_file``), else None."""
+    gives them (``from_file``), else None.
+
+    Attributes
+    ----------
+    pre, post : numpy.ndarray
+        Presynaptic and postsynaptic neuron of each synapse, indices within their populations.
+    weight_nS : numpy.ndarray or None
+        Each synapse's initial weight (nS); None: the projection's ``weight_nS``.
+    delay_ms : numpy.ndarray or None
+        Each synapse's delay (ms); None: the projection's ``delay_ms``.
+    """
 
     pre: np.ndarray
     post: np.ndarray
@@ -40,7 +50,20 @@ class Synapses:
 
 
 def projection_rng(seed: int, projection: str) -> np.random.Generator:
-    """The generator of projection ``projection``: independent per projection, the same for the same seed."""
+    """The generator of projection ``projection``: independent per projection, the same for the same seed.
+
+    Parameters
+    ----------
+    seed : int
+        The run's seed (the network's).
+    projection : str
+        The projection's name in the network table.
+
+    Returns
+    -------
+    numpy.random.Generator
+        A generator that a connector or a weight/delay distribution draws from.
+    """
     return np.random.default_rng(np.random.SeedSequence([seed, zlib.crc32(f"network.{projection}".encode())]))
 
 

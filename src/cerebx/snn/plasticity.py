@@ -34,7 +34,19 @@ spikes still inside the window are dropped and counted (``Network.pairing_lost``
 class TraceSpec:
     """Pair STDP with traces (NEST ``stdp_synapse``). At a post spike: w/W += lam (1 − w/W)^mu_plus · x_pre;
     at a pre arrival: w/W −= alpha · lam (w/W)^mu_minus · y_post; x_pre (y_post) decays with tau_plus_ms
-    (tau_minus_ms) and jumps by 1 at each pre arrival (post spike). W: the projection's upper weight bound."""
+    (tau_minus_ms) and jumps by 1 at each pre arrival (post spike). W: the projection's upper weight bound.
+
+    Attributes
+    ----------
+    lam : float
+        Step size of potentiation (NEST ``lambda``).
+    alpha : float
+        Depression / potentiation ratio.
+    mu_plus, mu_minus : float
+        Weight-dependence exponents of potentiation and depression (0: additive, 1: multiplicative).
+    tau_plus_ms, tau_minus_ms : float
+        Time constants of the presynaptic and postsynaptic traces (ms).
+    """
 
     lam: float
     alpha: float
@@ -49,7 +61,19 @@ class PairingSpec:
     """Kernel pairing. ``k_pre[m]``: added (nS) at a pre arrival per partner event m steps of dt earlier (m = 0:
     the same step); ``k_post[m]``: added at a partner event per pre arrival m steps earlier (m >= 1: a same-step
     pair counts once, at the pre arrival). ``teacher``: the projection whose arrivals at the post neuron are the
-    partner events, or None for the post neuron's own spikes."""
+    partner events, or None for the post neuron's own spikes.
+
+    Attributes
+    ----------
+    fixed_nS : float
+        Change (nS) at every pre arrival, whatever the timing.
+    k_pre : numpy.ndarray
+        Change (nS) at a pre arrival per partner event m network steps earlier, m = 0, 1, ...
+    k_post : numpy.ndarray
+        Change (nS) at a partner event per pre arrival m network steps earlier (m >= 1).
+    teacher : str or None
+        The projection whose arrivals are the partner events; None: the post neuron's own spikes.
+    """
 
     fixed_nS: float
     k_pre: np.ndarray
