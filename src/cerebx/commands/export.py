@@ -24,7 +24,8 @@ def parser() -> Parser:
                     help="leave out what the target model lacks (e.g. NMDA receptors), each said in a note")
     ap.add_argument("--inputs-ms", type=float, default=0.0,
                     help="also store seeded input spike trains of this many ms (mossy box-coded, climbing 5 Hz)")
-    ap.add_argument("--seed", type=int, default=0, help="seed of the input spike trains")
+    ap.add_argument("--seed", type=int, default=0, help="the run's seed: it draws the random connectors, weights and "
+                    "delays (as `cerebx run seed=N` does) and the input spike trains")
     return ap
 
 
@@ -43,7 +44,7 @@ def main(args: list[str]) -> int:
     cfg = load_network(ns.network, ns.overrides)
     from cerebx.snn.topology import build_topology
 
-    topo = build_topology(cfg)
+    topo = build_topology(cfg, seed=ns.seed)
     inputs = seeded_inputs(cfg, ns.inputs_ms, ns.seed) if ns.inputs_ms > 0 else None
     out = Path(ns.out)
     plan = export(cfg, out, to=to, static=ns.static, approximate=ns.approximate, inputs=inputs, topo=topo)

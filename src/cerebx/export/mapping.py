@@ -110,12 +110,22 @@ CONNECTORS: dict[str, str] = {
     "all_to_all": "all_to_all / AllToAllConnector (exported with cerebx's weight matrix)",
     "one_to_one": "one_to_one / OneToOneConnector (exported as the synapse list)",
     "joint_combinations": "no NEST rule (exported as the synapse list: one_to_one over arrays / FromListConnector)",
+    "fixed_indegree": "fixed_indegree / FixedNumberPreConnector (exported as the synapse list cerebx drew)",
+    "fixed_outdegree": "fixed_outdegree / FixedNumberPostConnector (exported as the synapse list cerebx drew)",
+    "fixed_probability": "pairwise_bernoulli / FixedProbabilityConnector (exported as the synapse list cerebx drew)",
+    "from_file": "one_to_one over arrays / FromListConnector (exported as the file's synapse list)",
 }
 """Connection-rule kind -> the equivalent NEST / PyNN rule (the export writes cerebx's built synapses either way)."""
 
 PLASTICITY: dict[str, PlasticityMap | Refused] = {
     "kernel_stdp": Refused("CF-gated kernel LTD with LTP per PF spike has no NEST synapse model "
                            "(stdp_dopamine_synapse only loosely approximates it)"),
+    "symmetric_cos": Refused("cerebx pairs the PF-side spike with a teaching projection's arrivals; NEST's "
+                             "stdp_cos_synapse pairs with the post neuron's own spikes (no cross-check yet)"),
+    "symmetric_cos_stdp": Refused("not yet mapped onto NEST's stdp_cos_synapse (delay convention and weight "
+                                  "bounds not yet cross-checked)"),
+    "pair_stdp": Refused("not yet mapped onto NEST's stdp_synapse: NEST treats the whole delay as dendritic "
+                         "(its Δt is cerebx's + 2 d); the mapping and its cross-check are the next step"),
 }
 """Plasticity kind -> its NEST synapse model (or why there is none)."""
 
@@ -243,6 +253,7 @@ def plan(cfg: NetworkConfig, static: bool = False, approximate: bool = False) ->
                     continue
             else:
                 synapse, syn_params = rule.nest_synapse, rule.nest_params(p.plasticity)
-        projs[name] = ProjectionPlan(p.pre, p.post, p.receptor, rec[1], rec[0], p.delay_ms, synapse, syn_params,
+        delay = p.delay_ms if isinstance(p.delay_ms, float) else float("nan")  # drawn: per synapse (writer.py)
+        projs[name] = ProjectionPlan(p.pre, p.post, p.receptor, rec[1], rec[0], delay, synapse, syn_params,
                                      p.rule.kind, plastic)
     return Plan(dt, pops, projs, dropped, notes, problems)

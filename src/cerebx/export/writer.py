@@ -32,17 +32,23 @@ MAX_SLICE_MS = 2.0
 
 def synapse_tables(topo: Topology, weights: dict[str, np.ndarray] | None = None) -> dict[str, dict[str, np.ndarray]]:
     """Every projection's synapses as built: ``{"w": [n_pre, n_post]}`` for an all-to-all one, else
-    ``{"pre", "post", "w"}`` (local indices, float32 nS). ``weights``: all-to-all matrices to use instead of
-    the initial ones (e.g. a trained network's)."""
+    ``{"pre", "post", "w", "d"}`` (local indices, float32 nS, each synapse's delay in ms: a projection whose delays
+    differ is built as one table per delay, joined here). ``weights``: all-to-all matrices to use instead of the
+    initial ones (e.g. a trained network's)."""
     out: dict[str, dict[str, np.ndarray]] = {}
     lo = dict(zip(topo.names, topo.lo.tolist()))
     for d in topo.dense:
         w = topo.dense_block(d) if weights is None or d.name not in weights else weights[d.name]
         out[d.name] = {"w": np.asarray(w, dtype=np.float32)}
+    pieces: dict[str, list[dict[str, np.ndarray]]] = {}
     for s in topo.sparse:
         post_pop = topo.cfg.projections[s.name].post
         pre = np.repeat(np.arange(s.n_pre, dtype=np.int32), np.diff(s.ptr))
-        out[s.name] = {"pre": pre, "post": (s.post - lo[post_pop]).astype(np.int32), "w": s.w.astype(np.float32)}
+        pieces.setdefault(s.name, []).append({
+            "pre": pre, "post": (s.post - lo[post_pop]).astype(np.int32), "w": s.w.astype(np.float32),
+            "d": np.full(len(pre), s.delay * topo.dt_ms, dtype=np.float64)})
+    for name, parts in pieces.items():
+        out[name] = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     return out
 
 
@@ -71,7 +77,10 @@ def export(cfg: NetworkConfig, out: Path, to: tuple[str, ...] = ("nest",), stati
         t = tables[name]
         for key, a in t.items():
             arrays[f"{key}/{name}"] = a
-        projections[name] = {**asdict(pp), "layout": "dense" if "pre" not in t else "list", "n": int(t["w"].size)}
+        delays = t["d"] if "d" in t else np.array([pp.delay_ms])
+        projections[name] = {**asdict(pp), "layout": "dense" if "pre" not in t else "list", "n": int(t["w"].size),
+                             "delay_ms": float(delays.min()) if delays.size else pp.delay_ms,
+                             "max_delay_ms": float(delays.max()) if delays.size else pp.delay_ms}
     inputs = inputs or {}
     for pop, (idx, times) in inputs.items():
         if pop not in p.populations or p.populations[pop].kind != "input":
@@ -101,6 +110,6 @@ def read_npz(path: Path) -> tuple[dict, dict[str, dict[str, np.ndarray]]]:
         tables: dict[str, dict[str, np.ndarray]] = {}
         for key in data.files:
             kind, _, name = key.partition("/")
-            if kind in ("w", "pre", "post"):
+            if kind in ("w", "pre", "post", "d"):
                 tables.setdefault(name, {})[kind] = data[key]
     return meta, tables

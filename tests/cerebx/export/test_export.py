@@ -139,3 +139,28 @@ def test_crosscheck_without_nest_is_one_line(monkeypatch, tmp_path, capsys):
                                                "or set CEREBX_NEST_PYTHON to a Python that has it")
     assert main(["crosscheck", "small", "--ms", "3"]) == 2
     assert "--ms: must be a positive multiple of 2" in capsys.readouterr().err
+
+
+def test_drawn_connectors_weights_and_delays_are_exported_as_drawn(tmp_path):
+    """A fixed in-degree projection with drawn weights and delays: the npz holds the seed's synapses, each with its
+    weight and its delay (the engine's pieces per delay joined), and another seed draws other synapses."""
+    d = network_dict(joints=1, fibers=2, per_joint=4)
+    d["projections"]["mf_dcn"].update(
+        rule={"kind": "fixed_indegree", "indegree": 3}, synapses=3 * d["populations"]["dcn"]["size"],
+        weight_nS={"dist": "uniform", "low": 0.1, "high": 0.9}, delay_ms={"dist": "uniform", "low": 0.5, "high": 3.0})
+    cfg = NetworkConfig.model_validate(d)
+    topo = build_topology(cfg, seed=7)
+    export(cfg, tmp_path, to=("nest", "pynn"), static=True, approximate=True, topo=topo)
+    meta, tables = read_npz(tmp_path / "network.npz")
+    t = tables["mf_dcn"]
+    pieces = [s for s in topo.sparse if s.name == "mf_dcn"]
+    assert len(pieces) > 1  # several delays: one CSR table per delay in the engine
+    assert len(t["w"]) == 3 * cfg.populations["dcn"].size == sum(len(s.w) for s in pieces)
+    assert np.bincount(t["post"]).tolist() == [3] * cfg.populations["dcn"].size
+    assert float(t["w"].sum(dtype=np.float64)) == pytest.approx(sum(float(s.w.sum(dtype=np.float64)) for s in pieces))
+    engine = sorted(x for s in pieces for x in [s.delay * topo.dt_ms] * len(s.w))
+    assert sorted(t["d"].tolist()) == engine
+    assert meta["projections"]["mf_dcn"]["delay_ms"] == min(engine)
+    assert meta["projections"]["mf_dcn"]["max_delay_ms"] == max(engine)
+    other = synapse_tables(build_topology(cfg, seed=8))["mf_dcn"]
+    assert not np.array_equal(np.sort(other["w"]), np.sort(t["w"]))

@@ -85,3 +85,25 @@ def test_the_thesis_purkinje_and_dcn_layer_fires_as_in_nest(tmp_path):
     for r in rows.values():
         assert abs(r.rate_diff) < 0.01 and r.count_corr > 0.9 and r.matched > 0.98, r
     assert rows["dcn"].output_corr > 0.9
+
+
+def test_nest_holds_drawn_connectors_weights_and_delays(tmp_path):
+    """A fixed in-degree projection with drawn weights and delays (seed 5): NEST holds its synapses with their
+    weights and their delays."""
+    from cerebx.snn.presets import network_dict
+    from cerebx.snn.schema import NetworkConfig
+
+    d = network_dict(joints=1, fibers=2, per_joint=4)
+    d["projections"]["mf_dcn"].update(
+        rule={"kind": "fixed_indegree", "indegree": 3}, synapses=3 * d["populations"]["dcn"]["size"],
+        weight_nS={"dist": "uniform", "low": 0.1, "high": 0.9}, delay_ms={"dist": "uniform", "low": 0.5, "high": 3.0})
+    cfg = NetworkConfig.model_validate(d)
+    topo = build_topology(cfg, seed=5)
+    export(cfg, tmp_path, to=("nest",), static=True, approximate=True, topo=topo)
+    proc = subprocess.run([PYTHON, str(tmp_path / "nest_network.py"), "--connections"], capture_output=True,
+                          text=True, check=True)
+    got = json.loads(proc.stdout.strip().splitlines()[-1])["mf_dcn"]
+    t = synapse_tables(topo)["mf_dcn"]
+    assert got["synapses"] == len(t["w"]) == 3 * cfg.populations["dcn"].size
+    assert got["weight_sum_nS"] == pytest.approx(float(t["w"].sum(dtype=np.float64)), rel=1e-6)
+    assert got["delay_sum_ms"] == pytest.approx(float(t["d"].sum()), rel=1e-9)

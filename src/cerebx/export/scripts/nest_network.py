@@ -60,7 +60,7 @@ def build(meta: dict, arrays: dict[str, np.ndarray], threads: int = 1) -> dict:
             src = arrays[f"pre/{name}"].astype(np.int64) + pre[0].global_id
             tgt = arrays[f"post/{name}"].astype(np.int64) + post[0].global_id
             nest.Connect(src, tgt, "one_to_one", {"synapse_model": syn, "weight": w,
-                                                  "delay": np.full(len(w), pr["delay_ms"])})
+                                                  "delay": arrays.get(f"d/{name}", np.full(len(w), pr["delay_ms"]))})
     nest.Simulate(off)
     return pops
 
@@ -101,12 +101,14 @@ def spikes(meta: dict, pops: dict, recs: dict) -> dict[str, np.ndarray]:
 
 
 def connections(meta: dict) -> dict[str, dict[str, float]]:
-    """Synapse count and weight sum (nS, cerebx's sign) of every projection, as NEST holds them."""
+    """Synapse count, weight sum (nS, cerebx's sign) and delay sum (ms) of every projection, as NEST holds them."""
     out = {}
     for name, pr in meta["projections"].items():
         conns = nest.GetConnections(synapse_model=f"cx_{name}")
         w = np.asarray(conns.get("weight"), dtype=np.float64).reshape(-1) if len(conns) else np.zeros(0)
-        out[name] = {"synapses": len(conns), "weight_sum_nS": float(w.sum()) * pr["sign"]}
+        d = np.asarray(conns.get("delay"), dtype=np.float64).reshape(-1) if len(conns) else np.zeros(0)
+        out[name] = {"synapses": len(conns), "weight_sum_nS": float(w.sum()) * pr["sign"],
+                     "delay_sum_ms": float(d.sum())}
     return out
 
 

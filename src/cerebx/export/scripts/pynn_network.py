@@ -32,8 +32,9 @@ def load(path: Path = HERE / "network.npz") -> tuple[dict, dict[str, np.ndarray]
 def build(sim, meta: dict, arrays: dict[str, np.ndarray]) -> dict:
     """Populations (each recording its spikes), input spike trains and projections; returns name -> Population."""
     res = meta["resolution_ms"]
-    delays = [p["delay_ms"] for p in meta["projections"].values()] or [res]
-    sim.setup(timestep=res, min_delay=min(delays), max_delay=max(delays))
+    lo = [p["delay_ms"] for p in meta["projections"].values()] or [res]
+    hi = [p.get("max_delay_ms", p["delay_ms"]) for p in meta["projections"].values()] or [res]
+    sim.setup(timestep=res, min_delay=min(lo), max_delay=max(hi))
     off = meta["t_offset_ms"]
     pops = {}
     for name, p in meta["populations"].items():
@@ -54,7 +55,8 @@ def build(sim, meta: dict, arrays: dict[str, np.ndarray]) -> dict:
         if pr["layout"] == "dense":
             conn, syn = sim.AllToAllConnector(), sim.StaticSynapse(weight=w, delay=pr["delay_ms"])
         else:
-            rows = np.column_stack([arrays[f"pre/{name}"], arrays[f"post/{name}"], w, np.full(len(w), pr["delay_ms"])])
+            d = arrays.get(f"d/{name}", np.full(len(w), pr["delay_ms"]))
+            rows = np.column_stack([arrays[f"pre/{name}"], arrays[f"post/{name}"], w, d])
             conn, syn = sim.FromListConnector(rows, column_names=["weight", "delay"]), sim.StaticSynapse()
         sim.Projection(pre, post, conn, syn, receptor_type=pr["pynn_receptor"], label=name)
     return pops
