@@ -213,3 +213,17 @@ class LinkBuilder(Protocol):
     """``link`` group: the transport of one side (``role``), through the delay relay or not."""
 
     def __call__(self, cfg: Any, role: Literal["brain", "robot"], via_relay: bool, /) -> Any: ...
+
+
+class ConnectorBuilder(Protocol):
+    """``connector`` group: a projection's synapses (``cerebx.snn.connectors.Synapses``, local indices) drawn from
+    its rule, the two populations' sizes, whether they are one population, and the projection's generator."""
+
+    def __call__(self, rule: Any, n_pre: int, n_post: int, same_population: bool, rng: Any, /) -> Any: ...
+
+
+class PlasticityBuilder(Protocol):
+    """``plasticity`` group: the engine form of a rule (``cerebx.snn.plasticity.TraceSpec`` or ``PairingSpec``)
+    at the network's step ``dt_ms``."""
+
+    def __call__(self, rule: Any, dt_ms: float, /) -> Any: ...

@@ -34,12 +34,14 @@ from cerebx.errors import CerebxError
 if TYPE_CHECKING:
     from cerebx.builders import (
         ClimbingEncoderBuilder,
+        ConnectorBuilder,
         ControllerBuilder,
         DelayBuilder,
         EventBuilder,
         LinkBuilder,
         MossyEncoderBuilder,
         PlantBuilder,
+        PlasticityBuilder,
         ReceiverBuilder,
         StageBuilder,
         TaskBuilder,
@@ -134,8 +136,8 @@ delays: Registry[DelayBuilder] = Registry("delay")
 events: Registry[EventBuilder] = Registry("event")
 encoders: Registry[MossyEncoderBuilder | ClimbingEncoderBuilder] = Registry("encoder")
 links: Registry[LinkBuilder] = Registry("link")
-connectors = Registry("connector")
-plasticity_rules = Registry("plasticity")
+connectors: Registry[ConnectorBuilder] = Registry("connector")
+plasticity_rules: Registry[PlasticityBuilder] = Registry("plasticity")
 
 GROUPS = {r.group: r for r in (tasks, plants, controllers, stages, delays, events, encoders, links, connectors,
                                plasticity_rules)}

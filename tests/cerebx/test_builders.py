@@ -19,6 +19,8 @@ PROTOCOLS = {
     "delay": builders.DelayBuilder,
     "event": builders.EventBuilder,
     "link": builders.LinkBuilder,
+    "connector": builders.ConnectorBuilder,
+    "plasticity": builders.PlasticityBuilder,
 }
 
 

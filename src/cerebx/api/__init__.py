@@ -33,7 +33,8 @@ from cerebx.api.schema import *  # noqa: F403 - the schema layer's names are par
 from cerebx.api.schema import __all__ as _schema_names
 
 RUNTIME = (
-    "BuildContext", "ClimbingEncoderBuilder", "ControllerBuilder", "DelayBuilder", "EventBuilder", "LinkBuilder",
+    "BuildContext", "ClimbingEncoderBuilder", "ConnectorBuilder", "ControllerBuilder", "DelayBuilder", "EventBuilder",
+    "LinkBuilder", "PlasticityBuilder",
     "MossyEncoderBuilder", "PlantBuilder", "PlantView", "ReceiverBuilder", "StageBuilder", "TaskBuilder", "TaskView",
     "LWPR", "ClimbingEncoder", "ControlInput", "Controller", "Frame", "MossyEncoder", "MujocoArm", "Plant",
     "PlantEvent", "Stage", "Task", "TorqueMsg", "TrialReference", "build_components", "channel_counts",
