@@ -141,12 +141,12 @@ CONNECTORS: dict[str, str] = {
 """Connection-rule kind -> the equivalent NEST / PyNN rule (the export writes cerebx's built synapses either way)."""
 
 PLASTICITY: dict[str, PlasticityMap | Refused] = {
-    "kernel_stdp": Refused("CF-gated kernel LTD with LTP per PF spike has no NEST synapse model "
+    "kernel_stdp": Refused("CF-gated kernel LTD with LTP per PF spike has no NEST 3.10 synapse model "
                            "(stdp_dopamine_synapse only loosely approximates it)"),
-    "symmetric_cos": Refused("cerebx pairs the PF-side spike with a teaching projection's arrivals; NEST's "
-                             "stdp_cos_synapse pairs with the post neuron's own spikes (no cross-check yet)"),
-    "symmetric_cos_stdp": Refused("not yet mapped onto NEST's stdp_cos_synapse (delay convention and weight "
-                                  "bounds not yet cross-checked)"),
+    "symmetric_cos": Refused("a cosine kernel over the times to a teaching projection's arrivals has no NEST 3.10 "
+                             "synapse model (stdp_cos_synapse belongs to an extension module, not to NEST)"),
+    "symmetric_cos_stdp": Refused("a cosine kernel over the times to the post neuron's spikes has no NEST 3.10 "
+                                  "synapse model (its STDP windows are exponential)"),
     "pair_stdp": PlasticityMap("stdp_synapse", "STDPMechanism(SpikePairRule, GutigWeightDependence)", _stdp_nest,
                                post_params=lambda rule: {"tau_minus": rule.tau_minus_ms}, check=_stdp_check),
 }

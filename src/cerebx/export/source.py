@@ -53,6 +53,11 @@ def _network_part(doc: Any) -> dict | None:
     return net if isinstance(net, dict) else None
 
 
+def validate_network(net: dict, where: str) -> NetworkConfig:
+    """``net`` validated; a problem is one line ``where: location: message``."""
+    return _validate(net, where)
+
+
 def _validate(net: dict, where: str) -> NetworkConfig:
     try:
         return NetworkConfig.model_validate(net)
