@@ -384,9 +384,11 @@ class Speed:
 def speed(cfg: NetworkConfig, out: Path, ms: float, seed: int = 0, python: str | None = None) -> list[Speed]:
     """cerebx in 2 ms ``step`` calls (the 500 Hz loop's pace) and in one ``step_packed`` call; NEST (the export in
     ``out``, written here) in ``Simulate(2.0)`` slices, in ``Run(2.0)`` slices inside one ``RunManager``, and in one
-    ``Simulate``. What NEST cannot express is left out of both, as in :func:`crosscheck`."""
+    ``Simulate``. What NEST cannot express is left out of both, as in :func:`crosscheck`, and plasticity is off in
+    both."""
     p = plan(cfg, static=True, approximate=True)
     cfg_run = without(cfg, [k for k in p.dropped if not cfg.projections[k].teaching]) if p.dropped else cfg
+    cfg_run = static_weights(cfg_run, [k for k, x in cfg_run.projections.items() if x.plasticity is not None])
     inputs = seeded_inputs(cfg_run, ms, seed)
     n = ms / STEP_MS
     rows = []

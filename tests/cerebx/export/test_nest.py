@@ -46,14 +46,19 @@ def test_nest_holds_the_exported_synapses(tmp_path):
         assert got[name]["weight_sum_nS"] == pytest.approx(w, rel=1e-6, abs=1e-9)
 
 
-def test_the_pynn_script_fires_as_the_nest_one(tmp_path):
-    cfg = load_network("small")
+VOCAB = Path(__file__).parents[2] / "configs" / "nest_vocab.yaml"
+
+
+@pytest.mark.parametrize("source", ["small", str(VOCAB)], ids=["small", "nest_vocab_stdp"])
+def test_the_pynn_script_fires_as_the_nest_one(source, tmp_path):
+    """The same spikes from both scripts, with static synapses (small) and with pair STDP (nest_vocab)."""
+    cfg = load_network(source)
     export(cfg, tmp_path, to=("nest", "pynn"), static=True, approximate=True, inputs=seeded_inputs(cfg, 300.0, 1))
     for script in ("nest_network.py", "pynn_network.py"):
         subprocess.run([PYTHON, str(tmp_path / script), "--ms", "300"], capture_output=True, check=True)
     a, b = np.load(tmp_path / "spikes_nest.npz"), np.load(tmp_path / "spikes_pynn.npz")
     assert len(a["gc/t"]) > 10 and len(a["pc/t"]) > 10 and len(a["dcn/t"]) > 10
-    for pop in ("gc", "pc", "dcn"):
+    for pop in [n for n, p in cfg.populations.items() if p.neuron.kind != "input"]:
         assert sorted(zip(a[f"{pop}/idx"], a[f"{pop}/t"])) == sorted(zip(b[f"{pop}/idx"], b[f"{pop}/t"]))
 
 
@@ -154,7 +159,7 @@ def test_stdp_trains_drift_as_in_nest(tmp_path):
 def test_the_vocabulary_network_learns_as_in_nest(tmp_path):
     """tests/configs/nest_vocab.yaml (fixed_probability MF->GC, fixed_indegree GoC->GC, pair STDP at PF->PC) at a
     0.1 ms step: rates within 0.5 %, counts correlated > 0.99, the mean PF->PC drift within 0.5 % of NEST's."""
-    d = yaml.safe_load((Path(__file__).parents[2] / "configs" / "nest_vocab.yaml").read_text())
+    d = yaml.safe_load(VOCAB.read_text())
     cfg = NetworkConfig.model_validate({**d, "dt_ms": 0.1})
     res = crosscheck(cfg, tmp_path, ms=1000.0, python=PYTHON, plastic=True)
     for row in res.rows:
