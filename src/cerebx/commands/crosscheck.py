@@ -19,7 +19,8 @@ def parser() -> Parser:
     ap = Parser("cerebx crosscheck", "run a network in cerebx and in NEST on the same input spike trains and "
                 "compare rates, spike counts, spike times and output")
     ap.add_argument("network", help="a network preset (small, full, thesis_ch3, ...) or a YAML file holding one")
-    ap.add_argument("overrides", nargs="*", help="key=value overrides of a preset (as for cerebx run)")
+    ap.add_argument("overrides", nargs="*", help="key=value overrides: of a preset as for cerebx run; of a file, keys "
+                    "of its network (dt_ms=0.1)")
     ap.add_argument("--ms", type=float, default=1000.0, help="simulated time (ms, default 1000)")
     ap.add_argument("--seed", type=int, default=0, help="seed of the input spike trains")
     ap.add_argument("--layer", default="", help="simulate only these populations in NEST (e.g. pc,dcn), fed with "

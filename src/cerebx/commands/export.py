@@ -17,7 +17,8 @@ def parser() -> Parser:
                 "neuron parameters (network.npz) and a script that builds it")
     ap.add_argument("network", nargs="?", help="a network preset (full, small, thesis_ch3, ...) or a YAML file "
                     "holding one (with --weights RUN: default the run's network)")
-    ap.add_argument("overrides", nargs="*", help="key=value overrides of a preset (as for cerebx run)")
+    ap.add_argument("overrides", nargs="*", help="key=value overrides: of a preset as for cerebx run; of a file, keys "
+                    "of its network (dt_ms=0.1)")
     ap.add_argument("--to", default="nest", help="nest, pynn or nest,pynn (default: nest)")
     ap.add_argument("--out", required=True, help="the folder to write")
     ap.add_argument("--static", action="store_true",

@@ -273,3 +273,17 @@ def test_learned_weights_of_a_run_are_exported(tmp_path, capsys):
                  "--approximate", "--out", str(tmp_path / "o2")]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "of another structure" in err
+
+
+def test_a_network_file_takes_overrides_of_its_keys():
+    from pathlib import Path
+
+    from cerebx.errors import CerebxError
+    from cerebx.export.source import load_network
+
+    vocab = Path(__file__).parents[2] / "configs" / "nest_vocab.yaml"
+    cfg = load_network(str(vocab), ["dt_ms=0.1", "projections.pf_pc.plasticity.lam=0.02"])
+    assert cfg.dt_ms == 0.1 and cfg.projections["pf_pc"].plasticity.lam == 0.02
+    assert cfg.projections["goc_gc"].rule.kind == "fixed_indegree" and cfg.projections["mf_gc"].rule.p == 0.1
+    with pytest.raises(CerebxError, match="override 'nope.x=1': not key=value"):
+        load_network(str(vocab), ["nope.x=1"])

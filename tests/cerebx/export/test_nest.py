@@ -159,9 +159,7 @@ def test_stdp_trains_drift_as_in_nest(tmp_path):
 def test_the_vocabulary_network_learns_as_in_nest(tmp_path):
     """tests/configs/nest_vocab.yaml (fixed_probability MF->GC, fixed_indegree GoC->GC, pair STDP at PF->PC) at a
     0.1 ms step: rates within 0.5 %, counts correlated > 0.99, the mean PF->PC drift within 0.5 % of NEST's."""
-    d = yaml.safe_load(VOCAB.read_text())
-    cfg = NetworkConfig.model_validate({**d, "dt_ms": 0.1})
-    res = crosscheck(cfg, tmp_path, ms=1000.0, python=PYTHON, plastic=True)
+    res = crosscheck(load_network(str(VOCAB), ["dt_ms=0.1"]), tmp_path, ms=1000.0, python=PYTHON, plastic=True)
     for row in res.rows:
         assert abs(row.rate_diff) < 0.005 and row.count_corr > 0.99, row
     (drift,) = res.drift
