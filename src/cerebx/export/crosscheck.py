@@ -288,9 +288,9 @@ def crosscheck(cfg: NetworkConfig, out: Path, ms: float = 1000.0, seed: int = 0,
     notes = list(p.notes)
     cfg_run = without(cfg, [k for k in p.dropped if not cfg.projections[k].teaching]) if p.dropped else cfg
     learning = [k for k, pp in p.projections.items() if pp.synapse != "static_synapse"] if plastic else []
+    frozen = [k for k, pp in p.projections.items() if pp.plastic or (not plastic and pp.synapse != "static_synapse")]
+    cfg_run = static_weights(cfg_run, frozen)  # a rule that learns in one learns in both
     if plastic:
-        frozen = [k for k, pp in p.projections.items() if pp.plastic]
-        cfg_run = static_weights(cfg_run, frozen)
         notes += [f"projections.{k}: static in both (NEST cannot express its rule)" for k in frozen]
     inputs = seeded_inputs(cfg_run, ms, seed)
     w_cx: dict[str, np.ndarray] = {}
