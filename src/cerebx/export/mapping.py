@@ -26,17 +26,34 @@ from cerebx.snn.schema import LIFNeuron, NetworkConfig
 
 @dataclass(frozen=True)
 class Refused:
-    """A kind the target simulator cannot express, and why (one line)."""
+    """A kind the target simulator cannot express, and why (one line).
+
+    Attributes
+    ----------
+    reason : str
+        Why, named in the export's one-line refusal.
+    """
 
     reason: str
 
 
 @dataclass(frozen=True)
 class NeuronMap:
-    """One neuron kind in NEST and PyNN. ``receptors``: cerebx receptor -> (PyNN receptor type, sign of the NEST
-    weight) or :class:`Refused`; ``check(neuron, receptors_in, h_ms)`` -> (problems, notes) about what the model
-    does not do (``receptors_in``: the receptors the population's current-carrying inputs use; ``h_ms``: its
-    integration step)."""
+    """One neuron kind in NEST and PyNN.
+
+    Attributes
+    ----------
+    nest_model, pynn_model : str
+        The NEST model and the PyNN cell type.
+    nest_params, pynn_params : callable
+        ``(neuron, h_ms) -> dict``: the model's parameters from the neuron's schema (``h_ms``: its integration
+        step); NEST takes pF, nS, mV, ms and PyNN nF, µS, mV, ms.
+    receptors : dict
+        cerebx receptor -> (PyNN receptor type, sign of the NEST weight), or :class:`Refused`.
+    check : callable or None
+        ``(neuron, receptors_in, h_ms) -> (problems, notes)``: what the model does not do (``receptors_in``: the
+        receptors the population's current-carrying inputs use).
+    """
 
     nest_model: str
     pynn_model: str
@@ -48,10 +65,20 @@ class NeuronMap:
 
 @dataclass(frozen=True)
 class PlasticityMap:
-    """A plasticity kind as a NEST synapse model and a PyNN synapse type. ``nest_params(rule, w_max)``: the synapse
-    model's parameters (``w_max``: the projection's upper weight bound in nS, with the sign of its NEST weights);
-    ``post_params(rule)``: parameters the rule sets on the post neuron (NEST keeps some, e.g. ``tau_minus``, there);
-    ``check(rule, projection)`` -> (problems, notes): what the NEST model computes differently."""
+    """A plasticity kind as a NEST synapse model and a PyNN synapse type.
+
+    Attributes
+    ----------
+    nest_synapse, pynn_synapse : str
+        The NEST synapse model and the PyNN synapse type.
+    nest_params : callable
+        ``(rule, w_max) -> dict``: the synapse model's parameters (``w_max``: the projection's upper weight bound
+        in nS, with the sign of its NEST weights).
+    post_params : callable or None
+        ``rule -> dict``: parameters the rule sets on the post neuron (NEST keeps some there, e.g. ``tau_minus``).
+    check : callable or None
+        ``(rule, projection) -> (problems, notes)``: what the NEST model computes differently.
+    """
 
     nest_synapse: str
     pynn_synapse: str
@@ -169,7 +196,17 @@ def register_export(group: str, kind: str, entry: NeuronMap | PlasticityMap | Re
     plugin's ``register()``: ``group`` ``"neurons"`` (a :class:`NeuronMap`), ``"plasticity"`` (a
     :class:`PlasticityMap`) or ``"connectors"`` (the equivalent NEST / PyNN rule, a string: the export writes the
     synapses cerebx drew either way); :class:`Refused` says why it has no counterpart (the export then names it
-    in its one-line refusal). A kind without an entry is refused as unmapped; a kind is registered once."""
+    in its one-line refusal). A kind without an entry is refused as unmapped; a kind is registered once.
+
+    Parameters
+    ----------
+    group : str
+        ``"neurons"``, ``"connectors"`` or ``"plasticity"``.
+    kind : str
+        The kind's name, as its schema's ``kind`` field.
+    entry : NeuronMap, PlasticityMap, Refused or str
+        What the kind becomes (a string: the equivalent connection rule's name).
+    """
     table = GROUPS.get(group)
     if table is None:
         raise ValueError(f"export mapping group {group!r} is not one of {', '.join(GROUPS)}")
