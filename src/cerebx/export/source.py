@@ -15,12 +15,10 @@ from cerebx.snn.schema import NetworkConfig
 
 
 def load_network(source: str, overrides: list[str] | None = None) -> NetworkConfig:
-    """The validated network ``source`` names (``overrides``: ``key=value`` as for ``cerebx run``, applied to
-    a preset, e.g. ``controller.network.projections.pf_pc.weight_nS=1.0``)."""
+    """The validated network ``source`` names (``overrides``: ``key=value`` as for ``cerebx run`` on a preset, e.g.
+    ``controller.network.projections.pf_pc.weight_nS=1.0``; on a file, keys of its network, e.g. ``dt_ms=0.1``)."""
     path = Path(source)
     if path.suffix in (".yaml", ".yml") or path.is_file():
-        if overrides:
-            raise CerebxError(f"{source}: overrides apply to a network preset, not to a file")
         try:
             doc = yaml.safe_load(path.read_text())
         except OSError as err:
@@ -30,6 +28,8 @@ def load_network(source: str, overrides: list[str] | None = None) -> NetworkConf
         net = _network_part(doc)
         if net is None:
             raise CerebxError(f"{source}: holds no network (populations and projections, or controller.network)")
+        for item in overrides or []:
+            _override(net, item, source)
         return _validate(net, source)
     from cerebx.config import compose, to_plain  # Hydra only when a preset is composed
 
@@ -43,6 +43,18 @@ def load_network(source: str, overrides: list[str] | None = None) -> NetworkConf
     return _validate(net, f"network={source}")
 
 
+def _override(net: dict, item: str, source: str) -> None:
+    """Apply ``dotted.key=value`` (value read as YAML) to a file's network, e.g. ``dt_ms=0.1``."""
+    key, eq, text = item.partition("=")
+    *parents, last = key.split(".")
+    node: Any = net
+    for k in parents:
+        node = node.get(k) if isinstance(node, dict) else None
+    if not eq or not key or not isinstance(node, dict):
+        raise CerebxError(f"{source}: override {item!r}: not key=value with a key of the network (e.g. dt_ms=0.1)")
+    node[last] = yaml.safe_load(text)
+
+
 def _network_part(doc: Any) -> dict | None:
     if not isinstance(doc, dict):
         return None
@@ -51,6 +63,11 @@ def _network_part(doc: Any) -> dict | None:
     ctrl = doc.get("controller")
     net = ctrl.get("network") if isinstance(ctrl, dict) else None
     return net if isinstance(net, dict) else None
+
+
+def validate_network(net: dict, where: str) -> NetworkConfig:
+    """``net`` validated; a problem is one line ``where: location: message``."""
+    return _validate(net, where)
 
 
 def _validate(net: dict, where: str) -> NetworkConfig:

@@ -823,7 +823,7 @@ def run_step(t0, n_sub, inputs, learn, par, net):
     n_out = 0
     for s in range(n_sub):
         t = t0 + s
-        run_rules(t, learn, net.learning, dl)
+        run_rules(t, learn, net.learning, dl)  # before delivery: a synapse delivers its updated weight
         # sparse projections (CSR by presynaptic neuron); teaching ones carry no current
         for p in range(sp_i.shape[0]):
             if sp_i[p, 5] != 0:

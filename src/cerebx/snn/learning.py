@@ -10,6 +10,10 @@ partner side (pairing: events up to and including t; traces: before t); then eve
 history. So a pre arrival and a post spike in the same substep do not pair under pair STDP (NEST's
 ``stdp_synapse`` does not pair simultaneous spikes either) and pair once under the pairing family.
 
+With a dendritic delay (``TraceSpec.dendritic``, NEST's convention) a post spike reaches the synapse one delay d
+after it happened, and the pre arrival is d after the pre spike reaches the synapse: the partner events at t are
+the post spikes stamped t − 2d (``R_PDELAY``), and a pair then has NEST's Δt = t_post − t_pre + d.
+
 Traces are exact: a trace keeps its value and the substep of its last update and is decayed on read,
 x(t) = x(t_last) exp(−(t − t_last) dt / tau). Histories keep each neuron's last HISTORY_MAX spike times (a ring).
 """
@@ -25,8 +29,8 @@ from numba.extending import overload
 FAM_TRACE, FAM_PAIRING = 0, 1
 
 # columns of sr_i (int64 per rule)
-(R_FAM, R_PIECE, R_TLO, R_THI, R_POST_LO, R_NPOST, R_CSC, R_KOFF, R_KLEN, R_PRE_ROW, R_POST_ROW) = range(11)
-N_RI = 11
+(R_FAM, R_PIECE, R_TLO, R_THI, R_POST_LO, R_NPOST, R_CSC, R_KOFF, R_KLEN, R_PRE_ROW, R_POST_ROW, R_PDELAY) = range(12)
+N_RI = 12
 # columns of sr_f (float64 per rule)
 (R_WLO, R_WHI, R_FIXED, R_LAM, R_ALPHA, R_MUP, R_MUM, R_RATEP, R_RATEM) = range(9)
 N_RF = 9
@@ -118,8 +122,9 @@ def sparse_learning(t, learn, sl, dl):
         # partner events at t
         ne = 0
         if sr_i[r, R_TLO] < 0:
-            s0 = t % R
-            for k in range(ring_n[s0]):
+            td = t - sr_i[r, R_PDELAY]  # the post spikes that reach the synapse now
+            s0 = td % R
+            for k in range(ring_n[s0] if td >= 0 else 0):
                 i = ring_idx[s0, k] - post_lo
                 if i >= 0 and i < n_post:
                     ev[ne] = i

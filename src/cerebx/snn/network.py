@@ -88,7 +88,8 @@ def _sparse_learning(topo: Topology) -> learning.SparseLearning:
             sr_f[r, L.R_FIXED] = spec.fixed_nS
         t_lo, t_hi = rule.teachers
         teach_syn = max(teach_syn, sum(len(topo.sparse[k].post) for k in range(t_lo, t_hi)))
-        sr_i[r] = (fam, rule.piece, t_lo, t_hi, post_lo, n_post, csc, k_off, klen, rows, rows + s.n_pre)
+        pdelay = 2 * s.delay if isinstance(spec, TraceSpec) and spec.dendritic else 0
+        sr_i[r] = (fam, rule.piece, t_lo, t_hi, post_lo, n_post, csc, k_off, klen, rows, rows + s.n_pre, pdelay)
         sr_f[r, L.R_WLO], sr_f[r, L.R_WHI] = rule.w_lo, rule.w_hi
         ptrs.append(rule.csc_ptr + n_q)
         qs.append(rule.csc_q + base[rule.piece])

@@ -18,7 +18,7 @@ The PF–PC rule (:class:`~cerebx.snn.schema.KernelSTDP`) keeps its own dense pa
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -46,6 +46,9 @@ class TraceSpec:
         Weight-dependence exponents of potentiation and depression (0: additive, 1: multiplicative).
     tau_plus_ms, tau_minus_ms : float
         Time constants of the presynaptic and postsynaptic traces (ms).
+    dendritic : bool
+        The synapse's delay d is dendritic (NEST's convention): a post spike reaches the synapse d after it
+        happened, so it pairs with the pre arrivals as a post spike 2 d later would under the axonal convention.
     """
 
     lam: float
@@ -54,6 +57,7 @@ class TraceSpec:
     mu_minus: float
     tau_plus_ms: float
     tau_minus_ms: float
+    dendritic: bool = False
 
 
 @dataclass(frozen=True)
@@ -87,12 +91,19 @@ class PairSTDP(Strict):
     post neuron). Weights bounded by the projection's ``weight_range_nS`` (W = its upper end)."""
 
     kind: Literal["pair_stdp"] = "pair_stdp"
+    added_without_effect: ClassVar[dict[str, Any]] = {"delay": "axonal"}
+    """Fields added after runs were recorded, with the value that computes what those runs did
+    (``schema/legacy.py``)."""
     lam: PositiveFloat = Field(0.01, description="NEST lambda: step size of potentiation")
     alpha: NonNegFloat = Field(1.0, description="depression / potentiation ratio")
     mu_plus: NonNegFloat = Field(1.0, description="weight dependence exponent of potentiation (0: additive)")
     mu_minus: NonNegFloat = Field(1.0, description="weight dependence exponent of depression (0: additive)")
     tau_plus_ms: PositiveFloat = Field(20.0, description="presynaptic trace time constant")
     tau_minus_ms: PositiveFloat = Field(20.0, description="postsynaptic trace time constant (NEST: the neuron's)")
+    delay: Literal["axonal", "dendritic"] = Field(
+        "axonal", description="where the projection's delay d sits for the pairing: axonal (a pre spike pairs "
+        "on arrival with the post neuron's spikes as they happen: Δt = t_post − t_pre − d) or dendritic (NEST "
+        "stdp_synapse: the post spike reaches the synapse d later: Δt = t_post − t_pre + d)")
 
 
 class SymmetricCos(Strict):
@@ -126,7 +137,8 @@ def cos_kernel(tau_ms: float, n: float, dt_ms: float) -> np.ndarray:
 
 
 def pair_stdp(rule: PairSTDP, dt_ms: float) -> TraceSpec:
-    return TraceSpec(rule.lam, rule.alpha, rule.mu_plus, rule.mu_minus, rule.tau_plus_ms, rule.tau_minus_ms)
+    return TraceSpec(rule.lam, rule.alpha, rule.mu_plus, rule.mu_minus, rule.tau_plus_ms, rule.tau_minus_ms,
+                     rule.delay == "dendritic")
 
 
 def symmetric_cos(rule: SymmetricCos | SymmetricCosSTDP, dt_ms: float) -> PairingSpec:

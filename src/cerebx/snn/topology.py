@@ -488,7 +488,8 @@ def build_topology(cfg: NetworkConfig, fill: bool = True, seed: int = 0) -> Topo
             ptr, q, j = _csc(sparse[k], int(lo[b]), int(sizes[b]))
             sparse_rules.append(SparseRule(name, k, span, spec, w_lo, w_hi, ptr, q, j))
 
-    max_delay = max([s.delay for s in sparse] + [d.delay for d in dense] + [1])
+    dendritic = [2 * sparse[r.piece].delay for r in sparse_rules if getattr(r.spec, "dendritic", False)]
+    max_delay = max([s.delay for s in sparse] + [d.delay for d in dense] + dendritic + [1])  # the ring's reach
     topo = Topology(cfg, n_sub, dt, names, lo, hi, kind, par, ipar, poly, sparse, dense, dense_w, plastic,
                     max_delay, index, sparse_rules, built, dense_init)
     if fill:
