@@ -22,6 +22,7 @@ from cerebx.builders import (
 from cerebx.config import load
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
+from cerebx.kernel_struct import KernelStruct
 from cerebx.lwpr.model import LWPR
 from cerebx.metrics import final_mae
 from cerebx.persistence.state import load_state_npz, save_state_npz
@@ -59,6 +60,7 @@ __all__ = [
     "ControlInput",
     "Controller",
     "Frame",
+    "KernelStruct",
     "MossyEncoder",
     "MujocoArm",
     "Plant",
