@@ -65,8 +65,8 @@ def test_no_two_folders_of_cerebx_import_each_other():
 
 
 def test_few_functions_take_more_than_ten_parameters():
-    """Kernels take their parameters named or grouped (a structref, a tuple); at most three functions of the
-    package, numba kernels included, take more than ten."""
+    """Kernels take their parameters named or grouped (a structref, a tuple): of the package's functions, numba
+    kernels included, one takes more than ten (the SNN controller's _run_chunk_outputs; the issue's goal: <= 3)."""
     import ast
 
     many = []
@@ -79,7 +79,7 @@ def test_few_functions_take_more_than_ten_parameters():
                 n -= bool(a.args) and a.args[0].arg in ("self", "cls")
                 if n > 10:
                     many.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name} ({n})")
-    assert len(many) <= 3, "\n".join(many)
+    assert len(many) <= 1, "\n".join(many)
 
 
 def test_every_schema_lives_in_a_module_named_schema():
