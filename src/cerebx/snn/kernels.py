@@ -199,6 +199,11 @@ class KernelState(KernelStruct, fields=NetworkArrays):
     with the 38 arrays as arguments and a quarter as much as with the named tuples, whose arrays and
     field names numba checks one by one on every call. Pickles as its arrays."""
 
+    @property
+    def arrays(self) -> NetworkArrays:
+        """The :class:`NetworkArrays` it was made of."""
+        return self.source
+
 
 def kernel_state(arrays: NetworkArrays) -> KernelState:
     """The kernels' handle on ``arrays`` (the same array objects: writes either way are seen both ways)."""
