@@ -145,9 +145,11 @@ def _imports(name: str) -> list[str]:
 
 @functools.cache
 def _kernel_count(name: str) -> int:
-    """The ``cache=True`` kernels defined in module ``name``."""
+    """The ``cache=True`` kernels defined in module ``name``, with one per ``KernelStruct`` subclass (a class
+    given ``fields=``: its compiled constructor)."""
     return sum(1 for node in ast.walk(_tree(name)) if isinstance(node, ast.FunctionDef)
-               and any(_caches(d) for d in node.decorator_list))
+               and any(_caches(d) for d in node.decorator_list)
+               or isinstance(node, ast.ClassDef) and any(k.arg == "fields" for k in node.keywords))
 
 
 def _caches(decorator: ast.expr) -> bool:

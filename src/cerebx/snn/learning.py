@@ -26,6 +26,8 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
+from cerebx.snn.topology import S_DELAY, S_N_PRE, S_PRE_LO, S_ROW
+
 FAM_TRACE, FAM_PAIRING = 0, 1
 
 # columns of sr_i (int64 per rule)
@@ -115,7 +117,7 @@ def sparse_learning(t, learn, sl, dl):
     R = ring_idx.shape[0]
     for r in range(sr_i.shape[0]):
         pc = sr_i[r, R_PIECE]
-        pre_lo, n_pre, off, delay = sp_i[pc, 0], sp_i[pc, 1], sp_i[pc, 2], sp_i[pc, 4]
+        pre_lo, n_pre, off, delay = sp_i[pc, S_PRE_LO], sp_i[pc, S_N_PRE], sp_i[pc, S_ROW], sp_i[pc, S_DELAY]
         post_lo, n_post, co = sr_i[r, R_POST_LO], sr_i[r, R_NPOST], sr_i[r, R_CSC]
         pre_row, post_row = sr_i[r, R_PRE_ROW], sr_i[r, R_POST_ROW]
         w_lo, w_hi = sr_f[r, R_WLO], sr_f[r, R_WHI]
@@ -131,10 +133,10 @@ def sparse_learning(t, learn, sl, dl):
                     ne += 1
         else:
             for tp in range(sr_i[r, R_TLO], sr_i[r, R_THI]):
-                if t - sp_i[tp, 4] < 0:
+                if t - sp_i[tp, S_DELAY] < 0:
                     continue
-                s1 = (t - sp_i[tp, 4]) % R
-                t_lo, t_n, t_off = sp_i[tp, 0], sp_i[tp, 1], sp_i[tp, 2]
+                s1 = (t - sp_i[tp, S_DELAY]) % R
+                t_lo, t_n, t_off = sp_i[tp, S_PRE_LO], sp_i[tp, S_N_PRE], sp_i[tp, S_ROW]
                 for k in range(ring_n[s1]):
                     j = ring_idx[s1, k] - t_lo
                     if j < 0 or j >= t_n:

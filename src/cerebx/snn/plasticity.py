@@ -1,5 +1,5 @@
-"""Learning rules of sparse (CSR) projections (docs/models.md#plasticity) and the two rule families the engine
-runs on them.
+"""Learning rules of sparse (CSR) projections (docs/models.md#plasticity): the two rule families the engine
+runs on them and the builders of the built-in rule kinds (their schemas are in :mod:`cerebx.snn.schema`).
 
 A plasticity kind is registered (``registry.plasticity_rules``) with a builder ``builder(rule, dt_ms) -> spec``
 that turns its parameters into one of the engine's families, so a plugin's rule runs in the compiled kernels
@@ -18,12 +18,11 @@ The PF–PC rule (:class:`~cerebx.snn.schema.KernelSTDP`) keeps its own dense pa
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field
 
-from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
+# the rules' schemas live with the network's; their names here are those older checkpoints pickled them by
+from cerebx.snn.schema import PairSTDP, SymmetricCos, SymmetricCosSTDP  # noqa: F401
 
 HISTORY_MAX = 64
 """Spikes kept per neuron for a pairing rule: enough for a window of 64 spikes (e.g. 100 ms at 640 Hz); older
@@ -83,51 +82,6 @@ class PairingSpec:
     k_pre: np.ndarray
     k_post: np.ndarray
     teacher: str | None
-
-
-class PairSTDP(Strict):
-    """Pair-based STDP, NEST ``stdp_synapse`` (Gütig et al. 2003 form; docs/models.md#pair-stdp): all-to-all
-    pairing through a presynaptic trace (tau_plus) and a postsynaptic one (tau_minus, in NEST a parameter of the
-    post neuron). Weights bounded by the projection's ``weight_range_nS`` (W = its upper end)."""
-
-    kind: Literal["pair_stdp"] = "pair_stdp"
-    added_without_effect: ClassVar[dict[str, Any]] = {"delay": "axonal"}
-    """Fields added after runs were recorded, with the value that computes what those runs did
-    (``schema/legacy.py``)."""
-    lam: PositiveFloat = Field(0.01, description="NEST lambda: step size of potentiation")
-    alpha: NonNegFloat = Field(1.0, description="depression / potentiation ratio")
-    mu_plus: NonNegFloat = Field(1.0, description="weight dependence exponent of potentiation (0: additive)")
-    mu_minus: NonNegFloat = Field(1.0, description="weight dependence exponent of depression (0: additive)")
-    tau_plus_ms: PositiveFloat = Field(20.0, description="presynaptic trace time constant")
-    tau_minus_ms: PositiveFloat = Field(20.0, description="postsynaptic trace time constant (NEST: the neuron's)")
-    delay: Literal["axonal", "dendritic"] = Field(
-        "axonal", description="where the projection's delay d sits for the pairing: axonal (a pre spike pairs "
-        "on arrival with the post neuron's spikes as they happen: Δt = t_post − t_pre − d) or dendritic (NEST "
-        "stdp_synapse: the post spike reaches the synapse d later: Δt = t_post − t_pre + d)")
-
-
-class SymmetricCos(Strict):
-    """MF–DCN rule of the distributed-plasticity models (docs/models.md#symmetric-cos): a fixed change per pre
-    spike, and a change scaled by a symmetric cosine kernel of the time to each teaching spike (PC spikes
-    arriving at the DCN): EDLUT SimetricCosAdditiveKernel, NEST stdp_cos_synapse."""
-
-    kind: Literal["symmetric_cos"] = "symmetric_cos"
-    fixed_nS: float = Field(0.001, description="change at each pre spike (EDLUT fixed_change; > 0: LTP)")
-    kernel_nS: float = Field(-0.010, description="scale of the kernel term (EDLUT kernel_change; < 0: LTD)")
-    tau_ms: PositiveFloat = Field(100.0, description="kernel half-width: k = 0 at |Δ| >= tau")
-    n: NonNegFloat = Field(2.0, description="exponential sharpening of the kernel")
-    teacher: str = Field(description="projection whose arrivals at the post neuron pair with the pre spikes")
-
-
-class SymmetricCosSTDP(Strict):
-    """PC–DCN rule of the distributed-plasticity models (docs/models.md#symmetric-cos): as ``symmetric_cos``
-    with the post neuron's own spikes as the partner (EDLUT SimetricCosSTDPAdditiveKernel)."""
-
-    kind: Literal["symmetric_cos_stdp"] = "symmetric_cos_stdp"
-    fixed_nS: float = Field(0.001, description="change at each pre spike (EDLUT fixed_change)")
-    kernel_nS: float = Field(-0.010, description="scale of the kernel term (EDLUT kernel_change)")
-    tau_ms: PositiveFloat = Field(100.0, description="kernel half-width: k = 0 at |Δ| >= tau")
-    n: NonNegFloat = Field(2.0, description="exponential sharpening of the kernel")
 
 
 def cos_kernel(tau_ms: float, n: float, dt_ms: float) -> np.ndarray:

@@ -53,6 +53,11 @@ METHODS = {"euler": 0, "rk2": 1, "rk4": 2}
 # Columns of the per-population integer table.
 I_LO, I_HI, I_KIND, I_RATIO, I_COMPACT, I_NFINE = range(6)
 N_IPAR = 6
+# Columns of the sparse projections' integer table (``Delivery.sp_i``, one row per projection): the first
+# presynaptic neuron and their count, the projection's first row in sp_ptr, receptor, delay (substeps),
+# teaching (1: a pairing rule's partner, delivered by the rule, not as current), the post population.
+S_PRE_LO, S_N_PRE, S_ROW, S_RECEPTOR, S_DELAY, S_TEACHING, S_POST_POP = range(7)
+N_SPAR = 7
 N_COEF = 7  # polynomial coefficients (degree <= 6 in g) of a one-step update of an AMPA-only LIF
 ORDER = {"euler": 1, "rk2": 2, "rk4": 4}  # degree in g0 of one step of each method
 
