@@ -23,7 +23,7 @@ def test_the_experiment_runs_the_luque_distributed_preset(load):
     assert rules == {"pf_pc": "kernel_stdp", "mf_dcn": "symmetric_cos", "pc_dcn": "symmetric_cos_stdp"}
 
 
-REDUCED = [*EXP, f"{PART}.mf.fibers_per_signal=5",
+REDUCED = [*EXP, f"+{PART}.mf={{kind: box, fibers_per_signal: 5}}",
            f"{PART}.network.per_joint={{mf: 20, gc: 625, pc: 10, cf: 10, dcn: 10}}",
            f"{PART}.network.projections.mf_gc.rule.fibers_per_signal=5", f"{PART}.decoder.alpha_Nm_per_spike=[10.0]"]
 

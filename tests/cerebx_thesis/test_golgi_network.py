@@ -59,6 +59,6 @@ def test_golgi_cells_cut_the_granule_spikes_by_a_third_and_the_pcs_keep_their_ra
 
 @pytest.mark.slow
 def test_the_reduced_golgi_network_learns_the_circle(load, tmp_path):
-    s = run_experiment(load(["+experiment=learn_circle", "network=small_golgi", *SMALL, "trials=12"]), tmp_path)
+    s = run_experiment(load(["+experiment=learn_circle", "network=small_golgi", *SMALL, "trials=20"]), tmp_path)
     mae = np.asarray(s["mae_per_trial"])
-    assert s["status"] == "completed" and mae[-3:].mean() < 0.8 * mae[0], mae
+    assert s["status"] == "completed" and mae[-3:].mean() < 0.8 * mae[0], mae  # measured: 0.224 -> ~0.14

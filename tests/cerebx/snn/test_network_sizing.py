@@ -27,10 +27,12 @@ def test_per_joint_on_the_planar_arm_has_two_joints_of_everything(load):
     assert sizes == {"mf": (80, 2), "cf": (200, 2), "gc": (20000, 2), "pc": (200, 2), "dcn": (200, 2)}
     assert net.projections["mf_gc"].rule.joints == 2
     assert net.projections["pf_pc"].synapses == 20000 * 200 and net.projections["mf_dcn"].synapses == 80 * 200
-    # each PC sees a third of full's PFs (2 joints, not 6): weights, range and steps x 3 keep its drive
+    # each PC sees a third of full's PFs (2 joints, not 6): weights, range and steps x 3 keep its drive (the
+    # experiment gives the steps 0.0133333 / -0.0066667, so upper_limb's 0.04 / -0.02 after the x 3)
     pf = net.projections["pf_pc"]
     assert pf.weight_nS == pytest.approx(6.0) and pf.weight_range_nS == pytest.approx((0.0, 15.0))
-    assert pf.plasticity.ltp_nS == pytest.approx(0.006) and pf.plasticity.ltd_nS == pytest.approx(-0.0024)
+    assert pf.plasticity.ltp_nS == pytest.approx(0.04, rel=1e-5)
+    assert pf.plasticity.ltd_nS == pytest.approx(-0.02, rel=1e-4)
     assert net.projections["mf_dcn"].weight_nS == pytest.approx(0.3)
     assert net.projections["pc_dcn"].weight_nS == 1.0  # one_to_one: not scaled
     # one-entry gains are given to both joints
@@ -66,10 +68,10 @@ def _learns(load, tmp_path, overrides, trials):
 @pytest.mark.slow
 def test_the_planar_arm_learns_the_sine_from_scratch(load, tmp_path):
     first, last = _learns(load, tmp_path, PLANAR, 15)
-    assert last < 0.85 * first, (first, last)
+    assert last < 0.6 * first, (first, last)  # measured: 0.272 -> 0.09 at trial 12
 
 
 @pytest.mark.slow
 def test_poisson_mossy_fibres_on_a_random_granular_layer_learn(load, tmp_path):
-    first, last = _learns(load, tmp_path, ["+experiment=snn_planar2_poisson"], 15)
-    assert last < 0.85 * first, (first, last)
+    first, last = _learns(load, tmp_path, ["+experiment=snn_planar2_poisson"], 30)
+    assert last < 0.7 * first, (first, last)  # measured: 0.296 -> ~0.1 at trial 24
