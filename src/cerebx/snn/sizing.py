@@ -40,7 +40,9 @@ def plant_joints(experiment: dict[str, Any]) -> int | None:
 
 def sized_network(network: dict[str, Any], n_joints: int) -> dict[str, Any]:
     """``network`` (plain data) with its ``per_joint`` populations sized for ``n_joints`` joints; unchanged
-    when it has no ``per_joint`` key. Values the schema refuses are left for validation to report."""
+    when it has no ``per_joint`` key. A ``per_joint`` entry naming no population, or not a positive number of
+    cells, is a ``ValueError`` (a validation error of the experiment); other values the schema refuses are left
+    for validation to report."""
     if not isinstance(network, dict) or KEY not in network:
         return network
     out = copy.deepcopy(network)
@@ -51,8 +53,11 @@ def sized_network(network: dict[str, Any], n_joints: int) -> dict[str, Any]:
         out[KEY] = per_joint  # refused by the schema, with its path
         return out
     for name, cells in per_joint.items():
-        if isinstance(pops.get(name), dict) and isinstance(cells, int):
-            pops[name] = {**pops[name], "size": cells * n_joints, "microcomplexes": n_joints}
+        if not isinstance(pops.get(name), dict):
+            raise ValueError(f"controller.network.per_joint.{name}: no population {name!r} in the network")
+        if not isinstance(cells, int) or isinstance(cells, bool) or cells < 1:
+            raise ValueError(f"controller.network.per_joint.{name}: {cells!r} is not a positive whole number of cells")
+        pops[name] = {**pops[name], "size": cells * n_joints, "microcomplexes": n_joints}
     for proj in (out.get("projections") or {}).values():
         if not isinstance(proj, dict):
             continue

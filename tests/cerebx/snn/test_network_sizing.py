@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from cerebx.errors import ConfigError
 from cerebx.loop.runner import run_experiment
 from cerebx.snn.sizing import sized_network
 
@@ -48,6 +49,14 @@ def test_a_random_rule_gets_its_expected_count_and_a_bad_population_is_left_to_v
     assert out["projections"]["ab"]["synapses"] == 180  # 30 x 60 x 0.1
     assert out["projections"]["zz"]["synapses"] == 7
     assert "per_joint" not in out and "per_joint" in net  # the input is not changed
+
+
+@pytest.mark.parametrize("override, problem", [
+    ("+controller.network.per_joint.gcc=100", "controller.network.per_joint.gcc: no population 'gcc'"),
+    ("controller.network.per_joint.gc=0", "controller.network.per_joint.gc: 0 is not a positive")])
+def test_a_bad_per_joint_entry_is_one_line(load, override, problem):
+    with pytest.raises(ConfigError, match=problem):
+        load([*PLANAR, override])
 
 
 def test_a_composite_part_is_sized_too(load):
