@@ -12,6 +12,7 @@ import copy
 from typing import Any
 
 from cerebx import registry
+from cerebx.link.schema import LINK_ADDED_WITHOUT_EFFECT, is_loopback, split_address
 from cerebx.schema.experiment import ADDED_WITHOUT_EFFECT
 
 
@@ -34,12 +35,24 @@ def _fill(part: dict[str, Any], dotted: str, value: Any) -> None:
         node[last] = copy.deepcopy(value)
 
 
+def _upgrade_link(link: Any) -> None:
+    """A real link recorded before its newer fields: filled in (beyond_loopback as that run needed it)."""
+    if not isinstance(link, dict) or link.get("kind") not in LINK_ADDED_WITHOUT_EFFECT:
+        return
+    for key, value in LINK_ADDED_WITHOUT_EFFECT[link["kind"]].items():
+        if key == "beyond_loopback" and key not in link:
+            value = any(isinstance(link.get(k), str) and ":" in link[k]
+                        and not is_loopback(split_address(link[k])[0]) for k in ("robot", "brain", "relay"))
+        link.setdefault(key, copy.deepcopy(value))
+
+
 def upgrade(config: dict[str, Any]) -> dict[str, Any]:
     """A copy of a recorded experiment config in today's layout (unchanged when it already is)."""
     registry.load_plugins()
     out = copy.deepcopy(config)
     for key, value in ADDED_WITHOUT_EFFECT.items():
         out.setdefault(key, copy.deepcopy(value))
+    _upgrade_link(out.get("link"))
     network = out.pop("network", None)
     controller = out.get("controller")
     if not isinstance(controller, dict):

@@ -353,7 +353,7 @@ def test_two_namespaces_joined_by_a_veth_pair(tmp_path):
             _ip("-n", ns, "link", "set", dev, "up")
             _ip("-n", ns, "link", "set", "lo", "up")
         addr = [f"link.robot={net}.1:7611", f"link.brain={net}.2:7612", f"link.relay={net}.2:7613"]
-        common = [*PD, "link=zenoh", "trials=1", "link.clock_sync=ping", *addr]
+        common = [*PD, "link=zenoh", "trials=1", "link.clock_sync=ping", "link.beyond_loopback=true", *addr]
         env = {KEY_ENV: "cd" * 32}
         netns = ["ip", "netns", "exec"]
         robot = subprocess.Popen(netns + [ns_r] + CLI + ["robot", "--run-dir", str(tmp_path / "robot"), *common],
