@@ -234,6 +234,10 @@ class LinkEnd:
         data: list[Arrived] = []
         control: list[Packet] = []
         for pkt in self.transport.inbox.take(limit):
+            if isinstance(pkt, Arrival):  # queued before this end took over the inbox
+                pkt = self.admit(pkt)
+                if pkt is None:
+                    continue
             cand = pkt.candidate
             if cand is not None:
                 if self.session is None and cand.brain_nonce in self.candidates:
