@@ -1,11 +1,12 @@
 """The link under attack, over real sockets and processes (loopback only; every process has a time limit and
 is stopped by the test): a recorded session replayed into a fresh robot side, replayed PINGs after the brain
-side died, a flood of junk datagrams at the robot's port, and set-up that fails."""
+side died, a flood of junk datagrams at the robot's port, set-up that fails, and zenoh over mutual TLS."""
 
 from __future__ import annotations
 
 import json
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -17,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from cerebx.link.transport import free_port
-from cerebx.recording.reader import read_messages, read_summary
+from cerebx.recording.reader import read_messages, read_metadata, read_summary
 
 pytestmark = pytest.mark.integration
 
@@ -270,3 +271,41 @@ def test_a_flood_of_junk_datagrams_does_not_move_the_pacing(tmp_path):
     # under 5 ms; on a machine whose other jobs already make the baseline later than that, within 2x of it
     assert flood["p99"] < max(5.0, 2 * base["p99"])
     assert flood["overruns"] <= 2 * base["overruns"] + 20
+
+
+# ---------------------------------------------------------------------- confidentiality
+def _certificates(folder: Path) -> dict[str, Path]:
+    """A CA and one certificate for 127.0.0.1 signed by it (server and client use), made with openssl."""
+    def ssl(*args: str) -> None:
+        subprocess.run(["openssl", *args], check=True, capture_output=True, timeout=60, cwd=folder)
+
+    ssl("req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:P-256", "-nodes", "-keyout", "ca.key",
+        "-out", "ca.pem", "-days", "2", "-subj", "/CN=cerebx test CA")
+    ssl("req", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:P-256", "-nodes", "-keyout", "side.key", "-out",
+        "side.csr", "-subj", "/CN=localhost")
+    (folder / "ext.cnf").write_text("subjectAltName=DNS:localhost,IP:127.0.0.1\n"
+                                    "extendedKeyUsage=serverAuth,clientAuth\nbasicConstraints=CA:FALSE\n")
+    ssl("x509", "-req", "-in", "side.csr", "-CA", "ca.pem", "-CAkey", "ca.key", "-CAcreateserial", "-out",
+        "side.pem", "-days", "2", "-extfile", "ext.cnf")
+    return {"ca": folder / "ca.pem", "cert": folder / "side.pem", "key": folder / "side.key"}
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl to make the test certificates")
+def test_zenoh_over_mutual_tls_completes_and_a_peer_without_a_certificate_reads_nothing(tmp_path):
+    certs = _certificates(tmp_path)
+    addr = ports(socket.SOCK_STREAM)
+    run = tmp_path / "run"
+    brain = start(["run", *PD, "link=zenoh", "trials=2", f"hydra.run.dir={run}", *addr,
+                   f"+link.tls.root_ca_certificate={certs['ca']}", f"+link.tls.listen_certificate={certs['cert']}",
+                   f"+link.tls.listen_private_key={certs['key']}"], KEY)
+    wait_for(lambda: ticking(run), 60, "the robot side")
+    seen: list[bytes] = []
+    with _zenoh_session([_endpoint(addr[0]), "tls/" + addr[0].split("=", 1)[1]]) as session:
+        session.declare_subscriber("cerebx/r2c/0", lambda s: seen.append(s.payload.to_bytes()))
+        time.sleep(1.5)
+    code, _, err = finish(brain)
+    assert code == 0, err
+    assert read_summary(run)["status"] == "completed" and seen == []
+    meta = read_metadata(run)["link"]
+    assert meta["listen"].startswith("['tls/") and meta["connect"].startswith("['tls/")
