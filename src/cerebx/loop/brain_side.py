@@ -96,6 +96,7 @@ class BrainSide:
         self.shared_clock = True
         self.robot_done = False
         self.clock_refused = 0
+        self._dropped = end.dropped()
 
     def t0(self) -> int:
         """Tick 0 on this side's clock (follows the offset estimate)."""
@@ -170,7 +171,7 @@ class BrainSide:
                 break
             inbox.wait((until - now) / 1e9)
         began = now_ns()
-        lost0, refused0 = end.data.lost, sum(end.rejected.values())
+        lost0, refused0 = end.data.lost, sum(self._dropped.values())
         used = [a for a in self._pending if a.tick <= k]
         self._pending = [a for a in self._pending if a.tick > k]
         for a in used:
@@ -211,10 +212,14 @@ class BrainSide:
             for name, field in self._record_as:
                 msg[field] = out[name]
             rec.write("/control", "cerebx.Control", t, msg)
+        dropped = end.dropped()
         rec.write("/timing/brain", "cerebx.BrainTiming", t,
                   {"t": t, "tick": k, "lag_ms": round(lag_ms, 4), "compute_ms": round(compute_ms, 4),
                    "sensors": len(used), "lost": end.data.lost - lost0,
-                   "refused": sum(end.rejected.values()) - refused0, "level": self.watchdog.level})
+                   "refused": sum(dropped.values()) - refused0,
+                   "dropped": {r: n - self._dropped.get(r, 0) for r, n in dropped.items()
+                               if n != self._dropped.get(r, 0)}, "level": self.watchdog.level})
+        self._dropped = dropped
         self._resync(t, sent)
         self.tick += 1
 
@@ -446,7 +451,6 @@ def run_brain_side(cfg: Any, run_dir: Path, resolved: dict | None = None, overri
     link = with_free_ports(cfg.link, udp=cfg.link.kind == "udp") if cfg.link.spawn_robot else cfg.link
     cfg = cfg.model_copy(update={"link": link})
     via_relay = link.relay_on(cfg.delay.kind)
-    signer = _signer(link)
     why = clock.realtime_process(link.rt_priority, "brain")
     if why:
         print(f"brain side: {why}", file=sys.stderr)
@@ -456,6 +460,7 @@ def run_brain_side(cfg: Any, run_dir: Path, resolved: dict | None = None, overri
     paired = False
     try:
         try:
+            signer = _signer(link)
             transport = registry.links.build(link, "brain", via_relay)
             if link.spawn_robot:
                 folder = run_dir / ROBOT_DIR

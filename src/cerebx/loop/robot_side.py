@@ -247,7 +247,7 @@ class RobotSide:
             self._fire(*self._plant_events.pop(0), t)
         sensed = plant.sense()
         end.send_message(Message(t, sensed), k)
-        lost0, refused0 = end.data.lost, sum(end.dropped().values())
+        lost0, refused0 = end.data.lost, sum(self._dropped.values())
         waited0 = now_ns()
         arrived = self._collect(k, deadline + self.wait_ns)
         waited = now_ns() - waited0

@@ -104,6 +104,17 @@ def test_a_port_in_use_exits_2_with_one_line_and_leaves_nothing(tmp_path):
     assert not run.exists()
 
 
+@pytest.mark.slow
+def test_an_unresolvable_host_exits_2_with_one_line_and_leaves_nothing(tmp_path):
+    run = tmp_path / "run"
+    code, _, err = finish(start(["run", *PD, "link=udp", "trials=1", "link.spawn_robot=false",
+                                 "link.beyond_loopback=true", "link.robot=nowhere.invalid:7000",
+                                 f"hydra.run.dir={run}"], KEY), 90)
+    (line,) = stderr_lines(err)
+    assert code == 2 and line.startswith("link: nowhere.invalid:7000: the host cannot be resolved"), err
+    assert not run.exists()
+
+
 # ---------------------------------------------------------------------- zenoh eavesdropper
 def _zenoh_session(endpoints: list[str]):
     zenoh = pytest.importorskip("zenoh")
