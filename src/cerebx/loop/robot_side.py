@@ -468,11 +468,12 @@ def main(argv: list[str]) -> int:
     via_relay = cfg.link.relay_on(cfg.delay.kind)
     transport = registry.links.build(cfg.link, "robot", via_relay)
     expected = {s.name: s.size for s in wire(cfg).sent}
-    end = LinkEnd(transport, signer, "robot", expected, max_tick=cfg.trials * 10**6)
+    end = LinkEnd(transport, signer, "robot", expected)
     run_dir = Path(args.run_dir) if args.run_dir else default_run_dir(cfg)
     try:
         hello = wait_for_hello(end, fingerprint(cfg), cfg.link.pair_timeout_s)
         ctx = build_robot_parts(cfg, hello.info.get("controller") or {}, None)
+        end.max_tick = cfg.trials * ctx.task.steps_per_trial
         prepare_real_time()
         facts = {"fingerprint": fingerprint(cfg), **host_identity()}
         pair(end, hello, facts, cfg.link.pair_timeout_s)
