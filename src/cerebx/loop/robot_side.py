@@ -438,8 +438,8 @@ def default_run_dir(cfg: Any) -> Path:
 
 
 def from_parent() -> tuple[Signer, list[str]]:
-    """Started by ``cerebx run``: the key and the addresses come as one JSON line on stdin (not on the command
-    line, which any user of the machine can read); afterwards stdin closing means the parent is gone."""
+    """Started by ``cerebx run``: the key and the addresses come as one JSON line on stdin, a pipe only the two
+    processes hold (not on the command line or in the environment, which other processes may read)."""
     line = sys.stdin.buffer.readline(1 << 16)
     try:
         setup = json.loads(line)

@@ -212,11 +212,14 @@ def test_replayed_pings_neither_move_the_clock_nor_keep_a_robot_side_alive(tmp_p
             time.sleep(0.02)
     wait_for(lambda: read_summary(run / "robot").get("status") not in (None, "running"), 30, "the robot side")
     r = read_summary(run / "robot")
-    offsets = [m["offset_ms"] for topic, _t, m in read_messages(run, topics=["/clock_sync"])]
-    print(f"\nrobot side: {r['status']} ({r['error']}), {r['link']['packets']}; brain offsets (ms): {offsets}")
+    sync = [m for topic, _t, m in read_messages(run, topics=["/clock_sync"]) if "refused" not in m["method"]]
+    offsets = [(round(m["offset_ms"], 3), round(m["uncertainty_ms"], 3)) for m in sync]
+    print(f"\nrobot side: {r['status']} ({r['error']}), {r['link']['packets']}; brain offsets +- uncertainty "
+          f"(ms): {offsets}")
     assert r["status"] == "interrupted" and r["error"].startswith("link lost"), r["error"]
     assert r["link"]["packets"]["rejected"].get("replayed", 0) >= 80, r["link"]["packets"]
-    assert offsets and max(abs(o) for o in offsets) < 1.0, offsets
+    # one host, one clock: each estimate within its own uncertainty of 0 (a replay moved it by 2 s before)
+    assert offsets and all(abs(o) <= u + 0.05 for o, u in offsets), offsets
     assert robot_pid is not None
 
 
@@ -245,10 +248,12 @@ def udp_no_ports() -> int:
     return int(lines[1][lines[0].index("NoPorts")])
 
 
-def robot_run(tmp_path: Path, name: str, flood_rate: int) -> dict:
+def robot_run(tmp_path: Path, name: str, flood_rate: int, extra: tuple[str, ...] = ()) -> dict:
+    """A 5,000-tick PD run over UDP, with ``flood_rate`` junk datagrams/s at the robot side's port for 5 s once
+    it ticks: the robot side's lateness p99 and overruns, and what reached its process."""
     addr = ports()
     run = tmp_path / name
-    brain = start(["run", *PD, "link=udp", "trials=5", f"hydra.run.dir={run}", *addr])
+    brain = start(["run", *PD, "link=udp", "trials=5", f"hydra.run.dir={run}", *addr, *extra])
     pid = wait_for(lambda: ticking(run), 60, "the robot side")
     out: dict = {}
     cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().decode(errors="replace")
