@@ -136,6 +136,20 @@ class RealLink(Strict):
     beyond_loopback: bool = Field(False, description="allow addresses beyond the loopback interface (each side "
                                                      "that listens there says so); off: loopback only")
 
+    added_without_effect: ClassVar[dict[str, Any]] = {"max_clock_uncertainty_ms": 2.0, "beyond_loopback": False}
+    """Fields added since runs were recorded, with the value that does what those runs did (read by
+    ``cerebx.schema.legacy.upgrade`` through :meth:`upgrade_recorded`)."""
+
+    @classmethod
+    def upgrade_recorded(cls, link: dict[str, Any]) -> None:
+        """Fill a recorded link config in place with the fields added since; ``beyond_loopback`` with what that
+        run needed (a run recorded beyond loopback did so without the opt-in asked for now)."""
+        for key, value in cls.added_without_effect.items():
+            if key == "beyond_loopback" and key not in link:
+                value = any(isinstance(link.get(k), str) and ":" in link[k]
+                            and not is_loopback(split_address(link[k])[0]) for k in ("robot", "brain", "relay"))
+            link.setdefault(key, value)
+
     @model_validator(mode="after")
     def _order(self) -> RealLink:
         _finite(self)
@@ -175,6 +189,7 @@ class ZenohLink(RealLink):
     """eclipse-zenoh peers joined by explicit TCP endpoints (no multicast scouting), optionally TLS."""
 
     kind: Literal["zenoh"] = "zenoh"
+    added_without_effect: ClassVar[dict[str, Any]] = {**RealLink.added_without_effect, "tls": None}
     namespace: str = Field("cerebx", pattern=r"^[A-Za-z0-9_\-]+$", description="first part of the key expressions")
     tls: ZenohTls | None = Field(None, description="zenoh's TLS (mTLS by default) on every endpoint; None: TCP")
 
@@ -185,13 +200,5 @@ class UdpLink(RealLink):
     kind: Literal["udp"] = "udp"
 
 
-LINK_ADDED_WITHOUT_EFFECT: dict[str, dict[str, Any]] = {
-    "udp": {"max_clock_uncertainty_ms": 2.0, "beyond_loopback": False},
-    "zenoh": {"max_clock_uncertainty_ms": 2.0, "beyond_loopback": False, "tls": None},
-}
-"""Link fields added since runs were recorded, per kind, with the value that does what those runs did (read by
-``cerebx.schema.legacy.upgrade``). A recorded run beyond loopback did so without the opt-in that is now asked
-for; its recording gets ``beyond_loopback`` filled with what it needs."""
-
-__all__ = ["LINK_ADDED_WITHOUT_EFFECT", "Address", "RealLink", "SheddingConfig", "SimLink", "UdpLink", "ZenohLink",
+__all__ = ["Address", "RealLink", "SheddingConfig", "SimLink", "UdpLink", "ZenohLink",
            "ZenohTls", "is_loopback", "split_address"]

@@ -493,7 +493,7 @@ def run_brain_side(cfg: Any, run_dir: Path, resolved: dict | None = None, overri
         except CerebxError as err:
             raise NotPaired(str(err)) from None
         paired = True
-        return _run_paired(cfg, run_dir, ctx, end, welcome, estimates, shared, resolved, overrides, choices,
+        return _run_paired(cfg, run_dir, ctx, end, welcome, (estimates, shared), resolved, overrides, choices,
                            children)
     finally:
         if transport is not None:
@@ -502,8 +502,10 @@ def run_brain_side(cfg: Any, run_dir: Path, resolved: dict | None = None, overri
 
 
 def _run_paired(cfg: Any, run_dir: Path, ctx: BuildContext, end: LinkEnd, welcome: Packet,
-                estimates: list[clock.OffsetEstimate], shared: bool, resolved: dict | None, overrides: list[str],
+                clock_sync: tuple[list[clock.OffsetEstimate], bool], resolved: dict | None, overrides: list[str],
                 choices: dict[str, str] | None, children: Children) -> dict[str, Any]:
+    """``clock_sync``: the estimates made at pairing (the refused ones first) and whether the clock is shared."""
+    estimates, shared = clock_sync
     run_id = end.run_id or bytes(16)
     life = RunLifecycle(cfg, run_dir, compression=cfg.link.compression, overrides=overrides, resolved=resolved,
                         fields={"presets": dict(choices or {}), "side": "brain"},

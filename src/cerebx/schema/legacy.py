@@ -12,7 +12,6 @@ import copy
 from typing import Any
 
 from cerebx import registry
-from cerebx.link.schema import LINK_ADDED_WITHOUT_EFFECT, is_loopback, split_address
 from cerebx.schema.experiment import ADDED_WITHOUT_EFFECT
 
 
@@ -36,14 +35,13 @@ def _fill(part: dict[str, Any], dotted: str, value: Any) -> None:
 
 
 def _upgrade_link(link: Any) -> None:
-    """A real link recorded before its newer fields: filled in (beyond_loopback as that run needed it)."""
-    if not isinstance(link, dict) or link.get("kind") not in LINK_ADDED_WITHOUT_EFFECT:
+    """A real link recorded before its newer fields: filled in by its kind's schema (``upgrade_recorded``)."""
+    kind = link.get("kind") if isinstance(link, dict) else None
+    if not isinstance(kind, str) or kind not in registry.links:
         return
-    for key, value in LINK_ADDED_WITHOUT_EFFECT[link["kind"]].items():
-        if key == "beyond_loopback" and key not in link:
-            value = any(isinstance(link.get(k), str) and ":" in link[k]
-                        and not is_loopback(split_address(link[k])[0]) for k in ("robot", "brain", "relay"))
-        link.setdefault(key, copy.deepcopy(value))
+    fill = getattr(registry.links[kind].schema, "upgrade_recorded", None)
+    if callable(fill):
+        fill(link)
 
 
 def upgrade(config: dict[str, Any]) -> dict[str, Any]:
