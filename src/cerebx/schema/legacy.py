@@ -35,12 +35,23 @@ def _fill(part: dict[str, Any], dotted: str, value: Any) -> None:
         node[last] = copy.deepcopy(value)
 
 
+def _upgrade_link(link: Any) -> None:
+    """A real link recorded before its newer fields: filled in by its kind's schema (``upgrade_recorded``)."""
+    kind = link.get("kind") if isinstance(link, dict) else None
+    if not isinstance(kind, str) or kind not in registry.links:
+        return
+    fill = getattr(registry.links[kind].schema, "upgrade_recorded", None)
+    if callable(fill):
+        fill(link)
+
+
 def upgrade(config: dict[str, Any]) -> dict[str, Any]:
     """A copy of a recorded experiment config in today's layout (unchanged when it already is)."""
     registry.load_plugins()
     out = copy.deepcopy(config)
     for key, value in ADDED_WITHOUT_EFFECT.items():
         out.setdefault(key, copy.deepcopy(value))
+    _upgrade_link(out.get("link"))
     network = out.pop("network", None)
     controller = out.get("controller")
     if not isinstance(controller, dict):
