@@ -40,6 +40,8 @@ def upgrade(config: dict[str, Any]) -> dict[str, Any]:
     out = copy.deepcopy(config)
     for key, value in ADDED_WITHOUT_EFFECT.items():
         out.setdefault(key, copy.deepcopy(value))
+    if isinstance(out.get("recording"), dict):
+        out["recording"].setdefault("trials", None)  # recording.trials: every trial, as before windows
     network = out.pop("network", None)
     controller = out.get("controller")
     if not isinstance(controller, dict):
