@@ -24,7 +24,6 @@ import sys
 import time
 from pathlib import Path
 
-from hydra.core.override_parser.overrides_parser import OverridesParser
 from mcap.exceptions import McapError
 from mcap.reader import NonSeekingReader, make_reader
 from mcap.records import Message, Metadata
@@ -40,20 +39,8 @@ TRIAL_TOPICS_READ = ["/trial_metrics"]
 
 
 def study_recording(profile: str) -> dict[str, tuple[TrialWindow | None, bool]]:
-    """Each study's window (None: every trial) and whether it records joint states, from its overrides."""
-    parser = OverridesParser.create()
-    out = {}
-    for name, spec in with_replicas(load_studies(), profile).items():
-        window, joints = None, True
-        for arg in [*spec.args, *getattr(spec, profile).args]:
-            key = arg.split("=", 1)[0].lstrip("+~")
-            if key == "recording.trials":
-                value = parser.parse_overrides([arg])[0].value()
-                window = None if value in (None, "all") else TrialWindow() if value == "none" else TrialWindow(**value)
-            elif key == "recording.joint_states":
-                joints = bool(parser.parse_overrides([arg])[0].value())
-        out[name] = (window, joints)
-    return out
+    """Each study's window (None: every trial) and whether it records joint states (seeds included)."""
+    return {name: spec.recording(profile) for name, spec in with_replicas(load_studies(), profile).items()}
 
 
 def trial_spans(run_dir: Path) -> list[tuple[int, int, int]]:

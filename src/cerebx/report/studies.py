@@ -45,7 +45,8 @@ from cerebx.recording.summary import read_summary
 from cerebx.report.convergence import MIN_WINDOW, TOLERANCE, WINDOW_FRACTION, PlateauRule
 from cerebx.report.registry import STUDY_FILES, load_reports
 from cerebx.schema.base import Strict
-from cerebx.schema.experiment import format_errors, validate
+from cerebx.schema.experiment import RecordingConfig, format_errors, validate
+from cerebx.schema.window import TrialWindow
 
 PROFILES = ("quick", "full")
 M = TypeVar("M", bound=Strict)
@@ -85,6 +86,22 @@ class StudySpec(Strict):
     full: ProfileSpec = Field(description="the full profile (the paper's trial counts)")
     plateau: PlateauSpec = Field(default_factory=PlateauSpec, description="when a run of this study that learns "
                                  "has levelled off (the report's convergence badge)")
+
+
+    def recording(self, profile: str) -> tuple[TrialWindow | None, bool]:
+        """The window (``recording.trials``; None: every trial) and ``recording.joint_states`` its runs record
+        in ``profile``, from its overrides (the last one given wins, as in Hydra)."""
+        window, joints = None, True
+        parser = OverridesParser.create()
+        for arg in [*self.args, *getattr(self, profile).args]:
+            key = _key(arg)
+            if key in ("recording.trials", "recording.joint_states"):
+                value = parser.parse_overrides([arg])[0].value()
+                if key == "recording.joint_states":
+                    joints = bool(value)
+                else:
+                    window = RecordingConfig(trials=value).trials
+        return window, joints
 
 
 class StudiesFile(Strict):
