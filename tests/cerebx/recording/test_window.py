@@ -158,3 +158,15 @@ def test_a_resumed_run_keeps_its_windows(tmp_path):
     for topic in ("/trial_metrics", "/control", "/joint_states/actual"):
         assert list(read_messages(killed, [topic])) == list(read_messages(whole, [topic])), topic
     assert np.std(read_summary(whole)["mae_per_trial"]) > 0
+
+
+def test_the_size_estimate_counts_the_held_trials(tmp_path):
+    """The disk estimate of a windowed run is within 30 % of what it writes, about a third of the whole run's."""
+    from cerebx.config import load
+    from cerebx.estimate import estimate
+
+    whole, windowed = load(PD)[0], load([*PD, "recording.trials={first:2}"])[0]
+    run_experiment(windowed, tmp_path)
+    written = (tmp_path / "run.mcap").stat().st_size
+    assert abs(estimate(windowed).mcap_bytes / written - 1) < 0.3, (estimate(windowed), written)
+    assert estimate(windowed).mcap_bytes == pytest.approx(estimate(whole).mcap_bytes / 3)
