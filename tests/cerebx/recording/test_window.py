@@ -170,3 +170,20 @@ def test_the_size_estimate_counts_the_held_trials(tmp_path):
     written = (tmp_path / "run.mcap").stat().st_size
     assert abs(estimate(windowed).mcap_bytes / written - 1) < 0.3, (estimate(windowed), written)
     assert estimate(windowed).mcap_bytes == pytest.approx(estimate(whole).mcap_bytes / 3)
+
+
+def test_the_delay_table_of_a_run_without_delay_needs_no_control_step(tmp_path):
+    """delays.csv lists every run launched with a delay preset; one without a link delay has a realised round trip
+    of 0 ms whatever its window, so a run recording no control step still reads 0.0 (as one recording every step)."""
+    from cerebx.config import load
+    from cerebx.report.delays import delay_rows
+    from cerebx.report.runs import Run, RunSet
+
+    rows = {}
+    for name, extra in (("whole", []), ("none", ["recording.trials=none"])):
+        exp, plain = load([*PD, "trials=2", *extra])
+        run_experiment(exp, tmp_path / name, plain, choices={"delay": "none"})
+        rows[name] = delay_rows(RunSet([Run.load(tmp_path / name)]))[1]
+    assert channel_counts(tmp_path / "none").get("/control", 0) == 0
+    assert rows["none"][4] == rows["whole"][4] == "0.0"
+    assert rows["none"][:-1] == rows["whole"][:-1]
