@@ -50,7 +50,9 @@ def test_fig3_5_densities_are_held(study, profile):
 
 
 @pytest.mark.parametrize("profile", PROFILES)
-@pytest.mark.parametrize("study", ["fig3_4_snn", "fig3_4_ann", "fig3_5_snn_circle", "fig3_5_ann_circle"])
+@pytest.mark.parametrize("study", ["fig3_4_snn", "fig3_4_ann", *(f"fig3_5_{c}_{t}" for c in ("snn", "ann")
+                                                                   for t in ("circle", "inclined_circle",
+                                                                             "circle_eight"))])
 def test_torque_variability_runs_hold_every_trial_with_joint_states(study, profile):
     held, n, joints = _held(study, profile)
     assert held == set(range(n)) and joints
