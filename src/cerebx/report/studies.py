@@ -46,9 +46,26 @@ from cerebx.report.convergence import PlateauRule
 from cerebx.report.registry import STUDY_FILES, load_reports
 from cerebx.report.schema import PROFILES, ProfileSpec, StudiesFile, StudySpec
 from cerebx.schema.base import Strict
-from cerebx.schema.experiment import format_errors, validate
+from cerebx.schema.experiment import RecordingConfig, format_errors, validate
+from cerebx.schema.window import TrialWindow
 
 M = TypeVar("M", bound=Strict)
+
+
+def study_recording(spec: StudySpec, profile: str) -> tuple[TrialWindow | None, bool]:
+    """The window (``recording.trials``; None: every trial) and ``recording.joint_states`` the runs of study
+    ``spec`` record in ``profile``, from its overrides (the last one given wins, as in Hydra)."""
+    window, joints = None, True
+    parser = OverridesParser.create()
+    for arg in [*spec.args, *getattr(spec, profile).args]:
+        key = _key(arg)
+        if key in ("recording.trials", "recording.joint_states"):
+            value = parser.parse_overrides([arg])[0].value()
+            if key == "recording.joint_states":
+                joints = bool(value)
+            else:
+                window = RecordingConfig(trials=value).trials
+    return window, joints
 
 
 def load_studies(*paths: Path) -> dict[str, StudySpec]:

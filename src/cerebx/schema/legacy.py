@@ -52,6 +52,8 @@ def upgrade(config: dict[str, Any]) -> dict[str, Any]:
     for key, value in ADDED_WITHOUT_EFFECT.items():
         out.setdefault(key, copy.deepcopy(value))
     _upgrade_link(out.get("link"))
+    if isinstance(out.get("recording"), dict):
+        out["recording"].setdefault("trials", None)  # recording.trials: every trial, as before windows
     network = out.pop("network", None)
     controller = out.get("controller")
     if not isinstance(controller, dict):
