@@ -131,3 +131,36 @@ def test_far_distance_bounds_the_skipped_activations():
         q = far_distance(w, bisquare=True)
         assert q == pytest.approx(4 * (1 - np.sqrt(w)), rel=1e-8) and (1 - q / 4) ** 2 < w
     assert far_distance(0.0, bisquare=False) == np.inf
+
+
+def test_any_array_like_input_learns_what_float64_rows_learn():
+    """``update`` and ``predict`` take the caller's float64 C-contiguous rows as they are and convert anything
+    else (lists, float32, read-only, strided, 2-D single rows) to the same values: the same model bit for bit.
+    Two models of one shape share their compiled kernels but not their state."""
+    rng = np.random.default_rng(8)
+    xs = rng.uniform(-1, 1, (400, 2)).astype(np.float32).astype(np.float64)  # exact in float32 too
+    ys = cross(xs)[:, None]
+    ref, other = LWPR(2, 1, initial_capacity=2), LWPR(2, 1, initial_capacity=2)
+    for x, y in zip(xs, ys):
+        ref.update(x, y)
+    frozen = xs.copy()
+    frozen.flags.writeable = False
+    strided = np.asfortranarray(xs)  # its rows are not contiguous
+    for t, (x, y) in enumerate(zip(xs, ys)):
+        form = t % 5
+        if form == 0:
+            other.update(list(x), float(y[0]))
+        elif form == 1:
+            other.update(x.astype(np.float32).reshape(1, 2), y)
+        elif form == 2:
+            other.update(frozen[t], y)
+        elif form == 3:
+            other.update(strided[t], y.reshape(1, 1))
+        else:
+            other.update(x, y)
+    assert other.n_receptive_fields == ref.n_receptive_fields and ref.n_receptive_fields[0] > 2
+    for x in rng.uniform(-1, 1, (20, 2)):
+        want = ref.predict(x)
+        for form in (list(x), x.reshape(1, 2), np.asfortranarray(np.stack([x, x]))[0], x):
+            np.testing.assert_array_equal(other.predict(form), want)
+    assert ref.predict(xs[0]) is not ref.predict(xs[0])  # a new array each call
