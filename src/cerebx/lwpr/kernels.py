@@ -16,15 +16,15 @@ Before them in the buffer: ``cfg`` (``HP_*``: sizes and hyper-parameters, then `
 ``count``, ``pred`` (the last ``update`` or ``predict``, per output) and the scratch of one update
 (:class:`Work`).
 
-Speed: the entry points are compiled per model shape (:func:`entry_point`), with n_in and n_out as
-constants, so that the loops over inputs, directions and outputs have fixed lengths (unrolled: 1.8 x the
-updates per second on the 2-D cross, 2.5 x in 1-D). A call from Python costs about 100 ns per array argument
-(numba wraps each in a new reference-counted object), hence the model is passed as its buffer's address and a
-sample's prediction left in the buffer. Inside, the kernels pass named tuples of views without a reference count (:func:`_view`,
-:func:`_borrow`) to helpers that numba inlines: numba counts references to every array value a helper binds
-with atomic operations, which fold away on such views but on owned arrays cost more than the arithmetic of
-an RF update. RFs too far from x for their activation to matter skip the exponential; the entry points are
-compiled without LLVM's vectorizers.
+Speed: the entry points are compiled per model shape (:func:`entry_point`), with n_in and n_out as constants,
+so that the loops over inputs, directions and outputs have fixed lengths (unrolled: 1.8 x the updates per
+second on the 2-D cross, 2.5 x in 1-D). A call from Python costs about 100 ns per array argument (numba wraps
+each in a new reference-counted object), hence the model is passed as its buffer's address and a sample's
+prediction left in the buffer. Inside, the kernels pass named tuples of views without a reference count
+(:func:`_view`, :func:`_borrow`) to helpers that numba inlines: numba counts references to every array value a
+helper binds with atomic operations, which fold away on such views but on owned arrays cost more than the
+arithmetic of an RF update. RFs too far from x for their activation to matter skip the exponential; the entry
+points are compiled without LLVM's vectorizers.
 The meta learning of the learning rates (IDBD) of the reference library is not implemented.
 """
 
