@@ -59,16 +59,22 @@ def _head(p: LWPRParams, n_in: int, n_out: int) -> np.ndarray:
 def _buffer(head: np.ndarray, norm_in: np.ndarray, norm_out: np.ndarray, capacity: int) -> tuple[np.ndarray, K.Store]:
     """A zeroed model buffer holding ``capacity`` RF slots per output, and numpy views of its RF arrays."""
     n_in, n_out = len(norm_in), len(norm_out)
-    o_in, o_out, o_count, _, _, o_mat, o_vec, o_sca, size = K.regions(n_in, n_out, capacity)
+    o_in, o_out, o_count, *_, size = K.regions(n_in, n_out, capacity)
     buf = np.zeros(size)
     buf[: K.N_HP] = head
     buf[K.H_CAPACITY] = capacity
     buf[o_in:o_out], buf[o_out:o_count] = norm_in, norm_out
-    store = K.Store(buf[o_mat:o_vec].reshape(n_out, capacity, K.N_MAT, n_in, n_in),
-                    buf[o_vec:o_sca].reshape(n_out, capacity, K.N_VEC, n_in),
-                    buf[o_sca:size].reshape(n_out, capacity, K.N_SCA),
-                    buf[o_count:o_count + n_out * K.N_COUNT].reshape(n_out, K.N_COUNT))
-    return buf, store
+    return buf, _views(buf, n_in, n_out)
+
+
+def _views(buf: np.ndarray, n_in: int, n_out: int) -> K.Store:
+    """numpy views of the RF arrays of a model buffer."""
+    capacity = int(buf[K.H_CAPACITY])
+    _, _, o_count, _, _, o_mat, o_vec, o_sca, size = K.regions(n_in, n_out, capacity)
+    return K.Store(buf[o_mat:o_vec].reshape(n_out, capacity, K.N_MAT, n_in, n_in),
+                   buf[o_vec:o_sca].reshape(n_out, capacity, K.N_VEC, n_in),
+                   buf[o_sca:size].reshape(n_out, capacity, K.N_SCA),
+                   buf[o_count:o_count + n_out * K.N_COUNT].reshape(n_out, K.N_COUNT))
 
 
 class LWPR:
@@ -111,6 +117,28 @@ class LWPR:
 
     def _kernel(self, name: str) -> Any:
         return K.entry_point(name, self.n_in, self.n_out)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled (checkpoints) without what points into the buffer or at compiled code: the address, the
+        views (a pickle would hold them as copies) and the kernels."""
+        state = self.__dict__.copy()
+        for name in ("_store", "_addr", "_pred", "_update", "_predict"):
+            state.pop(name, None)
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """A state of :meth:`__getstate__`, or the pickled ``__dict__`` of earlier code, whose buffer had no
+        pred region: its RF arrays (``_store``) then go into a buffer of today's layout."""
+        old = state.pop("_store", None)  # only earlier code pickled it
+        self.__dict__.update(state)
+        self._update = K.entry_point("update", self.n_in, self.n_out)
+        self._predict = K.entry_point("predict", self.n_in, self.n_out)
+        if old is None:
+            self._use(self._buf, _views(self._buf, self.n_in, self.n_out))
+            return
+        self._use(*_buffer(self._head, self.norm_in, self.norm_out, old.mat.shape[1]))
+        for a, b in zip(old, self._store):
+            b[:] = a
 
     def _grow(self) -> None:
         """Move the model to a buffer with twice the RF slots per output."""
