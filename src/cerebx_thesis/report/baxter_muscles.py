@@ -176,7 +176,8 @@ def fig4_6(runs: RunSet, stem: Path) -> Figure:
     sag_sprung = {k: v for k, r in sprung.items() if (v := payload_sag_cm(r)) is not None}
     spring_label = _spring_label(list(sprung.values()))
     if sag_sprung:
-        ax_b.plot(list(sag_sprung), list(sag_sprung.values()), "o:", color="C2", label=f"cerebx {spring_label} (diagnostic)")
+        ax_b.plot(list(sag_sprung), list(sag_sprung.values()), "o:", color="C2",
+                  label=f"cerebx {spring_label} (diagnostic)")
     ax_b.set_xlabel("cocontraction c (multiple of the x1 baseline)")
     ax_b.set_ylabel("end-effector sag Δz with 2 kg (cm)")
     for letter, ax in (("A", ax_a), ("B", ax_b)):
@@ -212,7 +213,8 @@ def fig4_6(runs: RunSet, stem: Path) -> Figure:
     checks += _sag_values(got)
     for k in ks:
         if (v := sag_sprung.get(float(k))) is not None:
-            table.append([f"B (diagnostic, {spring_label}): sag at c = x{k} (cm)", f"{THESIS_SAG_CM[k]:.1f}", fmt(v, 1)])
+            table.append([f"B (diagnostic, {spring_label}): sag at c = x{k} (cm)", f"{THESIS_SAG_CM[k]:.1f}",
+                          fmt(v, 1)])
     n_seeds = max((iv.n for iv in intervals.values()), default=1)
     caption = ("Fig. 4.6. (A) Position MAE of the cerebellar SNN driving one Ekeberg muscle pair per joint "
                "(Eq. 4.6, Table 4.1) on the eight-like trajectory, each cocontraction profile learnt from scratch "
