@@ -30,7 +30,7 @@ def load_network(source: str, overrides: list[str] | None = None) -> NetworkConf
             raise CerebxError(f"{source}: holds no network (populations and projections, or controller.network)")
         for item in overrides or []:
             _override(net, item, source)
-        return _validate(net, source)
+        return _validate(_sized(net, doc if isinstance(doc, dict) else {}, source), source)
     from cerebx.config import compose, to_plain  # Hydra only when a preset is composed
 
     try:
@@ -40,7 +40,24 @@ def load_network(source: str, overrides: list[str] | None = None) -> NetworkConf
     net = _network_part(plain)
     if net is None:
         raise CerebxError(f"{source}: the composed controller has no network")
-    return _validate(net, f"network={source}")
+    return _validate(_sized(net, plain, f"network={source}"), f"network={source}")
+
+
+def _sized(net: dict, experiment: dict, where: str) -> dict:
+    """A network written per joint (``per_joint``, snn/sizing.py) sized for the experiment's plant, as a run
+    sizes it; a bare network file with ``per_joint`` names no plant and is refused."""
+    from cerebx.snn.sizing import KEY, plant_joints, sized_network
+
+    if KEY not in net:
+        return net
+    joints = plant_joints(experiment)
+    if joints is None:
+        raise CerebxError(f"{where}: per_joint: the network is sized from a plant's joints; give a whole experiment "
+                          "(e.g. a run's config.yaml) or a network preset")
+    try:
+        return sized_network(net, joints)
+    except ValueError as err:
+        raise CerebxError(f"{where}: {err}") from None
 
 
 def _override(net: dict, item: str, source: str) -> None:

@@ -287,3 +287,18 @@ def test_a_network_file_takes_overrides_of_its_keys():
     assert cfg.projections["goc_gc"].rule.kind == "fixed_indegree" and cfg.projections["mf_gc"].rule.p == 0.1
     with pytest.raises(CerebxError, match="override 'nope.x=1': not key=value"):
         load_network(str(vocab), ["nope.x=1"])
+
+
+def test_a_network_written_per_joint_is_sized_for_the_composed_plant(tmp_path):
+    """`cerebx export/crosscheck small_golgi` sizes the per-joint preset as a run on its plant would; a bare
+    network file written per joint names no plant and is refused in one line."""
+    from cerebx.errors import CerebxError
+    from cerebx.export.source import load_network
+
+    six = load_network("small_golgi")
+    two = load_network("small_golgi", ["plant=planar2"])
+    assert six.populations["pc"].size // 6 == two.populations["pc"].size // 2 > 0 and two.populations["pc"].size < 60
+    bare = tmp_path / "net.yaml"
+    bare.write_text("populations: {}\nprojections: {}\nper_joint: {pc: 10}\n")
+    with pytest.raises(CerebxError, match="per_joint: the network is sized from a plant"):
+        load_network(str(bare))
