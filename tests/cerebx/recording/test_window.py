@@ -6,15 +6,12 @@ from __future__ import annotations
 
 import collections
 import json
-import os
 import signal
-import subprocess
-import sys
-import time
-from pathlib import Path
 
 import numpy as np
 import pytest
+from run_processes import cerebx_run as _cerebx
+from run_processes import wait_for_checkpoint as _wait_for_checkpoint
 
 from cerebx.errors import ConfigError
 from cerebx.loop import resume
@@ -50,27 +47,6 @@ def test_recording_trials_values(load):
         with pytest.raises(ConfigError) as err:
             load(["+task=circle", "controller=pd", f"recording.trials={bad}"])
         assert str(err.value).startswith(says) and "\n" not in str(err.value)
-
-
-def _cerebx(*args: str, cwd: Path) -> subprocess.Popen:
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[3] / "src")}
-    return subprocess.Popen([sys.executable, "-m", "cerebx", "run", *args], cwd=cwd, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-
-
-def _wait_for_checkpoint(run_dir: Path, trials: int, proc: subprocess.Popen, timeout_s: float = 120) -> None:
-    head = run_dir / (resume.CHECKPOINT + ".json")
-    t0 = time.monotonic()
-    while time.monotonic() - t0 < timeout_s:
-        if proc.poll() is not None:
-            pytest.fail(f"run ended before its checkpoint: {proc.stdout.read()}")
-        try:
-            if json.loads(head.read_text())["trials_done"] >= trials:
-                return
-        except (OSError, ValueError):
-            pass
-        time.sleep(0.05)
-    pytest.fail(f"no checkpoint at trial {trials} within {timeout_s} s")
 
 
 def _control_trials(run_dir) -> collections.Counter:
