@@ -346,8 +346,9 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--profile", choices=("quick", "full"),
                     help="run the missing studies of this profile into runs/report/PROFILE first")
     ap.add_argument("--figures", help="comma-separated figure names (default: all; --list shows them)")
-    ap.add_argument("--jobs", type=int, default=2, help="studies run at once (default 2); each is one "
-                    "`cerebx run -m`, whose launcher runs its jobs")
+    ap.add_argument("--jobs", type=int, default=2, help="multiruns at once (default 2); each is one "
+                    "`cerebx run -m`, whose launcher runs its jobs; a sweep is split into this many multiruns "
+                    "side by side (by its swept key with the most values), so one long sweep keeps every core busy")
     ap.add_argument("-o", "--override", action="append", default=[], metavar="OVERRIDE",
                     help="Hydra override for every study's multirun, e.g. -o hydra/launcher=slurm "
                     "(repeatable; see docs/guide/sweeps.md)")
@@ -374,7 +375,7 @@ def main(argv: list[str]) -> int:
                 dry_run(jobs, root / a.profile, a.jobs)
                 return 0
             try:
-                failed = execute(group(jobs), runner=study_runner(a.override), parallel=a.jobs)
+                failed = execute(group(jobs, a.jobs), runner=study_runner(a.override), parallel=a.jobs)
             except KeyboardInterrupt:
                 print("report: interrupted; finished runs are kept (run the same command again to resume)",
                       file=sys.stderr)

@@ -18,6 +18,7 @@ fewer). The figures draw their curves from the first seed and take their headlin
 from __future__ import annotations
 
 import functools
+import re
 import shutil
 import signal
 import subprocess
@@ -307,11 +308,12 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
 
 @dataclass
 class Study:
-    """The jobs of one study, run together as one ``cerebx run -m``."""
+    """The jobs of one study, run together as one ``cerebx run -m`` (or a part of them: see :func:`group`)."""
 
     name: str
     jobs: list[Job]
     deps: list[Study] = field(default_factory=list, repr=False)
+    part: tuple[str, tuple[str, ...], int] | None = None  # (swept key, its values in this part, part number)
 
     @property
     def sweep_dir(self) -> Path:
@@ -324,6 +326,11 @@ class Study:
     @property
     def run_dir(self) -> Path:  # where its log goes
         return self.sweep_dir
+
+    @property
+    def log_name(self) -> str:
+        """Its ``cerebx run -m``'s log in :attr:`sweep_dir` (a part has its own: parts run side by side)."""
+        return "study.log" if self.part is None else f"study.{self.part[2]}.log"
 
     def done(self) -> bool:
         return all(j.done() for j in self.jobs)
@@ -340,8 +347,11 @@ class Study:
         """``cerebx run -m`` overrides: the shared ones, then where the jobs go, then ``extra`` (a launcher)."""
         common = self.jobs[0].common()
         swept = bool(self.jobs[0].sweep_args)
-        out = ["-m", *self.jobs[0].common(sweeps=True), "resume=auto", "recording.progress=off",
-               f"hydra.sweep.dir='{self.sweep_dir}'"]
+        shared = self.jobs[0].common(sweeps=True)
+        if self.part is not None:  # this part's values of one swept key replace the study's (the preset's too:
+            key, values, _ = self.part  # Hydra's basic sweeper lets the command line win)
+            shared = [*(a for a in shared if _key(a) != key), f"{key}={','.join(values)}"]
+        out = ["-m", *shared, "resume=auto", "recording.progress=off", f"hydra.sweep.dir='{self.sweep_dir}'"]
         if swept and self.name == self.jobs[0].name:  # one job of a paired study: its sweep point fixed
             out += [*self.jobs[0].sweep_args, f"hydra.sweep.subdir='{self.jobs[0].label}'"]
         elif swept:
@@ -353,17 +363,48 @@ class Study:
         return [*out, *extra]
 
 
-def group(jobs: list[Job]) -> list[Study]:
+_PLAIN_VALUE = re.compile(r"[\w.+-]+")  # a sweep value that can be listed again with commas as it is
+
+
+def split_sweep(jobs: list[Job], parts: int) -> list[tuple[str, tuple[str, ...]]]:
+    """How a sweep's ``jobs`` share out over ``parts`` multiruns side by side: the swept key with the most
+    values, its values dealt in turn (``seed=0,2,4…`` and ``seed=1,3,5…``), so that each part holds every
+    value of the other keys and the parts take about as long. ``[]`` when it does not split (one part, fewer
+    than two values, or values that cannot be written back as a comma list)."""
+    values: dict[str, dict[str, None]] = {}
+    for j in jobs:
+        for arg in j.sweep_args:
+            key, _, value = arg.partition("=")
+            values.setdefault(key, {})[value] = None
+    plain = {k: list(v) for k, v in values.items() if all(_PLAIN_VALUE.fullmatch(x) for x in v)}
+    if parts < 2 or not plain:
+        return []
+    key = max(plain, key=lambda k: len(plain[k]))
+    n = min(parts, len(plain[key]))
+    return [(key, tuple(plain[key][i::n])) for i in range(n)] if n > 1 else []
+
+
+def group(jobs: list[Job], parts: int = 1) -> list[Study]:
     """The jobs as studies (in plan order), each depending on the studies its jobs start from. A study whose
     jobs start from the jobs of the same sweep values of another (paired) runs each job as its own multirun
-    of one job, as each has its own ``init_from``."""
+    of one job, as each has its own ``init_from``. ``parts``: a sweep is run as that many multiruns side by
+    side into its folder (:func:`split_sweep`), so that one long sweep keeps every core busy."""
     studies: dict[str, Study] = {}
     of_job: dict[str, Study] = {}
     for j in jobs:
         paired = bool(j.sweep_args) and any(d.sweep_args for d in j.deps)
         st = studies.setdefault(j.name if paired else j.study, Study(j.name if paired else j.study, []))
         st.jobs.append(j)
-        of_job[j.name] = st
+    for name, st in list(studies.items()):
+        split = split_sweep(st.jobs, parts) if st.jobs[0].sweep_args and st.name == st.jobs[0].study else []
+        if split:
+            del studies[name]
+            for k, (key, values) in enumerate(split, 1):
+                mine = [j for j in st.jobs if any(f"{key}={v}" in j.sweep_args for v in values)]
+                studies[f"{name}:{k}/{len(split)}"] = Study(f"{name}:{k}/{len(split)}", mine, part=(key, values, k))
+    for st in studies.values():
+        for j in st.jobs:
+            of_job[j.name] = st
     for st in studies.values():
         st.deps = list({id(of_job[d.name]): of_job[d.name] for j in st.jobs for d in j.deps
                         if d.name in of_job}.values())
@@ -404,7 +445,7 @@ def study_runner(extra: list[str] = ()) -> Runner:
     def run(study: Study) -> int:
         study.sweep_dir.mkdir(parents=True, exist_ok=True)
         cmd = [sys.executable, "-m", "cerebx", "run", *study.overrides(list(extra))]
-        return _run_logged(cmd, study.sweep_dir / "study.log", "a")
+        return _run_logged(cmd, study.sweep_dir / study.log_name, "a")
 
     return run
 
@@ -473,7 +514,7 @@ class _Scheduler:
                 self.running[pool.submit(self.runner, j)] = j
 
     def _record(self, j: Any, fut: Future) -> None:
-        logname = "study.log" if isinstance(j, Study) else "job.log"
+        logname = j.log_name if isinstance(j, Study) else "job.log"
         try:
             rc, why = fut.result(), f"see {j.run_dir / logname}"
         except Exception as err:  # a runner that raises is a failed job, not a failed report

@@ -274,3 +274,53 @@ def test_plant_realism_takes_the_study_runs_not_chapter_3_runs_on_the_same_plant
     runs = RunSet([study, run("fig3_4", "snn_delays", [150.0], 102, 0.019),
                    run("multikernel", "snn", [100.0, 150.0, 200.0], 102, 0.033)])
     assert realism_cells(runs) == {("baxter", "snn", 0.0): study}
+
+
+def test_a_sweep_is_split_so_that_every_core_runs_part_of_it(tmp_path):
+    """One long sweep would leave a core idle: with two parts, each multirun sweeps every other value of the
+    key with the most values, into the same folder, with its own log, and the parts hold every job once."""
+    from cerebx.report.studies import group, split_sweep
+
+    f = tmp_path / "studies.yaml"
+    f.write_text("studies:\n  a:\n    args: [+experiment=fig3_4_pd, 'seed=0,1,2']\n"
+                 "    quick: {trials: 1}\n    full: {trials: 2}\n")
+    jobs = plan("quick", tmp_path, studies=load_studies(f))
+    assert len(jobs) == 15  # 5 delays x 3 seeds
+    assert split_sweep(jobs, 2) == [("delay.total_ms", ("0", "40", "80")), ("delay.total_ms", ("20", "60"))]
+    assert split_sweep(jobs, 1) == [] and split_sweep(jobs[:1], 2) == []
+    parts = group(jobs, 2)
+    assert [p.name for p in parts] == ["a:1/2", "a:2/2"]
+    assert sorted(j.name for p in parts for j in p.jobs) == sorted(j.name for j in jobs)
+    ov = parts[1].overrides()
+    assert "delay.total_ms=20,60" in ov and "seed=0,1,2" in ov
+    assert {p.sweep_dir for p in parts} == {tmp_path / "quick" / "a"}
+    assert [p.log_name for p in parts] == ["study.1.log", "study.2.log"]
+    assert group(jobs)[0].log_name == "study.log" and len(group(jobs)) == 1
+    # the command-line values win over the preset's sweep: Hydra runs exactly this part's jobs
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+    from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
+
+    parsed = OverridesParser.create().parse_overrides(["delay.total_ms=0,20,40,60,80", "delay.total_ms=20,60"])
+    (batch,) = BasicSweeper.split_arguments(parsed, None)
+    assert sorted(o[0] for o in batch) == ["delay.total_ms=20", "delay.total_ms=60"]
+
+
+def test_the_parts_of_a_split_sweep_run_side_by_side_and_its_dependents_wait(tmp_path):
+    from cerebx.report.studies import group
+
+    ran: list[str] = []
+
+    def fake(study) -> int:
+        ran.append(study.name)
+        for job in study.jobs:
+            _complete(job)
+        return 0
+
+    jobs = plan("quick", tmp_path, ["fig4_6a"])
+    studies = group(jobs, 2)
+    learn = [s for s in studies if s.name.startswith("fig4_6a_learn:")]
+    assert len(learn) == 2 and all(len(s.jobs) == 3 for s in learn)
+    paired = next(s for s in studies if s.name == "fig4_6a/muscle.cocontraction=5")
+    assert paired.deps == [next(s for s in learn if any(j.label == "muscle.cocontraction=5" for j in s.jobs))]
+    execute(studies, runner=fake, parallel=2, log=lambda line: None)  # (the fake saves no state to start from)
+    assert set(ran[:2]) == {s.name for s in learn} and len(ran) == 8  # both parts first, then the 6 that wait
