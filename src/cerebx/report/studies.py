@@ -82,6 +82,9 @@ def load_studies(*paths: Path) -> dict[str, StudySpec]:
                 raise ConfigError(f"{path}: studies.{name}: already defined in {where[name]}")
             studies[name], where[name] = spec, path
     for name, s in studies.items():
+        if s.full.from_full:
+            raise ConfigError(f"{where[name]}: studies.{name}.full.from_full: only the quick profile can draw on "
+                              "the full profile's runs")
         for prof in PROFILES:
             if getattr(s, prof).seeds > 1 and any(_key(a) == "seed" for a in [*s.args, *getattr(s, prof).args]):
                 raise ConfigError(f"{where[name]}: studies.{name}.{prof}.seeds: the study sets its seed itself "
@@ -220,6 +223,7 @@ class Job:
 
     sweep_args: list[str] = field(default_factory=list)  # this job's point of its preset's sweep
     sweeps: list[str] = field(default_factory=list)  # the study's args that sweep several values (seed=0,1,2)
+    borrowed: bool = False  # a full-profile run a quick report draws on (from_full): used if done, never run
 
     def overrides(self) -> list[str]:
         return [*self.common(), *self.sweep_args]
@@ -267,7 +271,8 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
     ``max_seeds``: only the first seeds of studies learned from more (e.g. 1: every study's first seed)."""
     if profile not in PROFILES:
         raise ConfigError(f"--profile: {profile!r} is not one of {', '.join(PROFILES)}")
-    studies = with_replicas(load_studies() if studies is None else studies, profile, max_seeds)
+    given = load_studies() if studies is None else studies
+    studies = with_replicas(given, profile, max_seeds)
     wanted: list[str] = []
 
     def want(n: str) -> None:
@@ -284,7 +289,17 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
 
     for n in names if names is not None else list(studies):
         want(n)
+    borrowed: list[str] = []  # from_full, or starting from a study that is: the full profile's runs
+    for n in wanted:
+        if getattr(studies[n], profile).from_full or _init_from(studies[n], profile) in borrowed:
+            borrowed.append(n)
     jobs: list[Job] = []
+    if borrowed:
+        bases = list(dict.fromkeys(n.split(REPLICA)[0] for n in borrowed))
+        jobs = plan("full", root, bases, given, max_seeds)
+        for j in jobs:
+            j.borrowed = True
+        wanted = [n for n in wanted if n not in borrowed]
     single: dict[str, Job] = {}
     by_label: dict[tuple[str, str], Job] = {}
     for n in wanted:

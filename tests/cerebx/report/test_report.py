@@ -237,20 +237,20 @@ def test_studies_are_multiruns_of_their_presets(tmp_path):
 def test_init_from_a_study_with_the_same_sweep_pairs_jobs_by_sweep_value(tmp_path):
     from cerebx.report.studies import group
 
-    jobs = plan("quick", tmp_path, ["fig4_6a"])
+    jobs = plan("full", tmp_path, ["fig4_6a"], max_seeds=1)  # quick draws Fig. 4.6 A from full
     by_name = {j.name: j for j in jobs}
     for k in (0, 1, 5, 9, 10, 12):
         job = by_name[f"fig4_6a/muscle.cocontraction={k}"]
         assert [d.name for d in job.deps] == [f"fig4_6a_learn/muscle.cocontraction={k}"]
-        assert f"init_from='{tmp_path}/quick/fig4_6a_learn/muscle.cocontraction={k}'" in job.overrides()
+        assert f"init_from='{tmp_path}/full/fig4_6a_learn/muscle.cocontraction={k}'" in job.overrides()
     studies = group(jobs)
     assert [s.name for s in studies][0] == "fig4_6a_learn" and len(studies) == 7  # one multirun per paired job
     one = studies[3]
     assert one.name == "fig4_6a/muscle.cocontraction=5" and one.deps == [studies[0]]
     ov = one.overrides()
     assert "muscle.cocontraction=5" in ov and "hydra.sweep.subdir='muscle.cocontraction=5'" in ov
-    assert f"init_from='{tmp_path}/quick/fig4_6a_learn/muscle.cocontraction=5'" in ov
-    assert f"hydra.sweep.dir='{tmp_path}/quick/fig4_6a'" in ov
+    assert f"init_from='{tmp_path}/full/fig4_6a_learn/muscle.cocontraction=5'" in ov
+    assert f"hydra.sweep.dir='{tmp_path}/full/fig4_6a'" in ov
     bad = tmp_path / "studies.yaml"
     bad.write_text("studies:\n  a:\n    args: [+experiment=fig3_4_pd]\n"
                    "    quick: {trials: 1}\n    full: {trials: 2}\n"
@@ -316,7 +316,7 @@ def test_the_parts_of_a_split_sweep_run_side_by_side_and_its_dependents_wait(tmp
             _complete(job)
         return 0
 
-    jobs = plan("quick", tmp_path, ["fig4_6a"])
+    jobs = plan("full", tmp_path, ["fig4_6a"], max_seeds=1)
     studies = group(jobs, 2)
     learn = [s for s in studies if s.name.startswith("fig4_6a_learn:")]
     assert len(learn) == 2 and all(len(s.jobs) == 3 for s in learn)
@@ -324,3 +324,37 @@ def test_the_parts_of_a_split_sweep_run_side_by_side_and_its_dependents_wait(tmp
     assert paired.deps == [next(s for s in learn if any(j.label == "muscle.cocontraction=5" for j in s.jobs))]
     execute(studies, runner=fake, parallel=2, log=lambda line: None)  # (the fake saves no state to start from)
     assert set(ran[:2]) == {s.name for s in learn} and len(ran) == 8  # both parts first, then the 6 that wait
+
+
+def test_a_study_that_cannot_converge_in_quick_is_drawn_from_the_full_profile(tmp_path, capsys):
+    """from_full: the quick profile runs neither the study nor those starting from it; it draws on their
+    full-profile runs when they exist, and the dry run says which are there and which lack."""
+    from cerebx.report.build import dry_run
+    from cerebx.report.studies import group
+
+    f = tmp_path / "studies.yaml"
+    f.write_text("studies:\n"
+                 "  learn:\n    args: [+experiment=learn_circle_ch3]\n"
+                 "    quick: {trials: 3, from_full: true}\n    full: {trials: 5}\n"
+                 "  evaluate:\n    args: [+experiment=fig3_4_snn, delay.total_ms=0]\n    init_from: learn\n"
+                 "    quick: {trials: 2}\n    full: {trials: 4}\n"
+                 "  pd:\n    args: [+experiment=fig3_4_pd, delay.total_ms=0]\n"
+                 "    quick: {trials: 2}\n    full: {trials: 4}\n")
+    studies = load_studies(f)
+    jobs = plan("quick", tmp_path, studies=studies)
+    by = {j.study: j for j in jobs}
+    assert by["learn"].borrowed and by["evaluate"].borrowed and not by["pd"].borrowed
+    assert by["learn"].run_dir == tmp_path / "full" / "learn" / "run" and by["learn"].trials == 5
+    assert by["evaluate"].trials == 4 and by["pd"].run_dir == tmp_path / "quick" / "pd" / "run"
+    assert [s.name for s in group([j for j in jobs if not j.borrowed])] == ["pd"]
+    dry_run(jobs, tmp_path / "quick", 2)
+    out = capsys.readouterr().out
+    assert f"lacks {tmp_path / 'full' / 'learn' / 'run'}" in out and "cannot converge" in out and "learn, evaluate" in out
+    _complete(by["learn"])
+    dry_run(plan("quick", tmp_path, studies=studies), tmp_path / "quick", 2)
+    assert f"full  {tmp_path / 'full' / 'learn' / 'run'}" in capsys.readouterr().out
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("studies:\n  a:\n    args: [+experiment=fig3_4_pd]\n"
+                   "    quick: {trials: 1}\n    full: {trials: 2, from_full: true}\n")
+    with pytest.raises(ConfigError, match="full.from_full: only the quick profile"):
+        load_studies(bad)
