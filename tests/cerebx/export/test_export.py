@@ -302,3 +302,26 @@ def test_a_network_written_per_joint_is_sized_for_the_composed_plant(tmp_path):
     bare.write_text("populations: {}\nprojections: {}\nper_joint: {pc: 10}\n")
     with pytest.raises(CerebxError, match="per_joint: the network is sized from a plant"):
         load_network(str(bare))
+
+
+def test_a_preset_population_s_integration_is_set_through_its_neuron():
+    """A preset's population names its neuron by reference (``neuron: ${...neurons.gc}``). Setting a key inside the
+    reference failed with Hydra's contradictory "already set; drop the leading '+'" (or, with '++', replaced the
+    neuron by the one key); the line now names the key that works, and that key sets the population's step."""
+    from cerebx.errors import CerebxError
+    from cerebx.export.source import load_network
+
+    cfg = load_network("small_golgi", ["controller.network.dt_ms=0.1",
+                                       "controller.network.neurons.gc.integration={method: rk4, dt_ms: null}"])
+    gc = cfg.populations["gc"].neuron
+    assert cfg.dt_ms == 0.1 and gc.integration.method == "rk4" and gc.integration.dt_ms is None
+    assert gc.clamp_at_rest and load_network("small_golgi").populations["gc"].neuron.integration.dt_ms == 1.0
+    for plus in ("", "+", "++"):
+        with pytest.raises(CerebxError) as err:
+            load_network("small_golgi", [f"{plus}controller.network.populations.gc.neuron.integration.dt_ms=0.1"])
+        assert str(err.value) == (
+            "controller.network.populations.gc.neuron.integration.dt_ms: controller.network.populations.gc.neuron "
+            "is a reference (${...neurons.gc}), and a key inside one cannot be overridden; use "
+            "controller.network.neurons.gc.integration.dt_ms=0.1 (it applies to everything that refers to "
+            "controller.network.neurons.gc), or replace controller.network.populations.gc.neuron whole")
+
