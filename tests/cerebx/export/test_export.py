@@ -236,22 +236,32 @@ def test_a_plugin_registers_its_kinds_export_through_the_api():
         mapping.CONNECTORS.pop("my_rule", None)
 
 
-def test_learned_weights_of_a_run_are_exported(tmp_path, capsys):
-    """``--weights RUN``: the npz holds the saved state's weights (count and sum per projection), not the initial
-    ones; a state of another network is refused in one line."""
+def _learned_state(tmp_path, seed: int, layout: bool, pc_dcn_weight=None):
+    """A small network with pair STDP on MF-DCN, its weights drawn at random (as if learned), saved as a run's
+    ``controller_state.npz`` in ``tmp_path`` (``layout``: with the populations' and projections' order, as
+    states are saved now; without: as before it was recorded)."""
     from cerebx.persistence.state import save_state_npz
     from cerebx.snn.network import Network
 
     d = network_dict(joints=1, fibers=2, per_joint=4)
     d["projections"]["mf_dcn"].update(rule={"kind": "fixed_indegree", "indegree": 2}, synapses=8)
+    if pc_dcn_weight is not None:
+        d["projections"]["pc_dcn"].update(weight_nS=pc_dcn_weight)
     _with_plasticity(d, "mf_dcn", dict(PAIR, delay="dendritic"))
     cfg = NetworkConfig.model_validate(d)
     net = Network(cfg, parallel=False)
-    rng = np.random.default_rng(4)
+    rng = np.random.default_rng(seed)
     net.dense_w[:] = rng.uniform(0, 5, net.dense_w.size)
     net.sp_w[:] = rng.uniform(0, 1, net.sp_w.size)
-    state = {f"net_{k}": v for k, v in net.state_arrays().items()}
-    save_state_npz(tmp_path / "controller_state.npz", {"fingerprint": cfg.fingerprint(), "network": cfg.name}, **state)
+    meta = {"fingerprint": cfg.fingerprint(), "network": cfg.name, **({"layout": cfg.layout()} if layout else {})}
+    save_state_npz(tmp_path / "controller_state.npz", meta, **{f"net_{k}": v for k, v in net.state_arrays().items()})
+    return cfg, net
+
+
+def test_learned_weights_of_a_run_are_exported(tmp_path, capsys):
+    """``--weights RUN``: the npz holds the saved state's weights (count and sum per projection), not the initial
+    ones; a state of another network is refused in one line."""
+    cfg, net = _learned_state(tmp_path, seed=4, layout=False)
     src = tmp_path / "net.yaml"
     src.write_text(yaml.safe_dump(cfg.model_dump(), sort_keys=False))  # the synapses' order is the projections'
     assert main(["export", str(src), "--weights", str(tmp_path / "controller_state.npz"), "--static", "--approximate",
@@ -330,20 +340,8 @@ def test_learned_weights_are_found_by_projection_name(tmp_path, capsys):
     """The saved weights follow the saving network's projection order, which the fingerprint leaves out: with the
     order recorded in the state (``layout``), a network file listing the projections in another order (here
     sorted, as ``yaml.safe_dump`` writes a dict) exports each projection's own weights."""
-    from cerebx.persistence.state import save_state_npz
-    from cerebx.snn.network import Network
-
-    d = network_dict(joints=1, fibers=2, per_joint=4)
-    d["projections"]["mf_dcn"].update(rule={"kind": "fixed_indegree", "indegree": 2}, synapses=8)
-    d["projections"]["pc_dcn"].update(weight_nS={"dist": "uniform", "low": 0.5, "high": 1.5})
-    _with_plasticity(d, "mf_dcn", dict(PAIR, delay="dendritic"))
-    cfg = NetworkConfig.model_validate(d)
-    net = Network(cfg, parallel=False)
-    rng = np.random.default_rng(5)
-    net.dense_w[:] = rng.uniform(0, 5, net.dense_w.size)
-    net.sp_w[:] = rng.uniform(0, 1, net.sp_w.size)
-    meta = {"fingerprint": cfg.fingerprint(), "network": cfg.name, "layout": cfg.layout()}
-    save_state_npz(tmp_path / "controller_state.npz", meta, **{f"net_{k}": v for k, v in net.state_arrays().items()})
+    cfg, net = _learned_state(tmp_path, seed=5, layout=True,
+                              pc_dcn_weight={"dist": "uniform", "low": 0.5, "high": 1.5})
     src = tmp_path / "net.yaml"
     src.write_text(yaml.safe_dump(cfg.model_dump()))  # sorted keys: another projection order, same fingerprint
     assert list(yaml.safe_load(src.read_text())["projections"]) != list(cfg.projections)
