@@ -297,8 +297,8 @@ def test_a_sweep_is_split_so_that_every_core_runs_part_of_it(tmp_path):
     assert [p.log_name for p in parts] == ["study.1.log", "study.2.log"]
     assert group(jobs)[0].log_name == "study.log" and len(group(jobs)) == 1
     # the command-line values win over the preset's sweep: Hydra runs exactly this part's jobs
-    from hydra.core.override_parser.overrides_parser import OverridesParser
     from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
+    from hydra.core.override_parser.overrides_parser import OverridesParser
 
     parsed = OverridesParser.create().parse_overrides(["delay.total_ms=0,20,40,60,80", "delay.total_ms=20,60"])
     (batch,) = BasicSweeper.split_arguments(parsed, None)
@@ -349,7 +349,8 @@ def test_a_study_that_cannot_converge_in_quick_is_drawn_from_the_full_profile(tm
     assert [s.name for s in group([j for j in jobs if not j.borrowed])] == ["pd"]
     dry_run(jobs, tmp_path / "quick", 2)
     out = capsys.readouterr().out
-    assert f"lacks {tmp_path / 'full' / 'learn' / 'run'}" in out and "cannot converge" in out and "learn, evaluate" in out
+    assert f"lacks {tmp_path / 'full' / 'learn' / 'run'}" in out
+    assert "cannot converge" in out and "learn, evaluate" in out
     _complete(by["learn"])
     dry_run(plan("quick", tmp_path, studies=studies), tmp_path / "quick", 2)
     assert f"full  {tmp_path / 'full' / 'learn' / 'run'}" in capsys.readouterr().out
