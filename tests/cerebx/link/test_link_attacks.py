@@ -258,6 +258,8 @@ def robot_run(tmp_path: Path, name: str, flood_rate: int, extra: tuple[str, ...]
     cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().decode(errors="replace")
     environ = Path(f"/proc/{pid}/environ").read_bytes().decode(errors="replace")
     out["private"] = "link.robot=" not in cmdline and "link.brain=" not in cmdline and "CEREBX_LINK" not in environ
+    sched = Path(f"/proc/{pid}/sched").read_text().splitlines()  # the paced thread's fair-scheduler slice
+    out["slice_ns"] = next((int(ln.split(":")[1]) for ln in sched if ln.startswith("se.slice")), None)
     if flood_rate:
         port = int(addr[0].rsplit(":", 1)[1])
         before = udp_no_ports()
