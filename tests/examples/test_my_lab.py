@@ -63,4 +63,4 @@ def test_the_report_draws_the_figure_from_its_study(env, tmp_path):
     rows = list(csv.reader((tmp_path / "reports" / "paper_vs_cerebx.csv").open()))
     assert ["my_lab_rate_limit", "the error falls as the limit loosens", "yes", "yes"] in [r[:4] for r in rows]
     again = run_python(env, tmp_path, "-m", "cerebx", "report", "--profile", "quick", "--figures", "my_lab_rate_limit")
-    assert "1 reused, 0 to run" in again.stdout  # finished runs are reused
+    assert "2 multiruns, 2 reused, 0 to run" in again.stdout  # finished runs are reused (the sweep's two parts)
