@@ -47,9 +47,14 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import time
+
 import numpy as np
+from llvmlite import ir
 from numba import njit, prange, types
+from numba.core import cgutils
 from numba.experimental import structref
+from numba.extending import intrinsic, overload
 
 from cerebx.snn.learning import NoLearning, SparseLearning, run_rules
 from cerebx.snn.topology import (
@@ -104,6 +109,70 @@ RUN_MIN = 4  # targets at consecutive compact positions delivered as one vector 
 PAR_MIN = 4096  # neurons below which a population is integrated serially even when parallel
 
 MG_LN = float(np.log(1.2 / 3.57))  # NMDA Mg block g_inf(V) = 1 / (1 + e^(-0.062 V + MG_LN)), V in mV
+
+
+PROF_PARTS = ("delivery", "plasticity", "bookkeeping", "outputs")
+DELIVERY, PLASTICITY, BOOKKEEPING, OUTPUTS = range(len(PROF_PARTS))
+"""The network thread's parts that a cost profile times besides each population's integration. A profile
+(``prof`` of the step kernels, :meth:`cerebx.snn.network.Network.start_profile`) is an int64 array of
+nanoseconds: one entry per population (its integration: neuron updates, threshold, decay), then one per part:
+spike delivery (the synaptic currents, the sparse delivery caches' rebuilds and the activation of resting
+neurons), plasticity (sparse rules, LTP, the PF buffer, LTD), bookkeeping (the spike ring, collecting the
+spikes, compacting the lists of active neurons) and the chunk's outputs (decoding, spike messages). Without a
+profile (``prof`` None) the timing calls are compiled away."""
+_CLOCK = time.CLOCK_MONOTONIC
+
+
+@intrinsic
+def _clock_ns(typingctx):
+    """The monotonic clock in ns (``clock_gettime``: a vDSO call, a few tens of ns)."""
+
+    def codegen(context, builder, sig, args):
+        i64 = ir.IntType(64)
+        ts = cgutils.alloca_once(builder, ir.LiteralStructType([i64, i64]))  # struct timespec (LP64)
+        fnty = ir.FunctionType(ir.IntType(32), [ir.IntType(32), ts.type])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, "clock_gettime")
+        builder.call(fn, [ir.Constant(ir.IntType(32), _CLOCK), ts])
+        sec = builder.load(cgutils.gep_inbounds(builder, ts, 0, 0))
+        nsec = builder.load(cgutils.gep_inbounds(builder, ts, 0, 1))
+        return builder.add(builder.mul(sec, ir.Constant(i64, 1_000_000_000)), nsec)
+
+    return types.int64(), codegen
+
+
+def prof_now(prof):
+    """The clock (ns) when ``prof`` is a profile, else 0; numba code only."""
+    raise NotImplementedError
+
+
+def prof_lap(prof, k, t0):
+    """Charge the time since ``t0`` to ``prof[k]`` and return the clock now; without a profile, nothing (returns
+    t0); numba code only."""
+    raise NotImplementedError
+
+
+def _off(prof) -> bool:
+    return isinstance(prof, (types.NoneType, types.Omitted))
+
+
+@overload(prof_now, inline="always")
+def _now_impl(prof):
+    if _off(prof):
+        return lambda prof: 0
+    return lambda prof: _clock_ns()
+
+
+@overload(prof_lap, inline="always")
+def _lap_impl(prof, k, t0):
+    if _off(prof):
+        return lambda prof, k, t0: t0
+
+    def impl(prof, k, t0):
+        t = _clock_ns()
+        prof[k] += t - t0
+        return t
+
+    return impl
 
 
 class Neurons(NamedTuple):
@@ -384,6 +453,20 @@ def _du(x, a, n, b, gL, EL, EAL, EGL, invC):
     return (-gL * x + (a + n * mg) * (EAL - x) + b * (EGL - x)) * invC
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _end_full(u, ref, flag, gs, p):
+    """The end of a step of :func:`_lif_full` and :func:`_lif_full_fine` once u holds the integrated values:
+    threshold, reset and refractory count (:func:`_spikes`), then the conductances ``gs`` (AMPA, NMDA, GABA)
+    decayed over the step (p: the population's parameters). Returns the spike count."""
+    f32 = np.float32
+    cnt = _spikes(u, ref, flag, f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF]))
+    gA, gN, gG = gs
+    _decay(gA, f32(p[P_DA]))
+    _decay(gN, f32(p[P_DN]))
+    _decay(gG, f32(p[P_DG]))
+    return cnt
+
+
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
 def _lif_full(u, gA, gN, gG, ref, flag, p):
     """One step of a population with AMPA, NMDA (Mg block, Eq. 2.8) and GABA conductances
@@ -394,7 +477,6 @@ def _lif_full(u, gA, gN, gG, ref, flag, p):
     EAL, EGL = f32(p[P_EA] - p[P_EL]), f32(p[P_EG] - p[P_EL])
     dA, dAh, dN, dNh = f32(p[P_DA]), f32(p[P_DAH]), f32(p[P_DN]), f32(p[P_DNH])
     dG, dGh = f32(p[P_DG]), f32(p[P_DGH])
-    uth, nref = f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF])
     method = int(p[P_METHOD])
     lo_u = f32(0.0) if p[P_CLAMP] > 0.5 else f32(-3.0e38)
     half, sixth, two, zero = f32(0.5), f32(1.0 / 6.0), f32(2.0), f32(0.0)
@@ -423,11 +505,7 @@ def _lif_full(u, gA, gN, gG, ref, flag, p):
             x = u[i]
             un = max(x + h * _du(x, gA[i], gN[i], gG[i], gL, EL, EAL, EGL, invC), lo_u)
             u[i] = un if abs(un) >= U_FLOOR else zero
-    cnt = _spikes(u, ref, flag, uth, nref)
-    _decay(gA, dA)
-    _decay(gN, dN)
-    _decay(gG, dG)
-    return cnt
+    return _end_full(u, ref, flag, (gA, gN, gG), p)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
@@ -466,7 +544,6 @@ def _lif_full_fine(u, gA, gN, gG, ref, flag, p, nf):
     fA, fAh, fN, fNh = f32(p[P_DFA]), f32(p[P_DFAH]), f32(p[P_DFN]), f32(p[P_DFNH])
     fG, fGh = f32(p[P_DFG]), f32(p[P_DFGH])
     ufine = f32(p[P_UFINE])
-    uth, nref = f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF])
     method = int(p[P_METHOD])
     lo_u = f32(0.0) if p[P_CLAMP] > 0.5 else f32(-3.0e38)
     zero = f32(0.0)
@@ -483,11 +560,7 @@ def _lif_full_fine(u, gA, gN, gG, ref, flag, p, nf):
                 a0, n0, b0 = a0 * fA, n0 * fN, b0 * fG
         un = max(un, lo_u)
         u[i] = un if abs(un) >= U_FLOOR else zero
-    cnt = _spikes(u, ref, flag, uth, nref)
-    _decay(gA, dA)
-    _decay(gN, dN)
-    _decay(gG, dG)
-    return cnt
+    return _end_full(u, ref, flag, (gA, gN, gG), p)
 
 
 # --------------------------------------------------------------------------- AdEx (aeif_cond_exp)
@@ -791,12 +864,13 @@ def _ltd(plast, pl, w, n_post, n_col, t, buf):
 
 
 @njit(cache=True, nogil=True, fastmath=True, error_model="numpy", boundscheck=False)
-def run_step(t0, n_sub, inputs, learn, par, net):
+def run_step(t0, n_sub, inputs, learn, par, net, prof):
     """Advance the network (``net``: its :class:`KernelState`) by one control step of ``n_sub``
     substeps starting at substep t0.
 
     ``inputs`` are global indices of input fibres spiking at t0; ``learn``: plasticity on; ``par``:
-    numba threads for the large populations. Returns the number of spikes written to
+    numba threads for the large populations; ``prof``: None, or a cost profile the step adds its
+    parts' times to (:data:`PROF_PARTS`). Returns the number of spikes written to
     out_idx/out_t (out_t = substep 1..n_sub at whose end the spike happened).
 
     Sparse projections onto a compact population deliver through a per-presynaptic-neuron cache of
@@ -814,6 +888,8 @@ def run_step(t0, n_sub, inputs, learn, par, net):
     pf_head, pf_lost = plast.pf_head, plast.pf_lost
     col_buf, out_idx, out_t = buf.col_buf, buf.out_idx, buf.out_t
     R = ring_idx.shape[0]
+    pb = pop_i.shape[0]  # the profile's first part (after the populations)
+    tk = prof_now(prof)
     slot0 = t0 % R
     m = ring_n[slot0]
     for k in range(inputs.shape[0]):
@@ -823,7 +899,9 @@ def run_step(t0, n_sub, inputs, learn, par, net):
     n_out = 0
     for s in range(n_sub):
         t = t0 + s
+        tk = prof_lap(prof, pb + BOOKKEEPING, tk)
         run_rules(t, learn, net.learning, dl)
+        tk = prof_lap(prof, pb + PLASTICITY, tk)
         # sparse projections (CSR by presynaptic neuron); teaching ones carry no current
         for p in range(sp_i.shape[0]):
             if sp_i[p, 5] != 0:
@@ -924,6 +1002,8 @@ def run_step(t0, n_sub, inputs, learn, par, net):
                         gs, ws = g[rec, post_lo : post_lo + n_post], dense_w[row : row + n_post]
                         for q in range(n_post):
                             gs[q] += ws[q] * sc
+                    if pl >= 0:
+                        tk = prof_lap(prof, pb + DELIVERY, tk)
                     if pl >= 0 and learn:
                         ltp, hi_w = np.float32(pl_f[pl, 0]), np.float32(pl_f[pl, 3])
                         ws = dense_w[row : row + n_post]
@@ -939,6 +1019,8 @@ def run_step(t0, n_sub, inputs, learn, par, net):
                         pf_t[pl, e] = ta
                         pf_j[pl, e] = j
                         pf_head[pl] += 1
+                        tk = prof_lap(prof, pb + PLASTICITY, tk)
+        tk = prof_lap(prof, pb + DELIVERY, tk)
         # LTD: teacher (CF) spikes arriving now at PCs of each plastic projection
         if learn:
             for pl in range(pl_i.shape[0]):
@@ -960,6 +1042,7 @@ def run_step(t0, n_sub, inputs, learn, par, net):
                 if n_col > 0:
                     w_off = de_i[d, 4]
                     _ltd(plast, pl, dense_w[w_off : w_off + de_i[d, 1] * n_post], n_post, n_col, t, buf)
+        tk = prof_lap(prof, pb + PLASTICITY, tk)
         # integrate the LIF populations whose step ends at t + 1; spikes are stamped t + 1
         nxt = (t + 1) % R
         ring_n[nxt] = 0
@@ -973,6 +1056,7 @@ def run_step(t0, n_sub, inputs, learn, par, net):
                 continue
             hi = lo + na
             pp = pop_par[pi]
+            tk = prof_lap(prof, pb + BOOKKEEPING, tk)  # the spikes collected so far
             if kind == KIND_LIF_AMPA:
                 if par > 1 and na >= PAR_MIN:
                     cnt, nr = _lif_poly_par(u[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], pops, pi, par)
@@ -987,6 +1071,7 @@ def run_step(t0, n_sub, inputs, learn, par, net):
                                      pop_i[pi, I_NFINE])
             else:
                 cnt = _lif_full(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp)
+            tk = prof_lap(prof, pi, tk)
             if cnt > 0:
                 n_out = _collect(flag[lo:hi], cid[lo:hi], ring_idx, nxt, ring_n, out_idx, out_t, n_out,
                                  s + 1, pop_i[pi, I_COMPACT] != 0)
@@ -997,21 +1082,25 @@ def run_step(t0, n_sub, inputs, learn, par, net):
             n_act[pi] = _compact(pop_i[pi, I_LO], pop_i[pi, I_HI], nrn, buf)
             pop_ep[pi] += 1
             n_rest[pi] = 0
+    prof_lap(prof, pb + BOOKKEEPING, tk)
     return n_out
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def run_chunk(t0, n_sub, inputs, in_off, learn, par, net, chunk_idx, chunk_off):
+def run_chunk(t0, n_sub, inputs, in_off, learn, par, net, chunk_idx, chunk_off, prof):
     """``len(in_off) - 1`` consecutive :func:`run_step` calls in one GIL-free call (a pipelined
     chunk runs without touching Python). Inputs of step s are inputs[in_off[s]:in_off[s + 1]];
-    its spikes (global indices) end up in chunk_idx[chunk_off[s]:chunk_off[s + 1]]."""
+    its spikes (global indices) end up in chunk_idx[chunk_off[s]:chunk_off[s + 1]] (the copy is
+    the profile's bookkeeping)."""
     out_idx = net.buffers.out_idx
     total = 0
     chunk_off[0] = 0
     for s in range(in_off.shape[0] - 1):
-        n = run_step(t0 + s * n_sub, n_sub, inputs[in_off[s]:in_off[s + 1]], learn, par, net)
+        n = run_step(t0 + s * n_sub, n_sub, inputs[in_off[s]:in_off[s + 1]], learn, par, net, prof)
+        tk = prof_now(prof)
         for i in range(n):
             chunk_idx[total + i] = out_idx[i]
+        prof_lap(prof, net.populations.pop_i.shape[0] + BOOKKEEPING, tk)
         total += n
         chunk_off[s + 1] = total
     return total

@@ -1,0 +1,53 @@
+"""The kernels' cost profile (``cerebx bench``'s per-step table): it times without changing a result."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from cerebx.loop.timing import closed_loop_rt
+from cerebx.snn.kernels import PROF_PARTS
+from cerebx.snn.network import Network
+from cerebx.snn.presets import network
+
+
+def _inputs(steps: int, n_mf: int, seed: int) -> list[np.ndarray]:
+    """A few MFs per step (each fibre at most once), so GCs activate, rest and get compacted."""
+    rng = np.random.default_rng(seed)
+    return [np.sort(rng.choice(n_mf, size=int(rng.integers(0, 12)), replace=False)).astype(np.int32)
+            for _ in range(steps)]
+
+
+def test_a_profiled_network_steps_exactly_like_an_unprofiled_one():
+    cfg = network(fibers=5, per_joint=10)
+    plain, timed = (Network(cfg, parallel=False, compact_min=1000) for _ in range(2))
+    inputs = _inputs(300, plain.index("mf").stop, seed=2)
+    timed.start_profile()
+    t0 = time.perf_counter()
+    spikes_timed = [timed.step(x).idx.copy() for x in inputs]
+    wall = time.perf_counter() - t0
+    spikes_plain = [plain.step(x).idx.copy() for x in inputs]
+    assert sum(len(s) for s in spikes_plain) > 100
+    assert all(np.array_equal(a, b) for a, b in zip(spikes_plain, spikes_timed))
+    for key, value in plain.state_arrays().items():
+        np.testing.assert_array_equal(timed.state_arrays()[key], value, err_msg=key)
+    prof = timed.profile()
+    assert set(prof) == {"integrate.gc", "integrate.pc", "integrate.dcn", *PROF_PARTS}
+    assert all(prof[k] > 0 for k in ("integrate.gc", "integrate.pc", "integrate.dcn", "delivery", "bookkeeping"))
+    assert prof["outputs"] == 0.0  # decoding is the controller's chunk kernel's
+    assert sum(prof.values()) < wall
+    assert plain.profile() == {}
+
+
+@pytest.mark.integration
+def test_the_closed_loop_reports_each_part_per_step():
+    out = closed_loop_rt(["+task=circle", "+experiment=small_snn"], seconds=0.5, warmup_s=0.5, parts=True)
+    parts = out["per_step_us"]
+    assert {"plant", "brain", "loop"} <= set(parts["main"])
+    assert parts["main_total"] == pytest.approx(sum(parts["main"].values()), abs=0.1)
+    net = parts["network"]
+    assert {"integrate.gc", "integrate.dcn", "delivery", "plasticity", "bookkeeping", "outputs"} <= set(net)
+    assert all(v > 0 for k, v in net.items() if k != "thread_other")
+    assert parts["network_busy"] == pytest.approx(sum(net.values()), abs=0.1)
