@@ -232,13 +232,13 @@ class Plasticity(NamedTuple):
 class Buffers(NamedTuple):
     """Scratch space and the step's spike output."""
 
-    col_buf: np.ndarray  # int64 [n]: PCs hit by teacher spikes
+    col_buf: np.ndarray  # int64 [n]: PCs hit by teacher spikes; the compaction's merge
     acc: np.ndarray  # float64 [n]: summed kernel values per PF (zero between uses)
     acc_j: np.ndarray  # int64 [n]: PFs with a nonzero acc
     out_idx: np.ndarray  # int32 [n * n_sub]: spiking neurons of the step
     out_t: np.ndarray  # int32 [n * n_sub]: their substep (1..n_sub)
     scr_f: np.ndarray  # float32 [3, n]: compaction scratch (u, g_AMPA, ref)
-    scr_i: np.ndarray  # int64 [n]: compaction scratch (global index)
+    scr_i: np.ndarray  # int64 [n]: compaction scratch (sort keys)
 
 
 class NetworkArrays(NamedTuple):
@@ -291,23 +291,6 @@ def mg_block(v: np.ndarray) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- AMPA-only populations
-@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _spikes(u, ref, flag, uth, nref):
-    """Threshold, reset and refractory bookkeeping after u holds the integrated values; returns the
-    spike count (a float accumulator: integer reductions of booleans defeat the vectoriser)."""
-    zero, one = np.float32(0.0), np.float32(1.0)
-    cnt = zero
-    for i in range(u.shape[0]):
-        un = u[i]
-        r = ref[i]
-        spk = (un >= uth) & (r <= zero)
-        u[i] = zero if (r > zero) | spk else un
-        ref[i] = nref if spk else max(r - one, zero)
-        flag[i] = np.uint8(spk)
-        cnt += one if spk else zero
-    return int(cnt)
-
-
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
 def _decay(g, d):
     """g <- g d in place, values below G_FLOOR flushed to 0."""
@@ -455,16 +438,33 @@ def _du(x, a, n, b, gL, EL, EAL, EGL, invC):
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
 def _end_full(u, ref, flag, gs, p):
-    """The end of a step of :func:`_lif_full` and :func:`_lif_full_fine` once u holds the integrated values:
-    threshold, reset and refractory count (:func:`_spikes`), then the conductances ``gs`` (AMPA, NMDA, GABA)
-    decayed over the step (p: the population's parameters). Returns the spike count."""
+    """The end of a step of :func:`_lif_full` and :func:`_lif_full_fine` once u holds the integrated values, in
+    one pass: threshold, reset and refractory count, and the conductances ``gs`` (AMPA, NMDA, GABA) decayed over
+    the step, values below G_FLOOR flushed to 0 (p: the population's parameters). Returns the spike count (a
+    float accumulator: integer reductions of booleans defeat the vectoriser). Kept apart from the integration
+    loop: there the decayed AMPA conductance is a product the RK stages compute too, and sharing it changes how
+    the compiler contracts the stages' multiply-adds (the last bit of V moves)."""
     f32 = np.float32
-    cnt = _spikes(u, ref, flag, f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF]))
+    uth, nref = f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF])
+    dA, dN, dG = f32(p[P_DA]), f32(p[P_DN]), f32(p[P_DG])
     gA, gN, gG = gs
-    _decay(gA, f32(p[P_DA]))
-    _decay(gN, f32(p[P_DN]))
-    _decay(gG, f32(p[P_DG]))
-    return cnt
+    zero, one = f32(0.0), f32(1.0)
+    cnt = zero
+    for i in range(u.shape[0]):
+        un = u[i]
+        r = ref[i]
+        spk = (un >= uth) & (r <= zero)
+        u[i] = zero if (r > zero) | spk else un
+        ref[i] = nref if spk else max(r - one, zero)
+        flag[i] = np.uint8(spk)
+        cnt += one if spk else zero
+        x = gA[i] * dA
+        gA[i] = x if x > G_FLOOR else zero
+        x = gN[i] * dN
+        gN[i] = x if x > G_FLOOR else zero
+        x = gG[i] * dG
+        gG[i] = x if x > G_FLOOR else zero
+    return int(cnt)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
@@ -739,18 +739,20 @@ def _collect(flag, ids, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp, so
 
 
 @njit(cache=True, boundscheck=False)
-def _compact(lo, hi, nrn, buf):
-    """Drop the neurons at rest from the compact AMPA-only population [lo, hi) and put the others in
-    global index order (the order of the list does not affect any result: every per-neuron
-    operation is independent and collected spikes are sorted; index order makes the targets of one
-    presynaptic neuron long runs, see :func:`_build_runs`). Returns the new count."""
+def _compact(lo, na, nrn, buf):
+    """Drop the neurons at rest from the ``na`` listed neurons of the compact AMPA-only population
+    starting at ``lo`` and put the others in global index order (the order of the list does not
+    affect any result: every per-neuron operation is independent and collected spikes are sorted;
+    index order makes the targets of one presynaptic neuron long runs, see :func:`_build_runs`).
+    Only the list is read, never the whole population: the neurons listed at the last compaction
+    are still in index order, those activated since follow in the order they came and are sorted
+    (keys global index << 32 | position, so a key's order is its index's), then merged in.
+    Returns the new count."""
     u, g, ref, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot
-    sf, si = buf.scr_f, buf.scr_i
+    sf, key, merged = buf.scr_f, buf.scr_i, buf.col_buf
     j = 0
-    for i in range(lo, hi):
-        k = slot[i]
-        if k < 0:
-            continue
+    for k in range(lo, lo + na):
+        i = cid[k]
         x, gk, r = u[k], g[0, k], ref[k]
         if x == 0.0 and gk == 0.0 and r == 0.0:
             slot[i] = -1
@@ -758,14 +760,35 @@ def _compact(lo, hi, nrn, buf):
         sf[0, j] = x
         sf[1, j] = gk
         sf[2, j] = r
-        si[j] = i
+        key[j] = (np.int64(i) << 32) | j
         j += 1
+    p = 1
+    while p < j and key[p] > key[p - 1]:
+        p += 1
+    src = key
+    if p < j:
+        tail = np.sort(key[p:j])
+        a = b = m = 0
+        nt = j - p
+        while a < p and b < nt:
+            if key[a] < tail[b]:
+                merged[m] = key[a]
+                a += 1
+            else:
+                merged[m] = tail[b]
+                b += 1
+            m += 1
+        merged[m : m + p - a] = key[a:p]
+        merged[m + p - a : j] = tail[b:nt]
+        src = merged
     for m in range(j):
+        v = src[m]
+        i = v >> 32
+        q = v & 0xFFFFFFFF
         k = lo + m
-        u[k] = sf[0, m]
-        g[0, k] = sf[1, m]
-        ref[k] = sf[2, m]
-        i = si[m]
+        u[k] = sf[0, q]
+        g[0, k] = sf[1, q]
+        ref[k] = sf[2, q]
         cid[k] = i
         slot[i] = k
     return j
@@ -1079,7 +1102,7 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
     # they are integrated as exact no-ops)
     for pi in range(pop_i.shape[0]):
         if pop_i[pi, I_COMPACT] != 0 and n_rest[pi] > 0 and COMPACT_FRACTION * n_rest[pi] >= n_act[pi]:
-            n_act[pi] = _compact(pop_i[pi, I_LO], pop_i[pi, I_HI], nrn, buf)
+            n_act[pi] = _compact(pop_i[pi, I_LO], n_act[pi], nrn, buf)
             pop_ep[pi] += 1
             n_rest[pi] = 0
     prof_lap(prof, pb + BOOKKEEPING, tk)
