@@ -59,13 +59,15 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
 
 
 def per_step_parts(loop: ClosedLoop, trials: range, steps_per_trial: int) -> dict[str, Any]:
-    """Run ``trials`` with every part timed (after one more, untimed, when a network's kernels are timed); microseconds per control step of each. ``main``: the loop's thread
-    by phase (``loop/instrument.py``: plant, brain and robot stages, recording, end of trial, the loop's own
-    work, and ``wait`` for the network thread), summing to ``main_total``. ``network``: a spiking network's
+    """Run ``trials`` with every part timed (after one more, untimed, when a network's kernels are timed);
+    microseconds per control step of each. ``main``: the loop's thread by phase (``loop/instrument.py``: plant,
+    brain and robot stages, recording, end of trial, the loop's own work, and ``wait`` for the network thread),
+    summing to ``main_total``. ``network``: a spiking network's
     kernels by part (each population's integration, spike delivery, plasticity, bookkeeping, the chunk's
     outputs; ``snn/kernels.py``), and ``thread_other`` the rest of its thread's busy time (the chunk's hand-over
     in Python), summing to ``network_busy``, the network thread's wall time per step (the loop's own thread
-    when the network is not pipelined: then its parts are inside ``brain``)."""
+    when the network is not pipelined: then its parts are inside ``brain``). CPU time, which a loaded host changes
+    much less than wall time: ``process_cpu`` (every thread) and ``network_cpu`` (the network thread's chunks)."""
     clock = phase_clock.PhaseClock("loop")
     instrument(loop, clock)
     net = getattr(loop.ctx.controller, "net", None)  # a spiking controller's network
@@ -77,17 +79,20 @@ def per_step_parts(loop: ClosedLoop, trials: range, steps_per_trial: int) -> dic
         trials = range(trials.start + 1, trials.stop + 1)
         net.start_profile()
     phase_clock.activate(clock)
+    cpu0 = time.process_time()
     try:
         for i in trials:
             loop.run_trial(i)
         loop.settle()
     finally:
         phase_clock.activate(None)
+    cpu = time.process_time() - cpu0
     steps = len(trials) * steps_per_trial
     report = clock.report()
     us = 1e6 / steps
     main = {k: round(v * us, 2) for k, v in report["wall_s"].items()}
-    out: dict[str, Any] = {"steps": steps, "main": main, "main_total": round(sum(report["wall_s"].values()) * us, 2)}
+    out: dict[str, Any] = {"steps": steps, "main": main, "main_total": round(sum(report["wall_s"].values()) * us, 2),
+                           "process_cpu": round(cpu * us, 2)}
     if net is not None:
         kernels = {k: round(v * us, 2) for k, v in net.profile().items()}
         busy = report["background"].get("network", {}).get("wall_s", 0.0) * us
@@ -95,5 +100,7 @@ def per_step_parts(loop: ClosedLoop, trials: range, steps_per_trial: int) -> dic
             kernels["thread_other"] = round(busy - sum(kernels.values()), 2)
         out["network"] = kernels
         out["network_busy"] = round(busy or sum(kernels.values()), 2)
+        if busy:
+            out["network_cpu"] = round(report["background"]["network"]["cpu_s"] * us, 2)
         net.prof = None
     return out

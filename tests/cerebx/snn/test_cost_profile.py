@@ -51,3 +51,4 @@ def test_the_closed_loop_reports_each_part_per_step():
     assert {"integrate.gc", "integrate.dcn", "delivery", "plasticity", "bookkeeping", "outputs"} <= set(net)
     assert all(v > 0 for k, v in net.items() if k != "thread_other")
     assert parts["network_busy"] == pytest.approx(sum(net.values()), abs=0.1)
+    assert 0 < parts["network_cpu"] < parts["process_cpu"]
