@@ -45,9 +45,8 @@ mV), so a neuron returns to rest a few tens of ms after its last input.
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import time
+from typing import NamedTuple
 
 import numpy as np
 from llvmlite import ir
@@ -59,7 +58,6 @@ from numba.extending import intrinsic, overload
 from cerebx.snn.learning import NoLearning, SparseLearning, run_rules
 from cerebx.snn.topology import (
     I_COMPACT,
-    I_HI,
     I_KIND,
     I_LO,
     I_NFINE,
