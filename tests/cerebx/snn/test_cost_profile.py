@@ -7,6 +7,7 @@ import time
 import numpy as np
 import pytest
 
+from cerebx.bench import bench_network
 from cerebx.loop.timing import closed_loop_rt
 from cerebx.snn.kernels import PROF_PARTS
 from cerebx.snn.network import Network
@@ -52,3 +53,11 @@ def test_the_closed_loop_reports_each_part_per_step():
     assert all(v > 0 for k, v in net.items() if k != "thread_other")
     assert parts["network_busy"] == pytest.approx(sum(net.values()), abs=0.1)
     assert 0 < parts["network_cpu"] < parts["process_cpu"]
+
+
+def test_the_network_bench_splits_a_step_into_parts():
+    out = bench_network(network(fibers=5, per_joint=10), seconds=0.2, warmup=0.1)
+    parts = out["per_step_us"]
+    assert {"integrate.gc", "integrate.pc", "integrate.dcn", *PROF_PARTS, "total"} == set(parts)
+    assert 0 < sum(v for k, v in parts.items() if k != "total") < parts["total"]
+    assert out["listed_neurons"] == {}  # 3,750 GCs: below the size from which a population keeps a list
