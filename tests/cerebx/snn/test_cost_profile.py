@@ -15,10 +15,11 @@ from cerebx.snn.presets import network
 
 
 def _inputs(steps: int, n_mf: int, seed: int) -> list[np.ndarray]:
-    """A few MFs per step (each fibre at most once), so GCs activate, rest and get compacted."""
+    """Bursts of a few random MFs a step (each fibre at most once) for 16 ms, then 64 ms without input: GCs
+    activate out of index order, come back to rest and get compacted."""
     rng = np.random.default_rng(seed)
-    return [np.sort(rng.choice(n_mf, size=int(rng.integers(0, 12)), replace=False)).astype(np.int32)
-            for _ in range(steps)]
+    return [np.sort(rng.choice(n_mf, size=int(rng.integers(0, 12)) if k % 40 < 8 else 0,
+                               replace=False)).astype(np.int32) for k in range(steps)]
 
 
 def test_a_profiled_network_steps_exactly_like_an_unprofiled_one():
@@ -30,10 +31,15 @@ def test_a_profiled_network_steps_exactly_like_an_unprofiled_one():
     spikes_timed = [timed.step(x).idx.copy() for x in inputs]
     wall = time.perf_counter() - t0
     spikes_plain = [plain.step(x).idx.copy() for x in inputs]
+    unlisted = Network(cfg, parallel=False, compact_min=10**9)  # every GC integrated, no list to compact
+    spikes_unlisted = [unlisted.step(x).idx.copy() for x in inputs]
     assert sum(len(s) for s in spikes_plain) > 100
+    assert plain.pop_ep[plain.topo.index["gc"]] > 3  # the GC list was compacted (sorted and merged) repeatedly
     assert all(np.array_equal(a, b) for a, b in zip(spikes_plain, spikes_timed))
+    assert all(np.array_equal(a, b) for a, b in zip(spikes_plain, spikes_unlisted))
     for key, value in plain.state_arrays().items():
         np.testing.assert_array_equal(timed.state_arrays()[key], value, err_msg=key)
+        np.testing.assert_array_equal(unlisted.state_arrays()[key], value, err_msg=key)
     prof = timed.profile()
     assert set(prof) == {"integrate.gc", "integrate.pc", "integrate.dcn", *PROF_PARTS}
     assert all(prof[k] > 0 for k in ("integrate.gc", "integrate.pc", "integrate.dcn", "delivery", "bookkeeping"))
