@@ -40,6 +40,7 @@ WINDOW = 64
 POLL_BUDGET = 64
 MAX_CANDIDATES = 8
 """HELLOs (distinct brain nonces) a robot side answers before one of them proves the session key."""
+MAX_STRANGERS = 16
 
 
 class ReplayWindow:
@@ -111,6 +112,8 @@ class LinkEnd:
     data: DataCounts = field(default_factory=DataCounts)
     candidates: dict[bytes, Candidate] = field(default_factory=dict)
     committed: Candidate | None = None
+    strangers: Counter = field(default_factory=Counter)  # robot side: fingerprints of HELLOs refused
+    next_refuse_s: float = 0.0
     last_send_ns: int = 0
     _seq: Counter = field(default_factory=Counter)
     _windows: dict[Kind, ReplayWindow] = field(default_factory=dict)
@@ -150,6 +153,12 @@ class LinkEnd:
         with self._lock:
             self.candidates = {}
         self.transport.lock_to_peer()
+
+    def stranger(self, fingerprint: str) -> None:
+        """Robot side: a HELLO of another configuration was refused (at most :data:`MAX_STRANGERS` fingerprints
+        are told apart, the rest counted under ``...``)."""
+        key = fingerprint if fingerprint in self.strangers or len(self.strangers) < MAX_STRANGERS else "..."
+        self.strangers[key] += 1
 
     # ------------------------------------------------------------------ sending
     def _send(self, kind: Kind, tick: int, stamp_s: float, values: dict | None = None,

@@ -3,8 +3,12 @@ offset and the start time.
 
 1. The brain side sends HELLO (its config fingerprint, the run id it chose, a fresh nonce, what the
    robot side needs from its controller) until the robot side answers. A robot side whose fingerprint
-   differs answers REFUSE (naming the HELLO's nonce) and both stop with one line (exit code 2) before
-   writing anything.
+   differs answers REFUSE (naming the HELLO's nonce, at most every :data:`REFUSE_EVERY_S`), counts the
+   HELLO (``other_config``) and drops it: it keeps waiting for a brain side of its own configuration
+   until ``link.pair_timeout_s``, so that another experiment's brain side (or a replay of one) cannot
+   end it. A brain side that gets a REFUSE of its HELLO waits :data:`REFUSE_GRACE_S` more for a WELCOME
+   (another robot side may answer too) and then stops with one line (exit code 2) before writing
+   anything; a WELCOME of another configuration is counted (``other_config``) and dropped.
 2. The robot side answers WELCOME with a fresh nonce of its own and the HELLO's nonce. Both sides now
    derive the session key from the shared key and the two nonces (``auth.Signer.session``); every later
    packet is signed with it. The robot side answers every matching HELLO this way (each gets its own
@@ -46,6 +50,8 @@ NOT_PAIRED = {"init_from": True, "resume": True, "recording": {"progress": True}
 """Config keys the two sides may differ in."""
 
 HELLO_EVERY_S = 0.1
+REFUSE_EVERY_S = 0.05  # a robot side answers HELLOs of another configuration at most this often
+REFUSE_GRACE_S = 1.0  # a refused brain side still takes a WELCOME that comes this soon after the REFUSE
 START_LEAD_S = 0.25  # tick 0 is this far ahead of the robot's START answer
 
 
@@ -95,28 +101,58 @@ def _refused_line(mine: str, theirs: str, side: str) -> str:
             "both sides from the same overrides")
 
 
+def of_this_config(end: LinkEnd, pkt: Packet, fp: str) -> bool:
+    """Robot side: whether a HELLO comes from a brain side composed like this one. One that is not (another
+    experiment's, or a replay of one) is counted (``other_config``, its fingerprint in
+    :attr:`LinkEnd.strangers`), answered with a REFUSE at most every :data:`REFUSE_EVERY_S` so that its brain
+    side stops with one line, and dropped."""
+    theirs = pkt.info["fingerprint"]
+    if theirs == fp:
+        return True
+    end.reject("other_config")
+    end.stranger(theirs)
+    now = time.monotonic()
+    if now >= end.next_refuse_s:
+        end.next_refuse_s = now + REFUSE_EVERY_S
+        end.send_control(Kind.REFUSE, {"fingerprint": fp, "version": __version__,
+                                       "answers": pkt.info["nonce"].hex()}, run_id=pkt.run_id)
+    return False
+
+
+def strangers_line(end: LinkEnd, fp: str) -> str:
+    """What a robot side says about the HELLOs of other configurations it refused ("" when none)."""
+    if not end.strangers:
+        return ""
+    n = sum(end.strangers.values())
+    theirs = ", ".join(sorted(end.strangers)[:3]) + (", ..." if len(end.strangers) > 3 else "")
+    return f"refused {n} HELLO{'s' if n != 1 else ''} of another configuration (fingerprint {theirs}, this side {fp})"
+
+
+def gave_up(what: str, end: LinkEnd, fp: str) -> NotPaired:
+    """The one line of a robot side that did not pair, with the other configurations it refused."""
+    refused = strangers_line(end, fp)
+    return NotPaired(f"link: {what}; {refused}: compose both sides from the same overrides" if refused
+                     else f"link: {what}")
+
+
 def wait_for_hello(end: LinkEnd, fp: str, timeout_s: float, alive: Any = None) -> Packet:
-    """Robot side: the first HELLO of a brain side with the same fingerprint (REFUSE and raise otherwise); it
-    is offered a session (:meth:`LinkEnd.offer`) but not answered yet."""
+    """Robot side: the first HELLO of a brain side with the same fingerprint; it (and any other such HELLO
+    that came with it) is offered a session (:meth:`LinkEnd.offer`) but not answered yet. HELLOs of other
+    configurations are refused and dropped (:func:`of_this_config`) while it waits."""
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         if alive is not None and not alive():
             raise NotPaired("link: stopped while waiting for the brain side")
         end.transport.inbox.wait(0.05)
         _, control = end.poll()
-        for pkt in control:
-            if pkt.kind != Kind.HELLO:
-                continue
-            theirs = str(pkt.info.get("fingerprint"))
-            if theirs != fp:
-                for _ in range(3):
-                    end.send_control(Kind.REFUSE, {"fingerprint": fp, "version": __version__,
-                                                   "answers": pkt.info["nonce"].hex()}, run_id=pkt.run_id)
-                    time.sleep(0.02)
-                raise PairingRefused(_refused_line(fp, theirs, "brain"))
-            end.offer(pkt)
-            return pkt
-    raise NotPaired(f"link: no brain side paired within {timeout_s:g} s")
+        first = None
+        for pkt in control:  # all of them: another HELLO of the batch is offered a session too
+            if pkt.kind == Kind.HELLO and of_this_config(end, pkt, fp):
+                end.offer(pkt)
+                first = first or pkt
+        if first is not None:
+            return first
+    raise gave_up(f"no brain side paired within {timeout_s:g} s", end, fp)
 
 
 def welcome(end: LinkEnd, hello_pkt: Packet, facts: dict[str, Any]) -> None:
@@ -137,6 +173,7 @@ def hello(end: LinkEnd, fp: str, facts: dict[str, Any], timeout_s: float, alive:
             **clock.host_identity()}
     deadline = time.monotonic() + timeout_s
     next_hello = 0.0
+    refused: Packet | None = None
     while time.monotonic() < deadline:
         if alive is not None and not alive():
             break
@@ -152,9 +189,17 @@ def hello(end: LinkEnd, fp: str, facts: dict[str, Any], timeout_s: float, alive:
                 end.reject("unmatched")  # an answer to another HELLO (replayed, or of an earlier run)
                 continue
             if pkt.kind == Kind.REFUSE:
-                raise PairingRefused(_refused_line(fp, str(pkt.info.get("fingerprint")), "robot"))
+                if refused is None:
+                    refused = pkt
+                    deadline = min(deadline, time.monotonic() + REFUSE_GRACE_S)
+                continue
+            if pkt.info["fingerprint"] != fp:
+                end.reject("other_config")  # a robot side that should have refused: not ours
+                continue
             end.establish(end.signer.session(nonce, pkt.info["nonce"], end.run_id or bytes(16)))
             return pkt
+    if refused is not None:
+        raise PairingRefused(_refused_line(fp, refused.info["fingerprint"], "robot"))
     raise NotPaired(f"link: no robot side answered within {timeout_s:g} s")
 
 

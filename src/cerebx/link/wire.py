@@ -77,12 +77,13 @@ MAX_STAMP_S = 1e9
 
 REASONS = ("truncated", "malformed", "version", "unauthenticated", "other_run", "unknown_signal", "wrong_size",
            "missing_signal", "non_finite", "unexpected_kind", "stale", "replayed", "seq_window", "bad_field",
-           "too_deep", "unmatched", "foreign", "queue_full")
+           "too_deep", "unmatched", "other_config", "foreign", "queue_full")
 """Why a packet was dropped: ``stale`` a data packet older than one already received; ``replayed`` a control
 packet whose sequence number was seen; ``seq_window`` a sequence number too far ahead of the newest;
 ``bad_field`` a header or JSON field of the wrong type, range or finiteness; ``too_deep`` JSON nested beyond
 :data:`MAX_DEPTH`; ``unmatched`` an answer to no question of this side (a PONG of no PING in the current
-burst, a WELCOME to another HELLO); ``foreign`` a datagram from an address that is not the peer's;
+burst, a WELCOME to another HELLO); ``other_config`` a HELLO or WELCOME signed with the shared key by a side
+composed differently (another fingerprint); ``foreign`` a datagram from an address that is not the peer's;
 ``queue_full`` an authenticated packet that found the bounded inbox full."""
 
 

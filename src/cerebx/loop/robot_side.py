@@ -47,7 +47,18 @@ from cerebx.errors import CerebxError, LinkLost, PeerEnded
 from cerebx.link.auth import Signer, require_key
 from cerebx.link.channel import POLL_BUDGET, Arrived, LinkEnd
 from cerebx.link.clock import host_identity, host_steal_ms, now_ns, pace, realtime_process
-from cerebx.link.pairing import START_LEAD_S, NotPaired, RemoteController, fingerprint, pong, wait_for_hello, welcome
+from cerebx.link.pairing import (
+    START_LEAD_S,
+    NotPaired,
+    RemoteController,
+    fingerprint,
+    gave_up,
+    of_this_config,
+    pong,
+    strangers_line,
+    wait_for_hello,
+    welcome,
+)
 from cerebx.link.stats import describe
 from cerebx.link.wire import Kind, Packet
 from cerebx.loop.lifecycle import RunLifecycle
@@ -161,7 +172,7 @@ class RobotSide:
             pong(self.end, pkt)
         elif pkt.kind == Kind.START:  # our answer was lost: the same start time again
             self.end.send_control(Kind.START, {"t0_ns": self.t0})
-        elif pkt.kind == Kind.HELLO:
+        elif pkt.kind == Kind.HELLO and of_this_config(self.end, pkt, self.welcome_facts["fingerprint"]):
             welcome(self.end, pkt, self.welcome_facts)
         elif pkt.kind == Kind.BYE:
             raise PeerEnded(str(pkt.info.get("status", "interrupted")),
@@ -348,13 +359,16 @@ def pair(end: LinkEnd, first: Packet, facts: dict[str, Any], timeout_s: float) -
     """Answer every matching HELLO (each with its own session) and the PINGs of the session the brain side
     signs with, until that brain side asks to start (START, signed with its session key)."""
     welcome(end, first, facts)
+    for cand in list(end.candidates.values()):  # any other HELLO that came with ``first``
+        if cand.hello is not first:
+            welcome(end, cand.hello, facts)
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         end.transport.inbox.wait(0.05)
         _, control = end.poll()
         for pkt in control:
             if pkt.kind == Kind.HELLO:  # another brain side's, a replayed one, or ours again (our WELCOME lost)
-                if pkt.info["fingerprint"] == facts["fingerprint"]:
+                if of_this_config(end, pkt, facts["fingerprint"]):
                     welcome(end, pkt, facts)
             elif pkt.kind == Kind.PING:
                 pong(end, pkt)
@@ -362,7 +376,7 @@ def pair(end: LinkEnd, first: Packet, facts: dict[str, Any], timeout_s: float) -
                 return
             elif pkt.kind == Kind.BYE:
                 raise NotPaired("link: the brain side ended before the start")
-    raise NotPaired(f"link: no brain side started within {timeout_s:g} s")
+    raise gave_up(f"no brain side started within {timeout_s:g} s", end, facts["fingerprint"])
 
 
 def prepare_real_time() -> None:
@@ -410,6 +424,8 @@ def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, ctx: BuildContext, facts: d
         t0 = now_ns() + int(START_LEAD_S * 1e9)
         end.send_control(Kind.START, {"t0_ns": t0})
         events.add(0.0, "paired", f"run {run_id.hex()}")
+        if end.strangers:
+            events.add(0.0, "refused_hello", strangers_line(end, facts["fingerprint"]) + " while waiting to pair")
         side = RobotSide(ctx, rec, end, t0, events)
         side.welcome_facts = facts
         side.start()

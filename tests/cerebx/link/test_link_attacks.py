@@ -13,12 +13,16 @@ import subprocess
 import sys
 import threading
 import time
+import uuid
 from pathlib import Path
 
 import pytest
 from link_processes import PD, finish, ports, start, ticking, wait_for
 
+from cerebx.link.auth import Signer
+from cerebx.link.pairing import fingerprint
 from cerebx.link.transport import free_port
+from cerebx.link.wire import Kind, decode, encode
 from cerebx.recording.reader import read_messages, read_metadata, read_summary
 
 pytestmark = pytest.mark.integration
@@ -179,6 +183,45 @@ def test_replayed_pings_neither_move_the_clock_nor_keep_a_robot_side_alive(tmp_p
     assert robot_pid is not None
 
 
+def test_a_hello_of_another_configuration_or_run_leaves_the_robot_side_waiting_for_its_brain(tmp_path, load):
+    """A brain side of another experiment (same key, same ports) says HELLO to a waiting robot side first, then a
+    brain side of this configuration that never signs anything after it: the robot side refuses the first,
+    answers the second, and pairs with the real brain side that starts later; the run completes."""
+    addr = ports()
+    args = [*PD, "link=udp", "trials=1", "link.pair_timeout_s=40"]
+    robot = start(["robot", "--run-dir", str(tmp_path / "robot"), *args, *addr], KEY)
+    key = Signer(bytes.fromhex(KEY["CEREBX_LINK_KEY"]))
+    brain_at = ("127.0.0.1", int(addr[1].rsplit(":", 1)[1]))
+    robot_at = ("127.0.0.1", int(addr[0].rsplit(":", 1)[1]))
+    answers: list = []
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as stranger:
+        stranger.bind(brain_at)  # where the robot side expects its brain side
+        stranger.settimeout(0.25)
+        deadline = time.monotonic() + 60
+        for fp in ("f" * 16, fingerprint(load(args))):
+            hello = encode(key, Kind.HELLO, uuid.uuid4().bytes, 0, 0, 0.0, 1,
+                           info={"fingerprint": fp, "version": "0", "nonce": uuid.uuid4().hex})
+            got = None
+            while got is None and time.monotonic() < deadline and robot.poll() is None:
+                stranger.sendto(hello, robot_at)  # until the robot side (building its parts first) answers
+                try:
+                    got = decode(stranger.recv(65536), key)
+                except TimeoutError:
+                    pass
+            answers.append(got.kind if got is not None else None)
+    assert answers == [Kind.REFUSE, Kind.WELCOME] and robot.poll() is None, answers
+    brain = start(["run", *args, "link.spawn_robot=false", f"hydra.run.dir={tmp_path / 'b'}", *addr], KEY)
+    code, _, err = finish(brain)
+    rcode, _, rerr = finish(robot)
+    assert code == 0 and rcode == 0, err + rerr
+    s, r = read_summary(tmp_path / "b"), read_summary(tmp_path / "robot")
+    print(f"\nrobot side: {r['status']}, {r['link']['packets']}, {r['link']['events'][:2]}")
+    assert s["status"] == r["status"] == "completed" and s["link"]["run_id"] == r["link"]["run_id"]
+    assert r["link"]["packets"]["rejected"].get("other_config", 0) >= 1, r["link"]["packets"]
+    refused = [e for e in r["link"]["events"] if e["event"] == "refused_hello"]
+    assert len(refused) == 1 and "another configuration (fingerprint ffffffffffffffff" in refused[0]["detail"]
+
+
 # ---------------------------------------------------------------------- junk traffic
 FLOOD = """
 import os, socket, sys, time
@@ -215,6 +258,8 @@ def robot_run(tmp_path: Path, name: str, flood_rate: int, extra: tuple[str, ...]
     cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().decode(errors="replace")
     environ = Path(f"/proc/{pid}/environ").read_bytes().decode(errors="replace")
     out["private"] = "link.robot=" not in cmdline and "link.brain=" not in cmdline and "CEREBX_LINK" not in environ
+    sched = Path(f"/proc/{pid}/sched").read_text().splitlines()  # the paced thread's fair-scheduler slice
+    out["slice_ns"] = next((int(ln.split(":")[1]) for ln in sched if ln.startswith("se.slice")), None)
     if flood_rate:
         port = int(addr[0].rsplit(":", 1)[1])
         before = udp_no_ports()

@@ -3,6 +3,9 @@ fingerprints, the relay's holding, the merge of the two logs, the delay trace, t
 
 from __future__ import annotations
 
+import os
+import sys
+import threading
 import time
 
 import numpy as np
@@ -89,6 +92,43 @@ def test_pace_never_wakes_early():
         woke = clock.pace(deadline, 300_000)
         assert woke >= deadline
 
+
+
+def _slice_ns() -> int | None:
+    """This thread's fair-scheduler slice as the kernel reports it (None where it does not)."""
+    try:
+        lines = open("/proc/thread-self/sched").read().splitlines()
+    except OSError:
+        return None
+    found = [ln.split(":")[1].strip() for ln in lines if ln.startswith("se.slice")]
+    return int(found[0]) if found else None
+
+
+def _in_thread(fn):
+    out = []
+    t = threading.Thread(target=lambda: out.append(fn()))
+    t.start()
+    t.join(5)
+    return out[0]
+
+
+def test_the_robot_side_and_the_relay_ask_for_short_time_slices_and_the_brain_side_does_not():
+    if _slice_ns() is None or tuple(int(x) for x in os.uname().release.split(".")[:2]) < (6, 12):
+        pytest.skip("the kernel takes no slice request (Linux 6.12 on) or does not report it")
+    switch = sys.getswitchinterval()
+    try:
+        def asked(role):
+            assert clock.realtime_process(0, role) is None
+            return _slice_ns(), _in_thread(_slice_ns)  # and a thread it starts later
+
+        default = _in_thread(_slice_ns)
+        assert default > clock.SHORT_SLICE_NS
+        assert _in_thread(lambda: asked("robot")) == (clock.SHORT_SLICE_NS, clock.SHORT_SLICE_NS)
+        assert _in_thread(lambda: asked("relay")) == (clock.SHORT_SLICE_NS, clock.SHORT_SLICE_NS)
+        assert _in_thread(lambda: asked("brain")) == (default, default)
+        assert _in_thread(_slice_ns) == default  # only the threads that asked (and their own)
+    finally:
+        sys.setswitchinterval(switch)
 
 def test_fingerprint_covers_what_both_sides_compute_from(load):
     base = fingerprint(load(PD_WALL))

@@ -106,15 +106,19 @@ def test_zenoh_relay_delays_are_measured_and_replayed(tmp_path):
 
 @pytest.mark.slow
 def test_sides_composed_differently_refuse_to_pair(tmp_path):
+    """The brain side is refused and stops at once; the robot side keeps waiting for a brain side of its own
+    configuration until its pairing timeout, then says what it refused."""
     addr = ports()
     env = {KEY_ENV: "ab" * 32}
-    robot = start(["robot", "--run-dir", str(tmp_path / "robot"), *PD, "link=udp", "trials=2", *addr], env)
+    robot = start(["robot", "--run-dir", str(tmp_path / "robot"), *PD, "link=udp", "trials=2",
+                   "link.pair_timeout_s=20", *addr], env)
     brain = start(["run", *PD, "link=udp", "trials=1", "link.spawn_robot=false", f"hydra.run.dir={tmp_path / 'b'}",
                    *addr], env)
-    for proc in (brain, robot):
+    for proc, said in ((brain, "the robot side runs another configuration"),
+                       (robot, "no brain side paired within 20 s; refused")):
         code, _, err = finish(proc, 60)
         lines = [ln for ln in err.splitlines() if ln.strip() and not ln.startswith(("[", "run: estimate"))]
-        assert code == 2 and len(lines) == 1 and "another configuration" in lines[0], err
+        assert code == 2 and len(lines) == 1 and said in lines[0] and "another configuration" in lines[0], err
     assert not (tmp_path / "robot").exists()
 
 

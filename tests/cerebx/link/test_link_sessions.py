@@ -21,9 +21,9 @@ from cerebx.errors import PeerEnded
 from cerebx.link import clock
 from cerebx.link.auth import Signer
 from cerebx.link.channel import SEQ_AHEAD, LinkEnd
-from cerebx.link.pairing import NotPaired, Pings, hello, pong, wait_for_hello, within
+from cerebx.link.pairing import NotPaired, PairingRefused, Pings, hello, pong, wait_for_hello, within
 from cerebx.link.transport import Arrival, Inbox
-from cerebx.link.wire import HEADER, MAX_DEPTH, VERSION, Kind, WireError, encode, parse_json
+from cerebx.link.wire import HEADER, MAX_DEPTH, VERSION, Kind, WireError, decode, encode, parse_json
 from cerebx.loop.brain_side import BrainSide, sync_clock
 from cerebx.loop.robot_side import RobotSide, pair
 from cerebx.signals import Message
@@ -136,6 +136,100 @@ def test_a_replayed_session_cannot_pair_with_a_fresh_robot_side_and_the_real_bra
     brain2.send_message(Message(0.0, {"joint.torque": np.ones(2)}), 0)
     data, _ = robot2.poll()
     assert len(data) == 1 and robot2.data.received == 1
+
+
+def foreign_hello(fp: str, run_id: bytes | None = None, nonce: bytes | None = None) -> tuple[bytes, bytes]:
+    """A HELLO signed with the pairing key from a brain side of configuration ``fp`` (and its nonce)."""
+    nonce = nonce or uuid.uuid4().bytes
+    data = encode(KEY, Kind.HELLO, run_id or uuid.uuid4().bytes, 0, 0, 0.0, 1,
+                  info={"fingerprint": fp, "version": "0", "nonce": nonce.hex()})
+    return data, nonce
+
+
+def sent_kinds(t: PipeEnd, kind: Kind) -> list:
+    return [decode(d, KEY) for d in t.sent if d[5] == kind]
+
+
+def test_a_hello_of_another_configuration_or_run_is_dropped_and_the_robot_side_waits_for_its_brain():
+    bt, rt = pipe()
+    brain, robot = ends(bt, rt)
+    other, other_nonce = foreign_hello("f" * 16)  # another experiment's brain side (or a replay of one)
+    stranger, _ = foreign_hello(FP)  # a brain side of this configuration that never signs anything after
+    for data in (other, stranger, other):
+        rt.inbox.put(Arrival("c2r", 0, data, time.monotonic_ns()))
+    out: dict = {}
+    t = run_robot_pairing(robot, out)
+    time.sleep(0.4)
+    assert out == {} and t.is_alive()  # still waiting, not refused and gone
+    hello(brain, FP, {}, 5.0)
+    brain.send_control(Kind.START, {"offset_ns": 0})
+    t.join(10)
+    assert out.get("paired"), out
+    assert robot.run_id == brain.run_id and robot.session.tag(b"x") == brain.session.tag(b"x")
+    assert robot.rejected["other_config"] == 2 and robot.strangers == {"f" * 16: 2}
+    refusals = sent_kinds(rt, Kind.REFUSE)  # the other brain side is told, so that it stops with one line
+    assert refusals and all(p.info["answers"] == other_nonce.hex() and p.info["fingerprint"] == FP for p in refusals)
+    assert brain.rejected["unmatched"] >= 1  # the REFUSE and the WELCOME to the stranger reached the real brain
+
+
+def test_the_robot_side_that_only_saw_other_configurations_says_so_when_it_gives_up():
+    bt, rt = pipe()
+    _, robot = ends(bt, rt)
+    rt.inbox.put(Arrival("c2r", 0, foreign_hello("f" * 16)[0], time.monotonic_ns()))
+    with pytest.raises(NotPaired, match=r"^link: no brain side paired within 0.3 s; refused 1 HELLO of another "
+                                        r"configuration \(fingerprint ffffffffffffffff, this side 0123456789abcdef\): "
+                                        r"compose both sides from the same overrides$"):
+        wait_for_hello(robot, FP, 0.3)
+
+
+def test_a_welcome_or_refuse_from_a_stranger_does_not_end_the_brain_sides_pairing():
+    bt, rt = pipe()
+    brain, robot = ends(bt, rt)
+    stop = threading.Event()
+
+    def strangers():  # robot sides of another configuration, and one that answers for another run
+        while not stop.is_set() and not bt.sent:
+            time.sleep(0.005)
+        nonce = decode(bt.sent[0], KEY).info["nonce"]
+        for kind, run_id, info in (
+                (Kind.WELCOME, brain.run_id, {"fingerprint": "f" * 16, "nonce": "00" * 16, "answers": nonce}),
+                (Kind.WELCOME, uuid.uuid4().bytes, {"fingerprint": FP, "nonce": "00" * 16, "answers": nonce}),
+                (Kind.WELCOME, brain.run_id, {"fingerprint": FP, "nonce": "00" * 16, "answers": "11" * 16}),
+                (Kind.REFUSE, brain.run_id, {"fingerprint": "f" * 16, "answers": nonce})):
+            bt.inbox.put(Arrival("r2c", 0, encode(KEY, kind, run_id, 0, 0, 0.0, 1, info=info), time.monotonic_ns()))
+
+    t = threading.Thread(target=strangers, daemon=True)
+    t.start()
+    out: dict = {}
+    threading.Timer(0.3, lambda: run_robot_pairing(robot, out)).start()  # the real robot side comes later
+    welcome = hello(brain, FP, {}, 5.0)
+    brain.send_control(Kind.START, {"offset_ns": 0})
+    stop.set()
+    t.join(2)
+    wait = time.monotonic() + 5
+    while "paired" not in out and time.monotonic() < wait:
+        time.sleep(0.01)
+    assert out.get("paired"), out
+    assert welcome.info["fingerprint"] == FP and brain.session.tag(b"x") == robot.session.tag(b"x")
+    assert brain.rejected["other_config"] == 1 and brain.rejected["unmatched"] >= 2
+
+
+def test_a_refuse_alone_ends_the_brain_sides_pairing_after_a_grace():
+    bt, rt = pipe()
+    brain, _ = ends(bt, rt)
+
+    def refuse():
+        while not bt.sent:
+            time.sleep(0.005)
+        nonce = decode(bt.sent[0], KEY).info["nonce"]
+        bt.inbox.put(Arrival("r2c", 0, encode(KEY, Kind.REFUSE, brain.run_id, 0, 0, 0.0, 1, info={
+            "fingerprint": "f" * 16, "answers": nonce}), time.monotonic_ns()))
+
+    threading.Thread(target=refuse, daemon=True).start()
+    t0 = time.monotonic()
+    with pytest.raises(PairingRefused, match="another configuration"):
+        hello(brain, FP, {}, 30.0)
+    assert time.monotonic() - t0 < 3.0
 
 
 def test_replayed_pings_and_pongs_change_no_offset():
