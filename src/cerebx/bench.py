@@ -4,7 +4,9 @@ A synthetic sinusoidal joint state (desired and a lagging "actual") feeds the MF
 and the CF error encoder every 2 ms, with plasticity on, so GC, PC, DCN activity, LTP and LTD
 all run as they would in an experiment. The encoder output is computed before the timed loop
 (the encoders are part of the controller's cost, not the network's), so ``rt_factor`` and
-``us_per_step`` measure ``Network.step`` alone.
+``us_per_step`` measure ``Network.step`` alone. As many steps again follow with the kernels timed part by
+part (``per_step_us``, :meth:`~cerebx.snn.network.Network.start_profile`), with the mean number of granule
+cells off rest integrated per step (``listed_neurons``: how quiet the granule layer is).
 """
 
 from __future__ import annotations
@@ -19,12 +21,34 @@ from cerebx.controllers.snn.schema import BoxEncoder, CFEncoder, ErrorGains
 from cerebx.snn.encoders import ClimbingEncoder, MossyEncoder
 from cerebx.snn.network import Network
 from cerebx.snn.schema import NetworkConfig
+from cerebx.snn.topology import I_COMPACT
 
 STEP_S = 0.002
 
 
 def peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def _per_step_parts(net: Network, inputs: list[np.ndarray]) -> tuple[dict[str, float], dict[str, float]]:
+    """Microseconds per step of each part of the network's kernels over ``inputs`` (``total``: the profiled
+    steps' wall time, calls included), and the mean number of neurons off rest that each population with a list
+    of them (``compact``: the granule cells) integrates per step."""
+    net.step(inputs[0])  # a profiled step runs code of its own: compiled (or loaded) before the clock starts
+    net.start_profile()
+    listed = np.zeros_like(net.n_act)
+    t0 = time.perf_counter()
+    for x in inputs[1:]:
+        net.step(x)
+        listed += net.n_act
+    wall = time.perf_counter() - t0
+    n = max(1, len(inputs) - 1)
+    us = 1e6 / n
+    out = {k: round(v * us, 2) for k, v in net.profile().items()}
+    out["total"] = round(wall * us, 2)
+    net.prof = None
+    compact = np.flatnonzero(net.pop_i[:, I_COMPACT])
+    return out, {net.topo.names[i]: round(float(listed[i]) / n, 1) for i in compact}
 
 
 def bench_network(network_cfg: NetworkConfig, seconds: float = 3.0, warmup: float = 0.5,
@@ -69,6 +93,7 @@ def bench_network(network_cfg: NetworkConfig, seconds: float = 3.0, warmup: floa
             counts_arr += np.bincount(np.searchsorted(edges, sp.idx, side="right"), minlength=len(edges) + 1)
     wall = time.perf_counter() - t1
     counts = {name: int(counts_arr[i]) for i, name in enumerate(net.topo.names)}
+    parts, listed = _per_step_parts(net, [drive(k) for k in range(n_warm + n_run, n_warm + 2 * n_run)])
     return {
         "network": network_cfg.name,
         "neurons": net.n_neurons,
@@ -79,6 +104,8 @@ def bench_network(network_cfg: NetworkConfig, seconds: float = 3.0, warmup: floa
         "wall_s": round(wall, 3),
         "rt_factor": round(seconds / wall, 2),
         "us_per_step": round(wall / n_run * 1e6, 1),
+        "per_step_us": parts,
+        "listed_neurons": listed,
         "threads": net.n_threads,
         "parallel": parallel,
         "rates_hz": {name: round(counts[name] / seconds / (sl.stop - sl.start), 2)

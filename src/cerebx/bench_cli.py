@@ -3,7 +3,10 @@ as users make them (``bench_learning.py``).
 
 Each network is measured in a fresh subprocess so build time (numba cache warm) and peak RSS
 belong to that network alone, and its closed loop in another, as a run meets it.
-Output is JSON. Numbers are simulated seconds per wall second.
+Output is JSON. Numbers are simulated seconds per wall second; ``per_step_us`` says where a control step's time
+goes, in microseconds per part (the PD loop's and each closed loop's main thread by phase, each network's kernels by
+part: :func:`cerebx.loop.timing.per_step_parts`), from extra timed steps after the untimed ones that give the
+factors.
 """
 
 from __future__ import annotations
@@ -38,13 +41,13 @@ def _one_network(name: str, seconds: float, warmup: float, parallel: bool, start
     # Python, which the pipelined loop never does)
     loop_overrides = ["+task=circle", f"network={name}", f"controller.parallel={str(parallel).lower()}"]
     cmd = [sys.executable, "-m", "cerebx.cli", "bench", "--loop", json.dumps(loop_overrides), "--seconds", str(seconds),
-           "--warmup", str(warmup)]
+           "--warmup", str(warmup), "--parts"]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         out["closed_loop"] = {"error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}
         return out
     loop = json.loads(proc.stdout)
-    out["closed_loop"] = {k: loop[k] for k in ("build_s", "rt_factor", "cpu_rt_factor", "us_per_step")}
+    out["closed_loop"] = {k: loop[k] for k in ("build_s", "rt_factor", "cpu_rt_factor", "us_per_step", "per_step_us")}
     return out
 
 
@@ -52,8 +55,8 @@ def _plant_pd(seconds: float) -> dict[str, Any]:
     rows = {}
     for label, extra in (("baxter_pd", []), ("baxter_pd_physics_1ms", ["plant.physics_dt_ms=1.0"]),
                          ("baxter_sea_pd", ["plant=baxter_sea"])):
-        r = closed_loop_rt(["+task=circle", "controller=pd", *extra], seconds=seconds, warmup_s=1.0)
-        rows[label] = {"rt_factor": r["rt_factor"], "us_per_step": r["us_per_step"]}
+        r = closed_loop_rt(["+task=circle", "controller=pd", *extra], seconds=seconds, warmup_s=1.0, parts=not extra)
+        rows[label] = {k: r[k] for k in ("rt_factor", "us_per_step", "per_step_us") if k in r}
     return rows
 
 
@@ -71,12 +74,13 @@ def main(argv: list[str]) -> dict[str, Any]:
     ap.add_argument("--rounds", type=int, default=1, help="rounds of learning runs and their closed loops (medians)")
     ap.add_argument("--one", help=argparse.SUPPRESS)
     ap.add_argument("--loop", help=argparse.SUPPRESS)
+    ap.add_argument("--parts", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--started", type=float, default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.lwpr:
         return {"lwpr": bench_lwpr()}
     if args.loop:
-        return closed_loop_rt(json.loads(args.loop), seconds=args.seconds, warmup_s=args.warmup)
+        return closed_loop_rt(json.loads(args.loop), seconds=args.seconds, warmup_s=args.warmup, parts=args.parts)
     if args.one:
         return _one_network(args.one, args.seconds, args.warmup, not args.serial, args.started or time.time())
     report: dict[str, Any] = {"cpus": os.cpu_count(), "plant_pd": _plant_pd(args.seconds), "networks": {}}

@@ -1,4 +1,5 @@
-"""Closed-loop speed: simulated seconds per wall second for a composed experiment."""
+"""Closed-loop speed: simulated seconds per wall second for a composed experiment, and where a control step's time
+goes (:func:`per_step_parts`)."""
 
 from __future__ import annotations
 
@@ -6,19 +7,22 @@ import time
 from pathlib import Path
 from typing import Any
 
+from cerebx import phase_clock
 from cerebx.build import build_components
 from cerebx.config import load
+from cerebx.loop.instrument import instrument
 from cerebx.loop.loop import ClosedLoop
 from cerebx.recording.recorder import Recorder
 
 
 def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float = 1.0,
-                   record_to: Path | None = None) -> dict[str, Any]:
+                   record_to: Path | None = None, parts: bool = False) -> dict[str, Any]:
     """Run ``overrides`` for ``warmup_s`` (compilation, first-touch), then time ``seconds`` more: simulated
     seconds per wall second (``rt_factor``) and per CPU second of the process, all threads (``cpu_rt_factor``).
 
     With ``record_to`` the MCAP recording is on (as in a real run); otherwise it is off, which
-    measures plant + controller + loop alone.
+    measures plant + controller + loop alone. With ``parts`` as many trials again follow, timed part by part
+    (:func:`per_step_parts`; the factors above come from the untimed trials).
     """
     exp, _ = load(overrides)
     t0 = time.perf_counter()
@@ -39,6 +43,9 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
         for i in range(warm_trials, warm_trials + timed_trials):
             loop.run_trial(i)
         wall, cpu = time.perf_counter() - t1, time.process_time() - c1
+        if parts:
+            first = warm_trials + timed_trials
+            table = per_step_parts(loop, range(first, first + timed_trials), steps_per_trial)
     finally:
         if rec is not None:
             loop.settle()
@@ -48,4 +55,52 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
             "wall_seconds": round(wall, 3), "rt_factor": round(sim / wall, 2),
             "cpu_seconds": round(cpu, 3), "cpu_rt_factor": round(sim / cpu, 2),
             "us_per_step": round(wall / (timed_trials * steps_per_trial) * 1e6, 1),
-            "recording": record_to is not None}
+            "recording": record_to is not None, **({"per_step_us": table} if parts else {})}
+
+
+def per_step_parts(loop: ClosedLoop, trials: range, steps_per_trial: int) -> dict[str, Any]:
+    """Run ``trials`` with every part timed (after one more, untimed, when a network's kernels are timed);
+    microseconds per control step of each. ``main``: the loop's thread by phase (``loop/instrument.py``: plant,
+    brain and robot stages, recording, end of trial, the loop's own work, and ``wait`` for the network thread),
+    summing to ``main_total``. ``network``: a spiking network's
+    kernels by part (each population's integration, spike delivery, plasticity, bookkeeping, the chunk's
+    outputs; ``snn/kernels.py``), and ``thread_other`` the rest of its thread's busy time (the chunk's hand-over
+    in Python), summing to ``network_busy``, the network thread's wall time per step (the loop's own thread
+    when the network is not pipelined: then its parts are inside ``brain``). CPU time, which a loaded host changes
+    much less than wall time: ``process_cpu`` (every thread) and ``network_cpu`` (the network thread's chunks)."""
+    clock = phase_clock.PhaseClock("loop")
+    instrument(loop, clock)
+    net = getattr(loop.ctx.controller, "net", None)  # a spiking controller's network
+    net = net if hasattr(net, "start_profile") else None
+    if net is not None:  # the profiled kernels are other compiled code: loaded in an untimed first trial
+        net.start_profile()
+        loop.run_trial(trials[0])
+        loop.settle()
+        trials = range(trials.start + 1, trials.stop + 1)
+        net.start_profile()
+    phase_clock.activate(clock)
+    cpu0 = time.process_time()
+    try:
+        for i in trials:
+            loop.run_trial(i)
+        loop.settle()
+    finally:
+        phase_clock.activate(None)
+    cpu = time.process_time() - cpu0
+    steps = len(trials) * steps_per_trial
+    report = clock.report()
+    us = 1e6 / steps
+    main = {k: round(v * us, 2) for k, v in report["wall_s"].items()}
+    out: dict[str, Any] = {"steps": steps, "main": main, "main_total": round(sum(report["wall_s"].values()) * us, 2),
+                           "process_cpu": round(cpu * us, 2)}
+    if net is not None:
+        kernels = {k: round(v * us, 2) for k, v in net.profile().items()}
+        busy = report["background"].get("network", {}).get("wall_s", 0.0) * us
+        if busy:  # pipelined: the chunks' wall time on the network thread
+            kernels["thread_other"] = round(busy - sum(kernels.values()), 2)
+        out["network"] = kernels
+        out["network_busy"] = round(busy or sum(kernels.values()), 2)
+        if busy:
+            out["network_cpu"] = round(report["background"]["network"]["cpu_s"] * us, 2)
+        net.prof = None
+    return out

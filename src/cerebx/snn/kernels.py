@@ -45,16 +45,19 @@ mV), so a neuron returns to rest a few tens of ms after its last input.
 
 from __future__ import annotations
 
+import time
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
+from llvmlite import ir
+from numba import njit, prange, types
+from numba.core import cgutils
+from numba.extending import intrinsic, overload
 
 from cerebx.kernel_struct import KernelStruct
 from cerebx.snn.learning import NoLearning, SparseLearning, run_rules
 from cerebx.snn.topology import (
     I_COMPACT,
-    I_HI,
     I_KIND,
     I_LO,
     I_NFINE,
@@ -111,6 +114,75 @@ RUN_MIN = 4  # targets at consecutive compact positions delivered as one vector 
 PAR_MIN = 4096  # neurons below which a population is integrated serially even when parallel
 
 MG_LN = float(np.log(1.2 / 3.57))  # NMDA Mg block g_inf(V) = 1 / (1 + e^(-0.062 V + MG_LN)), V in mV
+
+
+PROF_PARTS = ("delivery", "plasticity", "bookkeeping", "outputs")
+DELIVERY, PLASTICITY, BOOKKEEPING, OUTPUTS = range(len(PROF_PARTS))
+"""The network thread's parts that a cost profile times besides each population's integration. A profile
+(``prof`` of the step kernels, :meth:`cerebx.snn.network.Network.start_profile`) is an int64 array of
+nanoseconds: one entry per population (its integration: neuron updates, threshold, decay), then one per part:
+spike delivery (the synaptic currents, the sparse delivery caches' rebuilds and the activation of resting
+neurons), plasticity (sparse rules, LTP, the PF buffer, LTD), bookkeeping (the spike ring, collecting the
+spikes, compacting the lists of active neurons) and the chunk's outputs (decoding, spike messages). Without a
+profile (``prof`` None) the timing calls are compiled away."""
+_CLOCK = time.CLOCK_MONOTONIC
+
+
+@intrinsic
+def _clock_ns(typingctx):
+    """The monotonic clock in ns (``clock_gettime``: a vDSO call, a few tens of ns)."""
+
+    def codegen(context, builder, sig, args):
+        i64 = ir.IntType(64)
+        ts = cgutils.alloca_once(builder, ir.LiteralStructType([i64, i64]))  # struct timespec (LP64)
+        fnty = ir.FunctionType(ir.IntType(32), [ir.IntType(32), ts.type])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, "clock_gettime")
+        builder.call(fn, [ir.Constant(ir.IntType(32), _CLOCK), ts])
+        sec = builder.load(cgutils.gep_inbounds(builder, ts, 0, 0))
+        nsec = builder.load(cgutils.gep_inbounds(builder, ts, 0, 1))
+        return builder.add(builder.mul(sec, ir.Constant(i64, 1_000_000_000)), nsec)
+
+    return types.int64(), codegen
+
+
+def prof_now(prof):
+    """The clock (ns) when ``prof`` is a profile, else 0; numba code only."""
+    raise NotImplementedError
+
+
+def prof_lap(prof, k, t0):
+    """Charge the time since ``t0`` to ``prof[k]`` and return the clock now; without a profile, nothing (returns
+    t0); numba code only."""
+    raise NotImplementedError
+
+
+def _off(prof) -> bool:
+    return isinstance(prof, (types.NoneType, types.Omitted))
+
+
+# Not inline="always": after inlining an overload, numba (0.68) runs a typed dead-code elimination whose alias
+# analysis does not follow arrays taken out of a tuple (the KernelState's NamedTuples): a store into such an array
+# that is not read again in the function is dropped as dead. run_step lost the LTP's row mark
+# (plast.dirty[pl, j] = 1), so checkpoints missed rows that only LTP had changed and resumed runs diverged.
+# Called, these compile to a few instructions that LLVM inlines.
+@overload(prof_now)
+def _now_impl(prof):
+    if _off(prof):
+        return lambda prof: 0
+    return lambda prof: _clock_ns()
+
+
+@overload(prof_lap)
+def _lap_impl(prof, k, t0):
+    if _off(prof):
+        return lambda prof, k, t0: t0
+
+    def impl(prof, k, t0):
+        t = _clock_ns()
+        prof[k] += t - t0
+        return t
+
+    return impl
 
 
 class Neurons(NamedTuple):
@@ -170,13 +242,13 @@ class Plasticity(NamedTuple):
 class Buffers(NamedTuple):
     """Scratch space and the step's spike output."""
 
-    col_buf: np.ndarray  # int64 [n]: PCs hit by teacher spikes
+    col_buf: np.ndarray  # int64 [n]: PCs hit by teacher spikes; the compaction's merge
     acc: np.ndarray  # float64 [n]: summed kernel values per PF (zero between uses)
     acc_j: np.ndarray  # int64 [n]: PFs with a nonzero acc
     out_idx: np.ndarray  # int32 [n * n_sub]: spiking neurons of the step
     out_t: np.ndarray  # int32 [n * n_sub]: their substep (1..n_sub)
     scr_f: np.ndarray  # float32 [3, n]: compaction scratch (u, g_AMPA, ref)
-    scr_i: np.ndarray  # int64 [n]: compaction scratch (global index)
+    scr_i: np.ndarray  # int64 [n]: compaction scratch (sort keys)
 
 
 class NetworkArrays(NamedTuple):
@@ -216,23 +288,6 @@ def mg_block(v: np.ndarray) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- AMPA-only populations
-@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _spikes(u, ref, flag, uth, nref):
-    """Threshold, reset and refractory bookkeeping after u holds the integrated values; returns the
-    spike count (a float accumulator: integer reductions of booleans defeat the vectoriser)."""
-    zero, one = np.float32(0.0), np.float32(1.0)
-    cnt = zero
-    for i in range(u.shape[0]):
-        un = u[i]
-        r = ref[i]
-        spk = (un >= uth) & (r <= zero)
-        u[i] = zero if (r > zero) | spk else un
-        ref[i] = nref if spk else max(r - one, zero)
-        flag[i] = np.uint8(spk)
-        cnt += one if spk else zero
-    return int(cnt)
-
-
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
 def _decay(g, d):
     """g <- g d in place, values below G_FLOOR flushed to 0."""
@@ -378,6 +433,37 @@ def _du(x, a, n, b, gL, EL, EAL, EGL, invC):
     return (-gL * x + (a + n * mg) * (EAL - x) + b * (EGL - x)) * invC
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _end_full(u, ref, flag, gs, p):
+    """The end of a step of :func:`_lif_full` and :func:`_lif_full_fine` once u holds the integrated values, in
+    one pass: threshold, reset and refractory count, and the conductances ``gs`` (AMPA, NMDA, GABA) decayed over
+    the step, values below G_FLOOR flushed to 0 (p: the population's parameters). Returns the spike count (a
+    float accumulator: integer reductions of booleans defeat the vectoriser). Kept apart from the integration
+    loop: there the decayed AMPA conductance is a product the RK stages compute too, and sharing it changes how
+    the compiler contracts the stages' multiply-adds (the last bit of V moves)."""
+    f32 = np.float32
+    uth, nref = f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF])
+    dA, dN, dG = f32(p[P_DA]), f32(p[P_DN]), f32(p[P_DG])
+    gA, gN, gG = gs
+    zero, one = f32(0.0), f32(1.0)
+    cnt = zero
+    for i in range(u.shape[0]):
+        un = u[i]
+        r = ref[i]
+        spk = (un >= uth) & (r <= zero)
+        u[i] = zero if (r > zero) | spk else un
+        ref[i] = nref if spk else max(r - one, zero)
+        flag[i] = np.uint8(spk)
+        cnt += one if spk else zero
+        x = gA[i] * dA
+        gA[i] = x if x > G_FLOOR else zero
+        x = gN[i] * dN
+        gN[i] = x if x > G_FLOOR else zero
+        x = gG[i] * dG
+        gG[i] = x if x > G_FLOOR else zero
+    return int(cnt)
+
+
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
 def _lif_full(u, gA, gN, gG, ref, flag, p):
     """One step of a population with AMPA, NMDA (Mg block, Eq. 2.8) and GABA conductances
@@ -388,7 +474,6 @@ def _lif_full(u, gA, gN, gG, ref, flag, p):
     EAL, EGL = f32(p[P_EA] - p[P_EL]), f32(p[P_EG] - p[P_EL])
     dA, dAh, dN, dNh = f32(p[P_DA]), f32(p[P_DAH]), f32(p[P_DN]), f32(p[P_DNH])
     dG, dGh = f32(p[P_DG]), f32(p[P_DGH])
-    uth, nref = f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF])
     method = int(p[P_METHOD])
     lo_u = f32(0.0) if p[P_CLAMP] > 0.5 else f32(-3.0e38)
     half, sixth, two, zero = f32(0.5), f32(1.0 / 6.0), f32(2.0), f32(0.0)
@@ -417,11 +502,7 @@ def _lif_full(u, gA, gN, gG, ref, flag, p):
             x = u[i]
             un = max(x + h * _du(x, gA[i], gN[i], gG[i], gL, EL, EAL, EGL, invC), lo_u)
             u[i] = un if abs(un) >= U_FLOOR else zero
-    cnt = _spikes(u, ref, flag, uth, nref)
-    _decay(gA, dA)
-    _decay(gN, dN)
-    _decay(gG, dG)
-    return cnt
+    return _end_full(u, ref, flag, (gA, gN, gG), p)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
@@ -460,7 +541,6 @@ def _lif_full_fine(u, gA, gN, gG, ref, flag, p, nf):
     fA, fAh, fN, fNh = f32(p[P_DFA]), f32(p[P_DFAH]), f32(p[P_DFN]), f32(p[P_DFNH])
     fG, fGh = f32(p[P_DFG]), f32(p[P_DFGH])
     ufine = f32(p[P_UFINE])
-    uth, nref = f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF])
     method = int(p[P_METHOD])
     lo_u = f32(0.0) if p[P_CLAMP] > 0.5 else f32(-3.0e38)
     zero = f32(0.0)
@@ -477,11 +557,7 @@ def _lif_full_fine(u, gA, gN, gG, ref, flag, p, nf):
                 a0, n0, b0 = a0 * fA, n0 * fN, b0 * fG
         un = max(un, lo_u)
         u[i] = un if abs(un) >= U_FLOOR else zero
-    cnt = _spikes(u, ref, flag, uth, nref)
-    _decay(gA, dA)
-    _decay(gN, dN)
-    _decay(gG, dG)
-    return cnt
+    return _end_full(u, ref, flag, (gA, gN, gG), p)
 
 
 # --------------------------------------------------------------------------- AdEx (aeif_cond_exp)
@@ -660,18 +736,20 @@ def _collect(flag, ids, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp, so
 
 
 @njit(cache=True, boundscheck=False)
-def _compact(lo, hi, nrn, buf):
-    """Drop the neurons at rest from the compact AMPA-only population [lo, hi) and put the others in
-    global index order (the order of the list does not affect any result: every per-neuron
-    operation is independent and collected spikes are sorted; index order makes the targets of one
-    presynaptic neuron long runs, see :func:`_build_runs`). Returns the new count."""
+def _compact(lo, na, nrn, buf):
+    """Drop the neurons at rest from the ``na`` listed neurons of the compact AMPA-only population
+    starting at ``lo`` and put the others in global index order (the order of the list does not
+    affect any result: every per-neuron operation is independent and collected spikes are sorted;
+    index order makes the targets of one presynaptic neuron long runs, see :func:`_build_runs`).
+    Only the list is read, never the whole population: the neurons listed at the last compaction
+    are still in index order, those activated since follow in the order they came and are sorted
+    (keys global index << 32 | position, so a key's order is its index's), then merged in.
+    Returns the new count."""
     u, g, ref, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot
-    sf, si = buf.scr_f, buf.scr_i
+    sf, key, merged = buf.scr_f, buf.scr_i, buf.col_buf
     j = 0
-    for i in range(lo, hi):
-        k = slot[i]
-        if k < 0:
-            continue
+    for k in range(lo, lo + na):
+        i = cid[k]
         x, gk, r = u[k], g[0, k], ref[k]
         if x == 0.0 and gk == 0.0 and r == 0.0:
             slot[i] = -1
@@ -679,14 +757,35 @@ def _compact(lo, hi, nrn, buf):
         sf[0, j] = x
         sf[1, j] = gk
         sf[2, j] = r
-        si[j] = i
+        key[j] = (np.int64(i) << 32) | j
         j += 1
+    p = 1
+    while p < j and key[p] > key[p - 1]:
+        p += 1
+    src = key
+    if p < j:
+        tail = np.sort(key[p:j])
+        a = b = m = 0
+        nt = j - p
+        while a < p and b < nt:
+            if key[a] < tail[b]:
+                merged[m] = key[a]
+                a += 1
+            else:
+                merged[m] = tail[b]
+                b += 1
+            m += 1
+        merged[m : m + p - a] = key[a:p]
+        merged[m + p - a : j] = tail[b:nt]
+        src = merged
     for m in range(j):
+        v = src[m]
+        i = v >> 32
+        q = v & 0xFFFFFFFF
         k = lo + m
-        u[k] = sf[0, m]
-        g[0, k] = sf[1, m]
-        ref[k] = sf[2, m]
-        i = si[m]
+        u[k] = sf[0, q]
+        g[0, k] = sf[1, q]
+        ref[k] = sf[2, q]
         cid[k] = i
         slot[i] = k
     return j
@@ -785,12 +884,13 @@ def _ltd(plast, pl, w, n_post, n_col, t, buf):
 
 
 @njit(cache=True, nogil=True, fastmath=True, error_model="numpy", boundscheck=False)
-def run_step(t0, n_sub, inputs, learn, par, net):
+def run_step(t0, n_sub, inputs, learn, par, net, prof):
     """Advance the network (``net``: its :class:`KernelState`) by one control step of ``n_sub``
     substeps starting at substep t0.
 
     ``inputs`` are global indices of input fibres spiking at t0; ``learn``: plasticity on; ``par``:
-    numba threads for the large populations. Returns the number of spikes written to
+    numba threads for the large populations; ``prof``: None, or a cost profile the step adds its
+    parts' times to (:data:`PROF_PARTS`). Returns the number of spikes written to
     out_idx/out_t (out_t = substep 1..n_sub at whose end the spike happened).
 
     Sparse projections onto a compact population deliver through a per-presynaptic-neuron cache of
@@ -808,6 +908,8 @@ def run_step(t0, n_sub, inputs, learn, par, net):
     pf_head, pf_lost = plast.pf_head, plast.pf_lost
     col_buf, out_idx, out_t = buf.col_buf, buf.out_idx, buf.out_t
     R = ring_idx.shape[0]
+    pb = pop_i.shape[0]  # the profile's first part (after the populations)
+    tk = prof_now(prof)
     slot0 = t0 % R
     m = ring_n[slot0]
     for k in range(inputs.shape[0]):
@@ -817,7 +919,9 @@ def run_step(t0, n_sub, inputs, learn, par, net):
     n_out = 0
     for s in range(n_sub):
         t = t0 + s
+        tk = prof_lap(prof, pb + BOOKKEEPING, tk)
         run_rules(t, learn, net.learning, dl)  # before delivery: a synapse delivers its updated weight
+        tk = prof_lap(prof, pb + PLASTICITY, tk)
         # sparse projections (CSR by presynaptic neuron); teaching ones carry no current
         for p in range(sp_i.shape[0]):
             if sp_i[p, S_TEACHING] != 0:
@@ -918,6 +1022,8 @@ def run_step(t0, n_sub, inputs, learn, par, net):
                         gs, ws = g[rec, post_lo : post_lo + n_post], dense_w[row : row + n_post]
                         for q in range(n_post):
                             gs[q] += ws[q] * sc
+                    if pl >= 0:
+                        tk = prof_lap(prof, pb + DELIVERY, tk)
                     if pl >= 0 and learn:
                         ltp, hi_w = np.float32(pl_f[pl, 0]), np.float32(pl_f[pl, 3])
                         ws = dense_w[row : row + n_post]
@@ -933,6 +1039,8 @@ def run_step(t0, n_sub, inputs, learn, par, net):
                         pf_t[pl, e] = ta
                         pf_j[pl, e] = j
                         pf_head[pl] += 1
+                        tk = prof_lap(prof, pb + PLASTICITY, tk)
+        tk = prof_lap(prof, pb + DELIVERY, tk)
         # LTD: teacher (CF) spikes arriving now at PCs of each plastic projection
         if learn:
             for pl in range(pl_i.shape[0]):
@@ -954,6 +1062,7 @@ def run_step(t0, n_sub, inputs, learn, par, net):
                 if n_col > 0:
                     w_off = de_i[d, 4]
                     _ltd(plast, pl, dense_w[w_off : w_off + de_i[d, 1] * n_post], n_post, n_col, t, buf)
+        tk = prof_lap(prof, pb + PLASTICITY, tk)
         # integrate the LIF populations whose step ends at t + 1; spikes are stamped t + 1
         nxt = (t + 1) % R
         ring_n[nxt] = 0
@@ -967,6 +1076,7 @@ def run_step(t0, n_sub, inputs, learn, par, net):
                 continue
             hi = lo + na
             pp = pop_par[pi]
+            tk = prof_lap(prof, pb + BOOKKEEPING, tk)  # the spikes collected so far
             if kind == KIND_LIF_AMPA:
                 if par > 1 and na >= PAR_MIN:
                     cnt, nr = _lif_poly_par(u[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], pops, pi, par)
@@ -981,6 +1091,7 @@ def run_step(t0, n_sub, inputs, learn, par, net):
                                      pop_i[pi, I_NFINE])
             else:
                 cnt = _lif_full(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp)
+            tk = prof_lap(prof, pi, tk)
             if cnt > 0:
                 n_out = _collect(flag[lo:hi], cid[lo:hi], ring_idx, nxt, ring_n, out_idx, out_t, n_out,
                                  s + 1, pop_i[pi, I_COMPACT] != 0)
@@ -988,24 +1099,28 @@ def run_step(t0, n_sub, inputs, learn, par, net):
     # they are integrated as exact no-ops)
     for pi in range(pop_i.shape[0]):
         if pop_i[pi, I_COMPACT] != 0 and n_rest[pi] > 0 and COMPACT_FRACTION * n_rest[pi] >= n_act[pi]:
-            n_act[pi] = _compact(pop_i[pi, I_LO], pop_i[pi, I_HI], nrn, buf)
+            n_act[pi] = _compact(pop_i[pi, I_LO], n_act[pi], nrn, buf)
             pop_ep[pi] += 1
             n_rest[pi] = 0
+    prof_lap(prof, pb + BOOKKEEPING, tk)
     return n_out
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def run_chunk(t0, n_sub, inputs, in_off, learn, par, net, chunk_idx, chunk_off):
+def run_chunk(t0, n_sub, inputs, in_off, learn, par, net, chunk_idx, chunk_off, prof):
     """``len(in_off) - 1`` consecutive :func:`run_step` calls in one GIL-free call (a pipelined
     chunk runs without touching Python). Inputs of step s are inputs[in_off[s]:in_off[s + 1]];
-    its spikes (global indices) end up in chunk_idx[chunk_off[s]:chunk_off[s + 1]]."""
+    its spikes (global indices) end up in chunk_idx[chunk_off[s]:chunk_off[s + 1]] (the copy is
+    the profile's bookkeeping)."""
     out_idx = net.buffers.out_idx
     total = 0
     chunk_off[0] = 0
     for s in range(in_off.shape[0] - 1):
-        n = run_step(t0 + s * n_sub, n_sub, inputs[in_off[s]:in_off[s + 1]], learn, par, net)
+        n = run_step(t0 + s * n_sub, n_sub, inputs[in_off[s]:in_off[s + 1]], learn, par, net, prof)
+        tk = prof_now(prof)
         for i in range(n):
             chunk_idx[total + i] = out_idx[i]
+        prof_lap(prof, net.populations.pop_i.shape[0] + BOOKKEEPING, tk)
         total += n
         chunk_off[s + 1] = total
     return total

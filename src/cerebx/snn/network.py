@@ -246,6 +246,7 @@ class Network:
         self._all_changed = True  # every weight counts as changed until the first changed_ranges()
         self.arrays = self._kernel_arrays()
         self._state = kernels.kernel_state(self.arrays)
+        self.prof: np.ndarray | None = None
 
     def _kernel_arrays(self) -> kernels.NetworkArrays:
         """The kernels' view of this network: the same array objects, grouped (state is only ever
@@ -402,6 +403,7 @@ class Network:
         state["_stats_cache"] = {}  # the weight statistics' first pass is read whole after a load
         state.pop("arrays", None)
         state.pop("_state", None)
+        state["prof"] = None  # a cost profile belongs to the process that timed it
         for name in _SCRATCH + _CACHES:
             a = state[name]
             state[name] = (_LEFT_OUT, a.dtype.str, a.shape)
@@ -423,6 +425,7 @@ class Network:
             self.sl = learning.empty()
         if "_stats_dirty" not in state:  # pickled by earlier code
             self._stats_dirty, self._stats_cache = np.zeros_like(self.pl_dirty), {}
+        self.prof = None
         if stale:
             self.sp_c[:, 0] = 0  # no cache is valid (epochs start at 1): each is rebuilt when first used
         self.arrays = self._kernel_arrays()
@@ -514,9 +517,26 @@ class Network:
         n = len(in_off) - 1
         idx, off = self.chunk_buffers(n)
         total = kernels.run_chunk(self.t_sub, self.n_sub, flat, in_off, self.learn, self.n_threads, self._state,
-                                  idx, off)
+                                  idx, off, self.prof)
         self.t_sub += self.n_sub * n
         return idx[:total].copy(), off
+
+    def start_profile(self) -> None:
+        """Time the kernels' parts from now on (:data:`~cerebx.snn.kernels.PROF_PARTS`; ``cerebx bench``). A
+        profiled step runs other compiled code than an unprofiled one (compiled on first use), with the same
+        results; unprofiled steps carry no timing code at all."""
+        self.prof = np.zeros(len(self.topo.names) + len(kernels.PROF_PARTS), dtype=np.int64)
+
+    def profile(self) -> dict[str, float]:
+        """Seconds per part since :meth:`start_profile`: ``integrate.<population>`` for each population integrated,
+        then each of :data:`~cerebx.snn.kernels.PROF_PARTS` (empty when not profiling)."""
+        if self.prof is None:
+            return {}
+        n = len(self.topo.names)
+        out = {f"integrate.{name}": float(self.prof[i]) * 1e-9 for i, name in enumerate(self.topo.names)
+               if self.topo.kind[i] != KIND_INPUT}
+        out.update({part: float(self.prof[n + k]) * 1e-9 for k, part in enumerate(kernels.PROF_PARTS)})
+        return out
 
     def chunk_buffers(self, n: int) -> tuple[np.ndarray, np.ndarray]:
         """The spike buffer and the step offsets :func:`~cerebx.snn.kernels.run_chunk` fills for ``n`` steps (the
@@ -531,6 +551,6 @@ class Network:
         """One 2 ms step; ``inputs`` are global indices of input fibres spiking at its start
         (each fibre at most once)."""
         inputs = np.ascontiguousarray(inputs, dtype=np.int32)
-        n = kernels.run_step(self.t_sub, self.n_sub, inputs, self.learn, self.n_threads, self._state)
+        n = kernels.run_step(self.t_sub, self.n_sub, inputs, self.learn, self.n_threads, self._state, self.prof)
         self.t_sub += self.n_sub
         return StepSpikes(self.out_idx[:n], self.out_t[:n])

@@ -49,7 +49,7 @@ from cerebx.recording.spike_chunks import chunk_spike_messages
 from cerebx.signals import Deferred
 from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
 from cerebx.snn.encoders import EncoderPair
-from cerebx.snn.kernels import run_chunk
+from cerebx.snn.kernels import OUTPUTS, prof_lap, prof_now, run_chunk
 from cerebx.snn.network import Network, pack
 from cerebx.snn.schema import layout_problem
 
@@ -94,15 +94,23 @@ def _chunk_outputs(idx, off, decode, record, first, step_s):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def _run_chunk_outputs(t0, n_sub, flat, in_off, learn, par, net, idx_buf, off, decode, record, first, step_s,
-                       pf_lost):  # pragma: no cover
+def _run_chunk_outputs(net, clock, chunk, outputs, prof):  # pragma: no cover
     """A whole chunk on the network thread in one compiled call: the network's steps
     (:func:`~cerebx.snn.kernels.run_chunk`), then :func:`_chunk_outputs`, and the PF spikes dropped so far. The
     thread needs the interpreter lock once a chunk, to hand the result over: each time it does, the loop's
-    thread, which holds the lock but for its MuJoCo steps, waits for it to let go and for its own wake-up."""
-    total = run_chunk(t0, n_sub, flat, in_off, learn, par, net, idx_buf, off)
+    thread, which holds the lock but for its MuJoCo steps, waits for it to let go and for its own wake-up.
+    ``net``: the network's kernel state; ``clock``: (first substep, substeps per step, plasticity on, threads);
+    ``chunk``: the packed inputs and offsets, and the spike buffer and step offsets to fill
+    (:meth:`~cerebx.snn.network.Network.chunk_buffers`); ``outputs``: the arguments of :func:`_chunk_outputs`
+    after the spikes; ``prof``: None or the network's cost profile."""
+    t0, n_sub, learn, par = clock
+    flat, in_off, idx_buf, off = chunk
+    decode, record, first, step_s = outputs
+    total = run_chunk(t0, n_sub, flat, in_off, learn, par, net, idx_buf, off, prof)
+    tk = prof_now(prof)
     taus, counts, words, starts = _chunk_outputs(idx_buf[:total], off, decode, record, first, step_s)
-    return taus, counts, words, starts, pf_lost.sum()
+    prof_lap(prof, net.populations.pop_i.shape[0] + OUTPUTS, tk)
+    return taus, counts, words, starts, net.plasticity.pf_lost.sum()
 
 
 class NetworkThread:
@@ -256,8 +264,8 @@ class SNNControllerImpl(Controller):
             net = self.net
             idx_buf, off = net.chunk_buffers(n)
             taus, counts, words, starts, lost = _run_chunk_outputs(
-                net.t_sub, net.n_sub, flat, in_off, net.learn, net.n_threads, net._state, idx_buf, off, self._decode,
-                record, first_step, STEP_S, net.pf_lost)
+                net._state, (net.t_sub, net.n_sub, net.learn, net.n_threads), (flat, in_off, idx_buf, off),
+                (self._decode, record, first_step, STEP_S), net.prof)
             net.t_sub += net.n_sub * n
         else:  # agonist/antagonist outputs: decoded here
             idx, off = self.net.step_packed(flat, in_off)

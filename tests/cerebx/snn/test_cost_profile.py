@@ -1,0 +1,69 @@
+"""The kernels' cost profile (``cerebx bench``'s per-step table): it times without changing a result."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from cerebx.bench import bench_network
+from cerebx.loop.timing import closed_loop_rt
+from cerebx.snn.kernels import PROF_PARTS
+from cerebx.snn.network import Network
+from cerebx.snn.presets import network
+
+
+def _inputs(steps: int, n_mf: int, seed: int) -> list[np.ndarray]:
+    """Bursts of a few random MFs a step (each fibre at most once) for 16 ms, then 64 ms without input: GCs
+    activate out of index order, come back to rest and get compacted."""
+    rng = np.random.default_rng(seed)
+    return [np.sort(rng.choice(n_mf, size=int(rng.integers(0, 12)) if k % 40 < 8 else 0,
+                               replace=False)).astype(np.int32) for k in range(steps)]
+
+
+def test_a_profiled_network_steps_exactly_like_an_unprofiled_one():
+    cfg = network(fibers=5, per_joint=10)
+    plain, timed = (Network(cfg, parallel=False, compact_min=1000) for _ in range(2))
+    inputs = _inputs(300, plain.index("mf").stop, seed=2)
+    timed.start_profile()
+    t0 = time.perf_counter()
+    spikes_timed = [timed.step(x).idx.copy() for x in inputs]
+    wall = time.perf_counter() - t0
+    spikes_plain = [plain.step(x).idx.copy() for x in inputs]
+    unlisted = Network(cfg, parallel=False, compact_min=10**9)  # every GC integrated, no list to compact
+    spikes_unlisted = [unlisted.step(x).idx.copy() for x in inputs]
+    assert sum(len(s) for s in spikes_plain) > 100
+    assert plain.pop_ep[plain.topo.index["gc"]] > 3  # the GC list was compacted (sorted and merged) repeatedly
+    assert all(np.array_equal(a, b) for a, b in zip(spikes_plain, spikes_timed))
+    assert all(np.array_equal(a, b) for a, b in zip(spikes_plain, spikes_unlisted))
+    for key, value in plain.state_arrays().items():
+        np.testing.assert_array_equal(timed.state_arrays()[key], value, err_msg=key)
+        np.testing.assert_array_equal(unlisted.state_arrays()[key], value, err_msg=key)
+    prof = timed.profile()
+    assert set(prof) == {"integrate.gc", "integrate.pc", "integrate.dcn", *PROF_PARTS}
+    assert all(prof[k] > 0 for k in ("integrate.gc", "integrate.pc", "integrate.dcn", "delivery", "bookkeeping"))
+    assert prof["outputs"] == 0.0  # decoding is the controller's chunk kernel's
+    assert sum(prof.values()) < wall
+    assert plain.profile() == {}
+
+
+@pytest.mark.integration
+def test_the_closed_loop_reports_each_part_per_step():
+    out = closed_loop_rt(["+task=circle", "+experiment=small_snn"], seconds=0.5, warmup_s=0.5, parts=True)
+    parts = out["per_step_us"]
+    assert {"plant", "brain", "loop"} <= set(parts["main"])
+    assert parts["main_total"] == pytest.approx(sum(parts["main"].values()), abs=0.1)
+    net = parts["network"]
+    assert {"integrate.gc", "integrate.dcn", "delivery", "plasticity", "bookkeeping", "outputs"} <= set(net)
+    assert all(v > 0 for k, v in net.items() if k != "thread_other")
+    assert parts["network_busy"] == pytest.approx(sum(net.values()), abs=0.1)
+    assert 0 < parts["network_cpu"] < parts["process_cpu"]
+
+
+def test_the_network_bench_splits_a_step_into_parts():
+    out = bench_network(network(fibers=5, per_joint=10), seconds=0.2, warmup=0.1)
+    parts = out["per_step_us"]
+    assert {"integrate.gc", "integrate.pc", "integrate.dcn", *PROF_PARTS, "total"} == set(parts)
+    assert 0 < sum(v for k, v in parts.items() if k != "total") < parts["total"]
+    assert out["listed_neurons"] == {}  # 3,750 GCs: below the size from which a population keeps a list
