@@ -10,6 +10,9 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 os.environ.setdefault("NUMBA_CACHE_DIR", str(ROOT / ".cache" / "numba"))
 os.environ.setdefault("CEREBX_CACHE", str(ROOT / ".cache" / "cerebx"))
+from cerebx.numba_cache import retire_stale  # noqa: E402  (kernels compiled from other sources are dropped first)
+
+retire_stale(Path(os.environ["NUMBA_CACHE_DIR"]))
 
 DEMO = ["+experiment=demo"]
 

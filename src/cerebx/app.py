@@ -19,8 +19,9 @@ from omegaconf import DictConfig
 from cerebx import runfiles
 from cerebx.config import to_plain, user_choices
 from cerebx.errors import CerebxError, ConfigError
-from cerebx.link.pairing import PairingRefused
+from cerebx.link.pairing import NotPaired
 from cerebx.loop import resume
+from cerebx.loop.brain_side import leave_nothing
 from cerebx.loop.runner import run_experiment
 from cerebx.recording.console import print_summary
 from cerebx.schema.experiment import validate
@@ -52,9 +53,13 @@ def run_app(cfg: DictConfig) -> float | None:
     choices = user_choices(hc.runtime.choices)
     try:
         summary = run_experiment(exp, run_dir, plain, overrides=list(hc.overrides.task), choices=choices)
-    except CerebxError as err:  # a wall-clock run whose sides did not pair (refused: composed differently)
+    except NotPaired as err:  # a wall-clock run whose sides did not pair: one line, nothing left behind
         print(err, file=sys.stderr)
-        raise SystemExit(2 if isinstance(err, PairingRefused) else 1) from None
+        leave_nothing(run_dir)
+        raise SystemExit(2) from None
+    except CerebxError as err:
+        print(err, file=sys.stderr)
+        raise SystemExit(1) from None
     print_summary(summary, run_dir)
     if summary["status"] == "interrupted":
         raise SystemExit(130)

@@ -53,6 +53,11 @@ def main(argv: list[str] | None = None) -> int:
 def _main(argv: list[str] | None) -> int:
     # compiled numba kernels go to one cache folder, never into src/.../__pycache__
     os.environ.setdefault("NUMBA_CACHE_DIR", str(numba_cache_dir()))
+    from pathlib import Path
+
+    from cerebx.numba_cache import retire_stale
+
+    retire_stale(Path(os.environ["NUMBA_CACHE_DIR"]))
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv and argv[0] in ("-sc", "--shell-completion"):
         return importlib.import_module(COMMANDS["run"]).completion(argv)

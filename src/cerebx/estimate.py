@@ -96,6 +96,9 @@ def estimate(exp: Any) -> Estimate:
     plastic = sum(p.network.n_plastic for p in snn)
     if any(getattr(p, "record_spikes", None) for p in snn):
         per_s += BYTES_PER_S_SPIKES
+    window = exp.recording.trials
+    if window is not None:  # the step channels of the held trials only (the per-trial messages are negligible)
+        per_s *= len(window.trials(exp.trials)) / exp.trials
     neurons = sum(p.network.n_neurons for p in snn)
     state = STATE_BYTES_PER_PLASTIC * plastic + STATE_BYTES_PER_NEURON * neurons if exp.recording.save_state else 0.0
     wall = sim_s * (WALL_PER_SIM_S + WALL_PER_SIM_S_PER_PLASTIC * plastic)

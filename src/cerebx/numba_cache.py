@@ -58,6 +58,54 @@ class ColdKernels:
                 f"change): compiling them first, ~{self.seconds:.0f} s, once (cached in {self.cache_dir})")
 
 
+STAMP = "cerebx-sources.sha1"
+"""File in the cache folder naming the kernel sources its entries were compiled from."""
+
+
+def sources_stamp() -> str:
+    """A digest of every source file of cerebx and its sibling plugin packages that uses numba. numba keeps a
+    cached kernel while the kernel's own file is unchanged, even when a type it was compiled against (a struct
+    of another module) has changed or moved: loading it then fails (``Can't get attribute ...``) instead of
+    compiling again. So any change to any numba-using file retires the whole cache."""
+    import cerebx
+
+    root = Path(cerebx.__file__).resolve().parents[1]
+    h = hashlib.sha1()
+    for path in sorted(root.glob("cerebx*/**/*.py")):
+        text = path.read_bytes()
+        if b"numba" in text:
+            h.update(str(path.relative_to(root)).encode() + b"\0" + hashlib.sha1(text).digest())
+    return h.hexdigest()
+
+
+def retire_stale(cache_dir: Path) -> bool:
+    """Empty ``cache_dir`` of compiled kernels when the numba-using sources changed since they were compiled
+    (see :func:`sources_stamp`); True when it did. Cheap when nothing changed (one digest of the sources)."""
+    stamp = sources_stamp()
+    mark = cache_dir / STAMP
+    try:
+        if mark.read_text() == stamp:
+            return False
+    except OSError:
+        pass
+    removed = False
+    if cache_dir.is_dir():
+        for f in [*cache_dir.rglob("*.nbi"), *cache_dir.rglob("*.nbc")]:
+            try:
+                f.unlink()
+                removed = True
+            except OSError:
+                pass
+    try:
+        cache_dir.mkdir(parents=True, exist_ok=True)
+        tmp = mark.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(stamp)
+        tmp.replace(mark)
+    except OSError:
+        pass
+    return removed
+
+
 def cold_kernels(exps: list[Any], cache_dir: Path | None = None) -> ColdKernels:
     """The not yet compiled kernels of the runs of experiments ``exps`` (a sweep's jobs compile each kernel once;
     ``cache_dir``: numba's cache folder, by default ``NUMBA_CACHE_DIR``)."""
@@ -145,9 +193,11 @@ def _imports(name: str) -> list[str]:
 
 @functools.cache
 def _kernel_count(name: str) -> int:
-    """The ``cache=True`` kernels defined in module ``name``."""
+    """The ``cache=True`` kernels defined in module ``name``, with one per ``KernelStruct`` subclass (a class
+    given ``fields=``: its compiled constructor)."""
     return sum(1 for node in ast.walk(_tree(name)) if isinstance(node, ast.FunctionDef)
-               and any(_caches(d) for d in node.decorator_list))
+               and any(_caches(d) for d in node.decorator_list)
+               or isinstance(node, ast.ClassDef) and any(k.arg == "fields" for k in node.keywords))
 
 
 def _caches(decorator: ast.expr) -> bool:

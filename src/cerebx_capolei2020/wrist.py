@@ -53,7 +53,8 @@ class ICubWrist(Plant):
         self._ball_v = m.jnt_dofadr[m.joint("ball").id] if cfg.ball else None
         self._period_s = 1.0 / cfg.sample_rate_hz
         self._rng = np.random.default_rng(0)
-        self._next_sample_s = 0.0
+        self._ticks = 0          # control steps since reset
+        self._samples = 0        # encoder samples taken since reset
         self._held = (np.zeros(3), np.zeros(3))
         self.balls_dropped = 0
 
@@ -62,9 +63,18 @@ class ICubWrist(Plant):
         self.data.qpos[self._qadr] = q0
         mujoco.mj_forward(self.model, self.data)
         self._rng = rng
-        self._next_sample_s = 0.0
+        self._ticks = 0
+        self._samples = 0
         self.balls_dropped = 0
         self._drop_ball()
+
+    def __setstate__(self, state: dict) -> None:
+        # Checkpoints written before the sample counters existed carry the running sum ``_next_sample_s``.
+        if "_next_sample_s" in state:
+            t = float(state["data"].time)
+            state["_ticks"] = int(round(t / self.control_dt_s))
+            state["_samples"] = int(round(state.pop("_next_sample_s") * state["cfg"].sample_rate_hz))
+        self.__dict__.update(state)
 
     def _drop_ball(self) -> None:
         if self._ball_q is None:
@@ -79,14 +89,17 @@ class ICubWrist(Plant):
         self.balls_dropped += 1
 
     def sensors(self) -> tuple[np.ndarray, np.ndarray]:
-        if self.data.time + 1e-9 >= self._next_sample_s:
+        # Sample k is due at k / sample_rate_hz. Both sides are products of whole counts, never running sums:
+        # MuJoCo's clock is a sum of 0.5 ms steps and drifts from one by 2e-9 s after about 188 s, which once
+        # moved every later sample one control tick late (Capolei's case A stepped at trial 48).
+        if self._ticks * self.control_dt_s + 1e-9 >= self._samples * self._period_s:
             q, qd = self.true_state()
             a = self.cfg.sensor_noise
             if a > 0:
                 q += self._rng.uniform(-a, a, 3)
                 qd += self._rng.uniform(-a, a, 3)
             self._held = (q, qd)
-            self._next_sample_s += self._period_s
+            self._samples += 1
         return self._held[0].copy(), self._held[1].copy()
 
     def true_state(self) -> tuple[np.ndarray, np.ndarray]:
@@ -99,6 +112,7 @@ class ICubWrist(Plant):
 
     def step(self) -> None:
         mujoco.mj_step(self.model, self.data, nstep=self._n)
+        self._ticks += 1
         if self._ball_q is not None and self.cfg.ball_reset:
             if self.data.qpos[self._ball_q + 2] < self.data.site_xpos[self._table][2] - self.cfg.ball_lost_below_m:
                 self._drop_ball()

@@ -16,3 +16,4 @@ def register() -> None:
     # learning runs as users make them, timed by `cerebx bench`: what `make run` runs, and chapter 3's
     add_bench_run("make_run", ["+experiment=default"])
     add_bench_run("learn_circle_ch3", ["+experiment=learn_circle_ch3"])
+    add_bench_run("learn_circle_golgi", ["+experiment=learn_circle_golgi"])

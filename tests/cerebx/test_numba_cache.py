@@ -78,3 +78,20 @@ def test_progress_counts_cerebx_kernels_only(capsys):
 def _fresh_parse():
     """Each test reads the sources as they are now."""
     numba_cache._closure.cache_clear()
+
+
+def test_a_cache_compiled_from_other_sources_is_retired(tmp_path):
+    """A kernel cached against a struct that has since changed or moved fails to load instead of compiling again
+    (numba checks only the kernel's own file): any change to a numba-using source retires the whole cache once."""
+    from cerebx.numba_cache import STAMP, retire_stale, sources_stamp
+
+    cache = tmp_path / "numba"
+    (cache / "snn_0123").mkdir(parents=True)
+    old = [cache / "snn_0123" / "kernels.run_step-10.py311.nbi", cache / "snn_0123" / "kernels.run_step-10.py311.1.nbc"]
+    for f in old:
+        f.write_bytes(b"compiled elsewhere")
+    (cache / STAMP).write_text("sources of another version")
+    assert retire_stale(cache)
+    assert not any(f.exists() for f in old) and (cache / STAMP).read_text() == sources_stamp()
+    old[0].write_bytes(b"compiled from these sources")
+    assert not retire_stale(cache) and old[0].exists()

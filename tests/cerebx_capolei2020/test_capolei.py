@@ -163,3 +163,26 @@ def test_architecture_iv_beats_the_pid_alone(load, tmp_path):
     assert pid["status"] == both["status"] == "completed"
     assert both["mae_per_trial"][:7] == pytest.approx(pid["mae_per_trial"][:7])  # identical until corrections
     assert both["mae_per_trial"][-1] < 0.7 * pid["mae_per_trial"][-1]
+
+
+def test_encoder_samples_stay_on_the_50hz_grid_past_188_s():
+    """The encoders are sampled every 10th control tick for as long as the run lasts. MuJoCo's clock is a
+    running sum of 0.5 ms steps; before the sample times were counted, its 2e-9 s drift after ~188 s moved
+    every later sample one tick late, and every architecture's error stepped at trial 48 of case A."""
+    from cerebx_capolei2020.schema import ICubWristConfig
+    from cerebx_capolei2020.wrist import ICubWrist
+
+    plant = ICubWrist(ICubWristConfig(ball=False))
+    plant.reset(np.zeros(3), np.random.default_rng(0))
+    changed, last = [], None
+    for tick in range(96_000):  # 192 s
+        q, _ = plant.sensors()
+        if last is not None and not np.array_equal(q, last):
+            changed.append(tick)
+        last = q
+        plant.apply(0.05 * np.sin([tick * 0.002, tick * 0.003 + 1.0, tick * 0.0025 + 2.0]))
+        plant.step()
+    assert plant.time_s > 188.0
+    gaps = np.diff(changed)
+    assert len(changed) > 9000 and set(gaps.tolist()) == {10}
+    assert changed[-1] % 10 == 0

@@ -231,3 +231,17 @@ def test_stage_kernel_peaks_at_teaching_delay_plus_arm_lag(load):
         stage = build_components(load(["+experiment=luque2011_eight", *extra])).brain[0].parts[1]
         assert stage.describe()["kernel_peak_ms"] == peak
         assert np.argmax(stage.kern) * stage.cfg.substep_ms == pytest.approx(peak, abs=0.25)
+
+
+def test_a_checkpoints_positional_constants_still_run(load):
+    """A circuit pickled before the constants were named carries them as arrays in field order: it loads with the
+    same constants, named and typed (integers as integers, the learning switch a bool)."""
+    from cerebx.build import build_components
+
+    stage = build_components(load(["+experiment=luque2011_eight"])).brain[0].parts[1]
+    named = stage.circuit.source
+    old = named._replace(pars=np.array(named.pars, float), pc=named.pc._replace(par=np.array(named.pc.par, float)),
+                         dcn=named.dcn._replace(par=np.array(named.dcn.par, float)))
+    restored = k.circuit_state(old)
+    assert restored.source.pars == named.pars and restored.source.dcn.par == named.dcn.par
+    assert isinstance(restored.source.pars.n_sub, int) and restored.source.pars.learn is True

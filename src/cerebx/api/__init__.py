@@ -10,11 +10,15 @@ import from cerebx. Everything else is internal and may change between versions;
   implement ``control(ControlInput) -> TorqueMsg``), ``Plant`` (a robot or
   body; ``MujocoArm`` for MuJoCo models), ``Task`` and ``TrialReference`` (desired trajectories), the encoders'
   interface (``MossyEncoder``, ``ClimbingEncoder``: see the how-tos), ``Frame`` (one tick's signals), ``LWPR``.
+- Kernels: ``KernelStruct`` (a numba kernel's arrays and constants, named, as one argument).
 - Builders: ``BuildContext`` (what a builder is given: the config, the parts built before it, a generator per
   component) and one builder protocol per registry group (``TaskBuilder``, ``PlantBuilder``,
   ``ControllerBuilder``, ``StageBuilder``, ``ReceiverBuilder``, ``DelayBuilder``, ``EventBuilder``,
   ``MossyEncoderBuilder``, ``ClimbingEncoderBuilder``, ``LinkBuilder``), with ``PlantView`` and ``TaskView``
   (what a builder may use of the plant and the task).
+- Export to NEST and PyNN: ``register_export`` (what a plugin's neuron, connector or plasticity kind becomes
+  there, as a ``NeuronMap``, ``PlasticityMap``, rule string or ``Refused``; ``cerebx export``, docs: cerebx and
+  NEST).
 - Checkers a plugin runs in its tests: ``check_plant``, ``check_experiment``.
 - Learned state: ``save_state_npz``, ``load_state_npz``.
 - Building and loading an experiment: ``load`` (compose and validate a command line's overrides),
@@ -36,11 +40,12 @@ RUNTIME = (
     "BuildContext", "ClimbingEncoderBuilder", "ConnectorBuilder", "ControllerBuilder", "DelayBuilder", "EventBuilder",
     "LinkBuilder", "PlasticityBuilder",
     "MossyEncoderBuilder", "PlantBuilder", "PlantView", "ReceiverBuilder", "StageBuilder", "TaskBuilder", "TaskView",
-    "LWPR", "ClimbingEncoder", "ControlInput", "Controller", "Frame", "MossyEncoder", "MujocoArm", "Plant",
+    "LWPR", "ClimbingEncoder", "ControlInput", "Controller", "Frame", "KernelStruct", "MossyEncoder", "MujocoArm",
+    "Plant",
     "PlantEvent", "Stage", "Task", "TorqueMsg", "TrialReference", "build_components", "channel_counts",
     "check_experiment", "check_plant", "final_mae", "grab_anchor", "half_sine", "load", "load_state_npz",
     "ltd_kernel_table", "mf_ranges", "read_messages", "read_metadata", "read_summary", "save_state_npz",
-    "updates_every",
+    "updates_every", "NeuronMap", "PlasticityMap", "Refused", "register_export",
 )
 """The names :mod:`cerebx.api.runtime` provides."""
 

@@ -22,6 +22,8 @@ from cerebx.builders import (
 from cerebx.config import load
 from cerebx.controllers.base import ControlInput, Controller, TorqueMsg
 from cerebx.controllers.ranges import mf_ranges
+from cerebx.export.mapping import NeuronMap, PlasticityMap, Refused, register_export
+from cerebx.kernel_struct import KernelStruct
 from cerebx.lwpr.model import LWPR
 from cerebx.metrics import final_mae
 from cerebx.persistence.state import load_state_npz, save_state_npz
@@ -39,6 +41,10 @@ from cerebx.stages.pid import updates_every
 from cerebx.tasks.base import Task, TrialReference
 
 __all__ = [
+    "NeuronMap",
+    "PlasticityMap",
+    "Refused",
+    "register_export",
     "BuildContext",
     "ClimbingEncoderBuilder",
     "ControllerBuilder",
@@ -59,6 +65,7 @@ __all__ = [
     "ControlInput",
     "Controller",
     "Frame",
+    "KernelStruct",
     "MossyEncoder",
     "MujocoArm",
     "Plant",

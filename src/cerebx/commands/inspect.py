@@ -3,14 +3,16 @@ other still shown."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 from cerebx import runfiles
 from cerebx.commands.common import Parser, fail
 from cerebx.errors import CerebxError
 from cerebx.recording.console import format_summary
-from cerebx.recording.reader import channel_counts, has_summary, read_summary
+from cerebx.recording.reader import channel_counts, has_summary, read_metadata, read_summary
 from cerebx.recording.segments import segments
+from cerebx.schema.window import TrialWindow
 
 
 def parser() -> Parser:
@@ -18,6 +20,26 @@ def parser() -> Parser:
     ap = Parser("cerebx inspect", "a run's summary and its MCAP channels")
     ap.add_argument("path", help="a run folder (RUN_DIR) or one of its .mcap files")
     return ap
+
+
+def recorded_steps(path: Path) -> str | None:
+    """Which control steps the log holds (``recording.trials``, ``decimation``, ``joint_states``), from its
+    recorded config; None when that cannot be read."""
+    try:
+        cfg = json.loads(read_metadata(path)["config"]["json"])
+        rec = cfg.get("recording") or {}
+        value = rec.get("trials")
+        window = None if value in (None, "all") else TrialWindow.model_validate({} if value == "none" else value)
+    except (CerebxError, KeyError, OSError, ValueError, TypeError):
+        return None
+    n = int(cfg.get("trials") or 0)
+    held = f"every trial ({n})" if window is None else f"trials {window.describe(n)}"
+    out = f"control steps recorded (recording.trials): {held}"
+    if int(rec.get("decimation") or 1) > 1:
+        out += f"; every {rec['decimation']}th step"
+    if rec.get("joint_states") is False:
+        out += "; no joint states"
+    return out
 
 
 def main(args: list[str]) -> int:
@@ -43,6 +65,9 @@ def main(args: list[str]) -> int:
                                    "complete record; the run was killed or is still going)"))
         for topic, n in counts.items():
             print(f"  {topic:<{width}}  {n:>9,}")
+        steps = recorded_steps(p)
+        if steps:
+            print(steps)
         robot = run_dir / "robot"
         if p.is_dir() and (robot / runfiles.MCAP).exists():  # the robot side of a wall-clock run
             log = robot / runfiles.MCAP

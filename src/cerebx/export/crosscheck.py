@@ -19,35 +19,39 @@ import os
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from cerebx.errors import CerebxError
+from cerebx.export.drift import Drift, drift_row, nest_weights_at
 from cerebx.export.mapping import plan
-from cerebx.export.writer import TARGETS, export
+from cerebx.export.writer import TARGETS, export, synapse_tables
 from cerebx.snn.schema import JointCombinations, NetworkConfig
+from cerebx.snn.topology import build_topology
 
 Spikes = dict[str, tuple[np.ndarray, np.ndarray]]
 """Population -> (local neuron index, spike time in ms)."""
 
 STEP_MS = 2.0
+FIBERS_PER_SIGNAL = 5
+"""Mossy fibres per box-coded signal where no joint_combinations projection of the network says how many."""
 
 
 def seeded_inputs(cfg: NetworkConfig, ms: float, seed: int = 0, cf_rate_hz: float = 5.0) -> Spikes:
     """Input spike trains of ``ms`` milliseconds (spikes at 2 ms step starts; none in the first step, so a
     recording starts from rest as a run does): the mossy population box-coded (groups of ``fibers_per_signal``
-    fibres, one active per group, following a sinusoid of random period 0.5-2 s and phase), the climbing
-    population Bernoulli at ``cf_rate_hz``."""
+    fibres, else of :data:`FIBERS_PER_SIGNAL`, one active per group, following a sinusoid of random period
+    0.5-2 s and phase), the climbing population Bernoulli at ``cf_rate_hz``."""
     rng = np.random.default_rng(seed)
     n_steps = int(round(ms / STEP_MS))
     t = np.arange(1, n_steps) * STEP_MS
     out: Spikes = {}
     mf = cfg.populations[cfg.io.mossy].size
     group = next((p.rule.fibers_per_signal for p in cfg.projections.values()
-                  if p.pre == cfg.io.mossy and isinstance(p.rule, JointCombinations)), mf)
+                  if p.pre == cfg.io.mossy and isinstance(p.rule, JointCombinations)), min(mf, FIBERS_PER_SIGNAL))
     n_groups = mf // group
     period = rng.uniform(500.0, 2000.0, n_groups)
     phase = rng.uniform(0, 2 * np.pi, n_groups)
@@ -62,16 +66,18 @@ def seeded_inputs(cfg: NetworkConfig, ms: float, seed: int = 0, cf_rate_hz: floa
 
 
 def run_cerebx(cfg: NetworkConfig, inputs: Spikes, ms: float, sliced: bool = True,
-               sparse_w: np.ndarray | None = None, cpu: list[float] | None = None) -> tuple[Spikes, float]:
-    """cerebx on one thread, plasticity off, driven by ``inputs`` (every spike at a 2 ms step start); returns
-    every population's spikes and the wall time of the run (build excluded). ``sliced``: one ``step`` call per
-    2 ms (the 500 Hz loop's pace); otherwise one ``step_packed`` call for the whole run (spike times then at
-    step resolution are not recorded: only used for timing). ``sparse_w``: the weights of the sparse projections
-    (their synapses in topology order) instead of the configured ones; ``cpu`` receives the run's CPU time."""
+               sparse_w: np.ndarray | None = None, cpu: list[float] | None = None, learn: bool = False,
+               weights: dict[str, np.ndarray] | None = None) -> tuple[Spikes, float]:
+    """cerebx on one thread, plasticity off unless ``learn``, driven by ``inputs`` (every spike at a 2 ms step
+    start); returns every population's spikes and the wall time of the run (build excluded). ``sliced``: one
+    ``step`` call per 2 ms (the 500 Hz loop's pace); otherwise one ``step_packed`` call for the whole run (spike
+    times then at step resolution are not recorded: only used for timing). ``sparse_w``: the weights of the sparse
+    projections (their synapses in topology order) instead of the configured ones; ``cpu`` receives the run's CPU
+    time; ``weights`` the sparse projections' weights at the end (synapse table order, :mod:`.writer`)."""
     from cerebx.snn.network import Network, pack
 
     net = Network(cfg, parallel=False)
-    net.learn = False
+    net.learn = learn
     if sparse_w is not None:
         net.sp_w[:] = sparse_w
     n_steps = int(round(ms / STEP_MS))
@@ -112,6 +118,9 @@ def run_cerebx(cfg: NetworkConfig, inputs: Spikes, ms: float, sliced: bool = Tru
         out[name] = ((gid[m] - lo).astype(np.int32), gt[m])
     for pop, spikes in inputs.items():
         out[pop] = spikes
+    if weights is not None:
+        for name in dict.fromkeys(piece.name for piece in topo.sparse):
+            weights[name] = net.sparse_weights(name)[2]
     return out, wall
 
 
@@ -132,20 +141,23 @@ def nest_python() -> str:
 
 
 def run_nest(folder: Path, ms: float, slice_ms: float = 0.0, mode: str = "simulate", threads: int = 1,
-             python: str | None = None) -> tuple[Spikes, dict[str, Any]]:
-    """Run the exported NEST script in ``folder``; returns its spikes and its timing line."""
+             python: str | None = None, weights: dict[str, np.ndarray] | None = None) -> tuple[Spikes, dict[str, Any]]:
+    """Run the exported NEST script in ``folder``; returns its spikes and its timing line. ``weights`` receives
+    the plastic projections' recorded weights (``wr/...``, ``w_end/...``: ``nest_network.py --weights``)."""
     script = folder / TARGETS["nest"]
     out = folder / f"spikes_nest_{mode}_{slice_ms:g}.npz"
     cmd = [python or nest_python(), str(script), "--ms", str(ms), "--slice-ms", str(slice_ms), "--mode", mode,
-           "--threads", str(threads), "--out", str(out)]
+           "--threads", str(threads), "--out", str(out)] + (["--weights"] if weights is not None else [])
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         tail = (proc.stderr.strip().splitlines() or ["failed"])[-1]
         raise CerebxError(f"crosscheck: NEST run failed: {tail}")
     timing = json.loads(proc.stdout.strip().splitlines()[-1])
     with np.load(out) as data:
-        names = {k.split("/")[0] for k in data.files}
+        names = {k[: -len("/idx")] for k in data.files if k.endswith("/idx") and k.count("/") == 1}
         spikes = {n: (data[f"{n}/idx"], data[f"{n}/t"]) for n in names}
+        if weights is not None:
+            weights.update({k: data[k] for k in data.files if k.startswith(("wr/", "w_end/"))})
     return spikes, timing
 
 
@@ -262,18 +274,27 @@ class Crosscheck:
     cerebx_s: float
     nest_s: float
     nest_build_s: float
+    drift: list[Drift] = field(default_factory=list)
 
 
 def crosscheck(cfg: NetworkConfig, out: Path, ms: float = 1000.0, seed: int = 0, layer: list[str] | None = None,
-               window_ms: float = 1.0, python: str | None = None) -> Crosscheck:
+               window_ms: float = 1.0, python: str | None = None, plastic: bool = False) -> Crosscheck:
     """Export ``cfg`` (plastic projections static, what NEST lacks left out and said), drive cerebx and NEST with
     the same seeded input for ``ms`` and compare. With ``layer``, cerebx runs the whole network and NEST only the
-    layer, fed with the spikes cerebx's other populations produced."""
+    layer, fed with the spikes cerebx's other populations produced. ``plastic``: the rules NEST expresses (pair
+    STDP) learn in both, and their weight drift is compared (``Crosscheck.drift``); the others stay static in
+    both."""
     p = plan(cfg, static=True, approximate=True)
     notes = list(p.notes)
     cfg_run = without(cfg, [k for k in p.dropped if not cfg.projections[k].teaching]) if p.dropped else cfg
+    learning = [k for k, pp in p.projections.items() if pp.synapse != "static_synapse"] if plastic else []
+    frozen = [k for k, pp in p.projections.items() if pp.plastic or (not plastic and pp.synapse != "static_synapse")]
+    cfg_run = static_weights(cfg_run, frozen)  # a rule that learns in one learns in both
+    if plastic:
+        notes += [f"projections.{k}: static in both (NEST cannot express its rule)" for k in frozen]
     inputs = seeded_inputs(cfg_run, ms, seed)
-    cx, cx_s = run_cerebx(cfg_run, inputs, ms)
+    w_cx: dict[str, np.ndarray] = {}
+    cx, cx_s = run_cerebx(cfg_run, inputs, ms, learn=bool(learning), weights=w_cx)
     target = cfg_run
     nest_inputs = inputs
     if layer:
@@ -281,11 +302,40 @@ def crosscheck(cfg: NetworkConfig, out: Path, ms: float = 1000.0, seed: int = 0,
         nest_inputs = {n: cx[n] for n, pop in target.populations.items() if pop.neuron.kind == "input"}
         notes.append(f"NEST simulates {', '.join(layer)} only, fed with the spikes of cerebx's "
                      f"{', '.join(sorted(nest_inputs))}")
-    export(target, out, to=("nest",), static=True, approximate=True, inputs=nest_inputs)
-    ne, timing = run_nest(out, ms, python=python)
+    topo = build_topology(target)
+    tp = export(target, out, to=("nest",), static=True, approximate=True, inputs=nest_inputs, topo=topo)
+    w_ne: dict[str, np.ndarray] = {}
+    ne, timing = run_nest(out, ms, python=python, weights=w_ne if learning else None)
     names = [n for n, pop in target.populations.items() if pop.neuron.kind != "input"]
     rows = compare(cfg_run, cx, ne, ms, window_ms, names)
-    return Crosscheck(cfg.name, ms, rows, notes, cx_s, timing["sim_s"], timing["build_s"])
+    tables = synapse_tables(topo)
+    drift = [_drift(tp.projections[k], k, tables[k], w_cx[k], w_ne, ne, ms)[0] for k in learning
+             if k in tp.projections]
+    return Crosscheck(cfg.name, ms, rows, notes, cx_s, timing["sim_s"], timing["build_s"], drift)
+
+
+def static_weights(cfg: NetworkConfig, projections: list[str]) -> NetworkConfig:
+    """``cfg`` with the plasticity of ``projections`` removed (their weights as configured, static)."""
+    d = cfg.model_dump()
+    for k in projections:
+        d["projections"][k]["plasticity"] = None
+    return NetworkConfig.model_validate(d)
+
+
+def _drift(pp: Any, name: str, table0: dict[str, np.ndarray], w_cerebx: np.ndarray, w_nest: dict[str, np.ndarray],
+           ne: Spikes, ms: float) -> tuple[Drift, np.ndarray]:
+    """cerebx's and NEST's weights of plastic projection ``name`` after ``ms``, compared synapse by synapse; also
+    NEST's weights in synapse table order."""
+    pre, post, d = table0["pre"], table0["post"], table0["d"]
+    key = pre.astype(np.int64) * (1 << 32) + post
+    if len(np.unique(key)) != len(key):
+        raise CerebxError(f"crosscheck: projections.{name}: weight drift is compared per (pre, post) pair; this "
+                          "projection has several synapses on one pair")
+    w0 = {(int(j), int(i), float(x)): float(w) for j, i, x, w in zip(pre, post, d, table0["w"], strict=True)}
+    at = nest_weights_at(w_nest, name, w0, ne[pp.pre], ne[pp.post], pp.synapse_params, ms)
+    w_max = abs(pp.synapse_params["Wmax"])
+    return drift_row(name, table0["w"].astype(np.float64), w_cerebx, np.array(list(at.values())), w_max), \
+        np.array(list(at.values()))
 
 
 def single_neuron(neuron: dict[str, Any], weights_nS: tuple[float, float], rate_hz: float, ms: float, dt_ms: float,
@@ -294,8 +344,6 @@ def single_neuron(neuron: dict[str, Any], weights_nS: tuple[float, float], rate_
     Bernoulli train (``rate_hz``, spikes at 2 ms step starts), weights spread evenly over ``weights_nS``; cerebx
     (its integrator at ``dt_ms``) against NEST's iaf_cond_exp at resolution ``dt_ms``. Returns the rates, their
     relative difference, the count correlation and the spikes matched on the same grid step and within 1 ms."""
-    from cerebx.snn.topology import build_topology
-
     nrn = {**neuron, "integration": {**neuron.get("integration", {}), "dt_ms": None}}
     cfg = NetworkConfig.model_validate({
         "name": "single", "dt_ms": dt_ms, "neurons": {},
@@ -336,9 +384,11 @@ class Speed:
 def speed(cfg: NetworkConfig, out: Path, ms: float, seed: int = 0, python: str | None = None) -> list[Speed]:
     """cerebx in 2 ms ``step`` calls (the 500 Hz loop's pace) and in one ``step_packed`` call; NEST (the export in
     ``out``, written here) in ``Simulate(2.0)`` slices, in ``Run(2.0)`` slices inside one ``RunManager``, and in one
-    ``Simulate``. What NEST cannot express is left out of both, as in :func:`crosscheck`."""
+    ``Simulate``. What NEST cannot express is left out of both, as in :func:`crosscheck`, and plasticity is off in
+    both."""
     p = plan(cfg, static=True, approximate=True)
     cfg_run = without(cfg, [k for k in p.dropped if not cfg.projections[k].teaching]) if p.dropped else cfg
+    cfg_run = static_weights(cfg_run, [k for k, x in cfg_run.projections.items() if x.plasticity is not None])
     inputs = seeded_inputs(cfg_run, ms, seed)
     n = ms / STEP_MS
     rows = []
@@ -378,3 +428,38 @@ def speed_table(rows: list[Speed], ms: float) -> str:
     lines.append(f"Per-step overhead (CPU, sliced minus one call, per 2 ms step): cerebx {1000 * cx:.0f} µs, "
                  f"NEST Simulate {1000 * ne:.0f} µs, NEST Run {1000 * nr:.0f} µs.")
     return "\n".join(lines)
+
+
+def stdp_synapses(pre: tuple[np.ndarray, np.ndarray], drive: tuple[np.ndarray, np.ndarray], n: int, ms: float,
+                  out: Path, rule: dict[str, Any] | None = None, delay_ms: Any = 1.0, drive_nS: float = 60.0,
+                  python: str | None = None) -> tuple[Drift, dict[str, Any]]:
+    """``n`` plastic synapses (pair STDP, ``delay: dendritic``, w0 0.5 of [0, 1] nS), one per post neuron, each
+    fed by its own input fibre (``pre``: local fibre, time in ms) while a strong synapse from ``drive`` (0.5 ms,
+    ``drive_nS``) makes its post neuron (the thesis network's PC) fire; cerebx against NEST's stdp_synapse.
+    Returns the drift row and per synapse (table order) ``d``, ``w0``, ``w_cerebx``, ``w_nest``, with both
+    simulators' post spikes (``post_cerebx``, ``post_nest``)."""
+    from cerebx.snn.presets import PC
+
+    one = {"kind": "one_to_one"}
+    syn = {"pre": "pre", "post": "post", "rule": one, "receptor": "ampa", "synapses": n, "weight_nS": 0.5,
+           "weight_range_nS": [0.0, 1.0], "delay_ms": delay_ms,
+           "plasticity": {"kind": "pair_stdp", "delay": "dendritic", **(rule or {})}}
+    drv = {"pre": "drv", "post": "post", "rule": one, "receptor": "ampa", "synapses": n, "weight_nS": drive_nS,
+           "delay_ms": 0.5}
+    fibres = {"size": n, "neuron": {"kind": "input"}}
+    cfg = NetworkConfig.model_validate({
+        "name": "stdp_synapses", "dt_ms": 0.5, "neurons": {},
+        "populations": {"pre": fibres, "drv": fibres, "post": {"size": n, "neuron": PC}},
+        "projections": {"syn": syn, "drive": drv},
+        "io": {"mossy": "pre", "climbing": "drv", "output": "post", "purkinje": ["post"], "granule": "post"}})
+    inputs = {"pre": pre, "drv": drive}
+    w_cx: dict[str, np.ndarray] = {}
+    cx, _ = run_cerebx(cfg, inputs, ms, learn=True, weights=w_cx)
+    topo = build_topology(cfg)
+    p = export(cfg, out, to=("nest",), inputs=inputs, topo=topo)
+    w_ne: dict[str, np.ndarray] = {}
+    ne, _ = run_nest(out, ms, python=python, weights=w_ne)
+    t0 = synapse_tables(topo)["syn"]
+    row, w_nest = _drift(p.projections["syn"], "syn", t0, w_cx["syn"], w_ne, ne, ms)
+    return row, {"d": t0["d"], "w0": t0["w"], "w_cerebx": w_cx["syn"], "w_nest": w_nest, "post_cerebx": cx["post"],
+                 "post_nest": ne["post"]}

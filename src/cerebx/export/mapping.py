@@ -20,22 +20,40 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from cerebx import registry
 from cerebx.snn.schema import LIFNeuron, NetworkConfig
 
 
 @dataclass(frozen=True)
 class Refused:
-    """A kind the target simulator cannot express, and why (one line)."""
+    """A kind the target simulator cannot express, and why (one line).
+
+    Attributes
+    ----------
+    reason : str
+        Why, named in the export's one-line refusal.
+    """
 
     reason: str
 
 
 @dataclass(frozen=True)
 class NeuronMap:
-    """One neuron kind in NEST and PyNN. ``receptors``: cerebx receptor -> (PyNN receptor type, sign of the NEST
-    weight) or :class:`Refused`; ``check(neuron, receptors_in, h_ms)`` -> (problems, notes) about what the model
-    does not do (``receptors_in``: the receptors the population's current-carrying inputs use; ``h_ms``: its
-    integration step)."""
+    """One neuron kind in NEST and PyNN.
+
+    Attributes
+    ----------
+    nest_model, pynn_model : str
+        The NEST model and the PyNN cell type.
+    nest_params, pynn_params : callable
+        ``(neuron, h_ms) -> dict``: the model's parameters from the neuron's schema (``h_ms``: its integration
+        step); NEST takes pF, nS, mV, ms and PyNN nF, µS, mV, ms.
+    receptors : dict
+        cerebx receptor -> (PyNN receptor type, sign of the NEST weight), or :class:`Refused`.
+    check : callable or None
+        ``(neuron, receptors_in, h_ms) -> (problems, notes)``: what the model does not do (``receptors_in``: the
+        receptors the population's current-carrying inputs use).
+    """
 
     nest_model: str
     pynn_model: str
@@ -47,11 +65,26 @@ class NeuronMap:
 
 @dataclass(frozen=True)
 class PlasticityMap:
-    """A plasticity kind as a NEST synapse model (``nest_params(rule)`` its parameters) and a PyNN synapse type."""
+    """A plasticity kind as a NEST synapse model and a PyNN synapse type.
+
+    Attributes
+    ----------
+    nest_synapse, pynn_synapse : str
+        The NEST synapse model and the PyNN synapse type.
+    nest_params : callable
+        ``(rule, w_max) -> dict``: the synapse model's parameters (``w_max``: the projection's upper weight bound
+        in nS, with the sign of its NEST weights).
+    post_params : callable or None
+        ``rule -> dict``: parameters the rule sets on the post neuron (NEST keeps some there, e.g. ``tau_minus``).
+    check : callable or None
+        ``(rule, projection) -> (problems, notes)``: what the NEST model computes differently.
+    """
 
     nest_synapse: str
     pynn_synapse: str
-    nest_params: Callable[[Any], dict[str, float]]
+    nest_params: Callable[[Any, float], dict[str, float]]
+    post_params: Callable[[Any], dict[str, float]] | None = None
+    check: Callable[[Any, Any], tuple[list[str], list[str]]] | None = None
 
 
 def _t_ref(nrn: LIFNeuron, h: float) -> float:
@@ -95,6 +128,23 @@ def _iaf_check(nrn: LIFNeuron, receptors_in: set[str], h: float) -> tuple[list[s
     return problems, notes
 
 
+def _stdp_nest(rule: Any, w_max: float) -> dict[str, float]:
+    return {"lambda": rule.lam, "alpha": rule.alpha, "mu_plus": rule.mu_plus, "mu_minus": rule.mu_minus,
+            "tau_plus": rule.tau_plus_ms, "Wmax": w_max}
+
+
+def _stdp_check(rule: Any, proj: Any) -> tuple[list[str], list[str]]:
+    """stdp_synapse's delay is dendritic and its weights are bounded below by 0."""
+    problems = []
+    if rule.delay != "dendritic":
+        problems.append("delay: axonal pairs Δt = t_post − t_pre − d, NEST's stdp_synapse t_post − t_pre + d (NEST "
+                        "3.10 has no axonal delay for it): set delay: dendritic to compute NEST's rule")
+    w_lo = proj.weight_range_nS[0]
+    if w_lo != 0.0:
+        problems.append(f"weight_range_nS starts at {w_lo} nS: stdp_synapse bounds weights at 0")
+    return problems, []
+
+
 NEURONS: dict[str, NeuronMap | Refused] = {
     "lif_cond": NeuronMap(
         "iaf_cond_exp", "IF_cond_exp", _iaf_nest, _iaf_pynn,
@@ -118,14 +168,14 @@ CONNECTORS: dict[str, str] = {
 """Connection-rule kind -> the equivalent NEST / PyNN rule (the export writes cerebx's built synapses either way)."""
 
 PLASTICITY: dict[str, PlasticityMap | Refused] = {
-    "kernel_stdp": Refused("CF-gated kernel LTD with LTP per PF spike has no NEST synapse model "
+    "kernel_stdp": Refused("CF-gated kernel LTD with LTP per PF spike has no NEST 3.10 synapse model "
                            "(stdp_dopamine_synapse only loosely approximates it)"),
-    "symmetric_cos": Refused("cerebx pairs the PF-side spike with a teaching projection's arrivals; NEST's "
-                             "stdp_cos_synapse pairs with the post neuron's own spikes (no cross-check yet)"),
-    "symmetric_cos_stdp": Refused("not yet mapped onto NEST's stdp_cos_synapse (delay convention and weight "
-                                  "bounds not yet cross-checked)"),
-    "pair_stdp": Refused("not yet mapped onto NEST's stdp_synapse: NEST treats the whole delay as dendritic "
-                         "(its Δt is cerebx's + 2 d); the mapping and its cross-check are the next step"),
+    "symmetric_cos": Refused("a cosine kernel over the times to a teaching projection's arrivals has no NEST 3.10 "
+                             "synapse model (stdp_cos_synapse belongs to an extension module, not to NEST)"),
+    "symmetric_cos_stdp": Refused("a cosine kernel over the times to the post neuron's spikes has no NEST 3.10 "
+                                  "synapse model (its STDP windows are exponential)"),
+    "pair_stdp": PlasticityMap("stdp_synapse", "STDPMechanism(SpikePairRule, GutigWeightDependence)", _stdp_nest,
+                               post_params=lambda rule: {"tau_minus": rule.tau_minus_ms}, check=_stdp_check),
 }
 """Plasticity kind -> its NEST synapse model (or why there is none)."""
 
@@ -135,6 +185,36 @@ def register(table: dict[str, Any], kind: str, entry: Any) -> None:
     if kind in table:
         raise ValueError(f"export mapping for kind {kind!r} is already registered")
     table[kind] = entry
+
+
+GROUPS: dict[str, dict[str, Any]] = {"neurons": NEURONS, "connectors": CONNECTORS, "plasticity": PLASTICITY}
+"""The registries by group name, as :func:`register_export` takes them."""
+
+
+def register_export(group: str, kind: str, entry: NeuronMap | PlasticityMap | Refused | str) -> None:
+    """Say what a plugin's kind becomes in NEST and PyNN (``cerebx export``, ``cerebx crosscheck``), from the
+    plugin's ``register()``: ``group`` ``"neurons"`` (a :class:`NeuronMap`), ``"plasticity"`` (a
+    :class:`PlasticityMap`) or ``"connectors"`` (the equivalent NEST / PyNN rule, a string: the export writes the
+    synapses cerebx drew either way); :class:`Refused` says why it has no counterpart (the export then names it
+    in its one-line refusal). A kind without an entry is refused as unmapped; a kind is registered once.
+
+    Parameters
+    ----------
+    group : str
+        ``"neurons"``, ``"connectors"`` or ``"plasticity"``.
+    kind : str
+        The kind's name, as its schema's ``kind`` field.
+    entry : NeuronMap, PlasticityMap, Refused or str
+        What the kind becomes (a string: the equivalent connection rule's name).
+    """
+    table = GROUPS.get(group)
+    if table is None:
+        raise ValueError(f"export mapping group {group!r} is not one of {', '.join(GROUPS)}")
+    want = {"neurons": NeuronMap, "plasticity": PlasticityMap, "connectors": str}[group]
+    if not isinstance(entry, (want, Refused)):
+        raise TypeError(f"export mapping of {group} kind {kind!r}: a {want.__name__} or Refused, not "
+                        f"{type(entry).__name__}")
+    register(table, kind, entry)
 
 
 @dataclass
@@ -183,6 +263,7 @@ def plan(cfg: NetworkConfig, static: bool = False, approximate: bool = False) ->
     """Map ``cfg`` through the registries. ``static``: a plastic projection whose rule NEST cannot express is
     exported with static weights (a note), not refused. ``approximate``: a receptor the model lacks (NMDA) is
     left out and a check's refusal becomes a note, each said in ``notes``."""
+    registry.load_plugins()  # a plugin's register() adds its kinds' entries (register_export)
     dt = cfg.dt_ms
     problems: list[str] = []
     notes: list[str] = []
@@ -218,6 +299,7 @@ def plan(cfg: NetworkConfig, static: bool = False, approximate: bool = False) ->
                                     entry.pynn_params(nrn, h))
     projs: dict[str, ProjectionPlan] = {}
     dropped: dict[str, str] = {}
+    post_set: dict[str, dict[str, tuple[float, str]]] = {}
     for name, p in cfg.projections.items():
         where = f"projections.{name}"
         if p.rule.kind not in CONNECTORS:
@@ -241,8 +323,17 @@ def plan(cfg: NetworkConfig, static: bool = False, approximate: bool = False) ->
         synapse, syn_params, plastic = "static_synapse", {}, False
         if p.plasticity is not None:
             rule = PLASTICITY.get(p.plasticity.kind)
-            if rule is None or isinstance(rule, Refused):
-                why = rule.reason if isinstance(rule, Refused) else "no NEST/PyNN mapping (cerebx/export/mapping.py)"
+            why = ""
+            if isinstance(rule, PlasticityMap) and rule.check is not None:
+                bad, said = rule.check(p.plasticity, p)
+                notes += [f"{where}.plasticity ({p.plasticity.kind}): {x}" for x in said]
+                if bad and approximate:
+                    notes += [f"{where}.plasticity ({p.plasticity.kind}): approximated: {x}" for x in bad]
+                elif bad:
+                    why = "; ".join(bad)
+            if rule is None or isinstance(rule, Refused) or why:
+                why = why or (rule.reason if isinstance(rule, Refused)
+                              else "no NEST/PyNN mapping (cerebx/export/mapping.py)")
                 if static:
                     plastic = True
                     notes.append(f"{where}.plasticity: kind {p.plasticity.kind!r} exported with static weights "
@@ -252,7 +343,15 @@ def plan(cfg: NetworkConfig, static: bool = False, approximate: bool = False) ->
                                     "(--static exports its weights static)")
                     continue
             else:
-                synapse, syn_params = rule.nest_synapse, rule.nest_params(p.plasticity)
+                w_hi = p.weight_range_nS[1]  # a plastic projection has one (schema)
+                synapse, syn_params = rule.nest_synapse, rule.nest_params(p.plasticity, rec[1] * w_hi)
+                if rule.post_params is not None:
+                    for key, value in rule.post_params(p.plasticity).items():
+                        have = post_set.setdefault(p.post, {}).setdefault(key, (value, name))
+                        if have[0] != value:
+                            problems.append(f"{where}.plasticity: {key} {value} differs from {have[0]} of "
+                                            f"projections.{have[1]}: NEST keeps {key} on the post neuron")
+                        pops[p.post].nest_params[key] = value
         delay = p.delay_ms if isinstance(p.delay_ms, float) else float("nan")  # drawn: per synapse (writer.py)
         projs[name] = ProjectionPlan(p.pre, p.post, p.receptor, rec[1], rec[0], delay, synapse, syn_params,
                                      p.rule.kind, plastic)

@@ -15,12 +15,10 @@ from cerebx.snn.schema import NetworkConfig
 
 
 def load_network(source: str, overrides: list[str] | None = None) -> NetworkConfig:
-    """The validated network ``source`` names (``overrides``: ``key=value`` as for ``cerebx run``, applied to
-    a preset, e.g. ``controller.network.projections.pf_pc.weight_nS=1.0``)."""
+    """The validated network ``source`` names (``overrides``: ``key=value`` as for ``cerebx run`` on a preset, e.g.
+    ``controller.network.projections.pf_pc.weight_nS=1.0``; on a file, keys of its network, e.g. ``dt_ms=0.1``)."""
     path = Path(source)
     if path.suffix in (".yaml", ".yml") or path.is_file():
-        if overrides:
-            raise CerebxError(f"{source}: overrides apply to a network preset, not to a file")
         try:
             doc = yaml.safe_load(path.read_text())
         except OSError as err:
@@ -30,7 +28,9 @@ def load_network(source: str, overrides: list[str] | None = None) -> NetworkConf
         net = _network_part(doc)
         if net is None:
             raise CerebxError(f"{source}: holds no network (populations and projections, or controller.network)")
-        return _validate(net, source)
+        for item in overrides or []:
+            _override(net, item, source)
+        return _validate(_sized(net, doc if isinstance(doc, dict) else {}, source), source)
     from cerebx.config import compose, to_plain  # Hydra only when a preset is composed
 
     try:
@@ -40,7 +40,36 @@ def load_network(source: str, overrides: list[str] | None = None) -> NetworkConf
     net = _network_part(plain)
     if net is None:
         raise CerebxError(f"{source}: the composed controller has no network")
-    return _validate(net, f"network={source}")
+    return _validate(_sized(net, plain, f"network={source}"), f"network={source}")
+
+
+def _sized(net: dict, experiment: dict, where: str) -> dict:
+    """A network written per joint (``per_joint``, snn/sizing.py) sized for the experiment's plant, as a run
+    sizes it; a bare network file with ``per_joint`` names no plant and is refused."""
+    from cerebx.snn.sizing import KEY, plant_joints, sized_network
+
+    if KEY not in net:
+        return net
+    joints = plant_joints(experiment)
+    if joints is None:
+        raise CerebxError(f"{where}: per_joint: the network is sized from a plant's joints; give a whole experiment "
+                          "(e.g. a run's config.yaml) or a network preset")
+    try:
+        return sized_network(net, joints)
+    except ValueError as err:
+        raise CerebxError(f"{where}: {err}") from None
+
+
+def _override(net: dict, item: str, source: str) -> None:
+    """Apply ``dotted.key=value`` (value read as YAML) to a file's network, e.g. ``dt_ms=0.1``."""
+    key, eq, text = item.partition("=")
+    *parents, last = key.split(".")
+    node: Any = net
+    for k in parents:
+        node = node.get(k) if isinstance(node, dict) else None
+    if not eq or not key or not isinstance(node, dict):
+        raise CerebxError(f"{source}: override {item!r}: not key=value with a key of the network (e.g. dt_ms=0.1)")
+    node[last] = yaml.safe_load(text)
 
 
 def _network_part(doc: Any) -> dict | None:
@@ -51,6 +80,11 @@ def _network_part(doc: Any) -> dict | None:
     ctrl = doc.get("controller")
     net = ctrl.get("network") if isinstance(ctrl, dict) else None
     return net if isinstance(net, dict) else None
+
+
+def validate_network(net: dict, where: str) -> NetworkConfig:
+    """``net`` validated; a problem is one line ``where: location: message``."""
+    return _validate(net, where)
 
 
 def _validate(net: dict, where: str) -> NetworkConfig:

@@ -118,9 +118,26 @@ class Relay:
 
 def _watch_parent(stop: threading.Event) -> None:
     """Started by ``cerebx run``: stop when its end of our stdin pipe closes (it finished or died)."""
-    while os.read(0, 4096):
+    try:
+        while os.read(0, 4096):
+            pass
+    except OSError:
         pass
     stop.set()
+
+
+def _setup_line() -> list[str]:
+    """Started by ``cerebx run``: the addresses come as one JSON line on stdin, not on the command line."""
+    line = b""
+    while not line.endswith(b"\n"):
+        chunk = os.read(0, 1)
+        if not chunk:
+            break
+        line += chunk
+    try:
+        return [str(o) for o in json.loads(line)["overrides"]]
+    except (ValueError, KeyError, TypeError):
+        raise CerebxError("relay: --parent-pipe: no setup line on stdin") from None
 
 
 def main(argv: list[str]) -> int:
@@ -128,6 +145,8 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--out", help="folder for summary.json and injected.csv")
     ap.add_argument("--parent-pipe", action="store_true", help=argparse.SUPPRESS)
     args, overrides = ap.parse_known_args(argv)
+    if args.parent_pipe:
+        overrides = overrides + _setup_line()
     cfg, _ = load(overrides)
     if not cfg.link.real:
         raise CerebxError("relay: needs a real link (link=zenoh or link=udp)")

@@ -6,14 +6,16 @@ shedding).
 ``link=udp`` split the experiment into the brain side (``cerebx run``) and the robot side
 (``cerebx robot``, started by ``cerebx run`` itself unless ``link.spawn_robot=false``); they need
 ``clock=wall``. Addresses are ``host:port``; port 0 lets ``cerebx run`` pick a free port when it
-starts the other processes itself. Every address defaults to the loopback interface: nothing listens
-beyond this machine unless told to.
+starts the other processes itself. Every address defaults to the loopback interface: an address beyond
+it needs ``link.beyond_loopback=true`` (and each side that listens there says so in a warning line).
 """
 
 from __future__ import annotations
 
+import ipaddress
+import math
 import re
-from typing import Annotated, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import AfterValidator, Field, model_validator
 
@@ -35,6 +37,26 @@ Address = Annotated[str, AfterValidator(_address)]
 def split_address(value: str) -> tuple[str, int]:
     host, _, port = value.rpartition(":")
     return host.strip("[]"), int(port)
+
+
+def is_loopback(host: str) -> bool:
+    """Whether ``host`` is this machine's loopback interface (a host name other than localhost may be anything)."""
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def _finite(model: Any, where: str = "") -> None:
+    """Every float of ``model`` (and its sub-models) is finite: ``inf`` is not a time limit."""
+    for name in type(model).model_fields:
+        v = getattr(model, name)
+        if isinstance(v, float) and not math.isfinite(v):
+            raise ValueError(f"{where}{name}: {v} is not a finite number")
+        if isinstance(v, Strict):
+            _finite(v, f"{where}{name}.")
 
 
 class SheddingConfig(Strict):
@@ -108,9 +130,35 @@ class RealLink(Strict):
     resync_every_s: float = Field(1.0, gt=0, description="re-estimate the clock offset this often (ping)")
     pings: int = Field(16, ge=1, le=256, description="probes per offset estimate (the fastest round trip wins)")
     shedding: SheddingConfig = SheddingConfig()
+    max_clock_uncertainty_ms: float = Field(
+        2.0, gt=0, description="a clock-offset estimate whose uncertainty (half the fastest ping's round trip) "
+        "exceeds this is refused and recorded; at pairing the run does not start without one within it")
+    beyond_loopback: bool = Field(False, description="allow addresses beyond the loopback interface (each side "
+                                                     "that listens there says so); off: loopback only")
+
+    added_without_effect: ClassVar[dict[str, Any]] = {"max_clock_uncertainty_ms": 2.0, "beyond_loopback": False}
+    """Fields added since runs were recorded, with the value that does what those runs did (read by
+    ``cerebx.schema.legacy.upgrade`` through :meth:`upgrade_recorded`)."""
+
+    @classmethod
+    def upgrade_recorded(cls, link: dict[str, Any]) -> None:
+        """Fill a recorded link config in place with the fields added since; ``beyond_loopback`` with what that
+        run needed (a run recorded beyond loopback did so without the opt-in asked for now)."""
+        for key, value in cls.added_without_effect.items():
+            if key == "beyond_loopback" and key not in link:
+                value = any(isinstance(link.get(k), str) and ":" in link[k]
+                            and not is_loopback(split_address(link[k])[0]) for k in ("robot", "brain", "relay"))
+            link.setdefault(key, value)
 
     @model_validator(mode="after")
     def _order(self) -> RealLink:
+        _finite(self)
+        if not self.beyond_loopback:
+            for name in ("robot", "brain", "relay"):
+                host, _ = split_address(getattr(self, name))
+                if not is_loopback(host):
+                    raise ValueError(f"{name}: {host} is beyond the loopback interface (allowed with "
+                                     "link.beyond_loopback=true, a side then listens where other machines reach it)")
         if self.hold_pose_after_ms <= self.safe_stop_after_ms:
             raise ValueError("hold_pose_after_ms must be longer than safe_stop_after_ms")
         if self.link_lost_after_ms <= self.hold_pose_after_ms:
@@ -123,11 +171,27 @@ class RealLink(Strict):
         return self.use_relay == "on"
 
 
+class ZenohTls(Strict):
+    """zenoh's own TLS on the link's endpoints (``tls/host:port`` instead of ``tcp/``): the traffic is
+    encrypted, and with ``mutual`` each side proves itself with a certificate. Paths to PEM files."""
+
+    root_ca_certificate: str = Field(description="the CA that signed the other sides' certificates")
+    listen_certificate: str = Field(description="this side's certificate, presented to those that connect")
+    listen_private_key: str = Field(description="its private key")
+    mutual: bool = Field(True, description="mTLS: a side that connects presents its certificate too")
+    connect_certificate: str | None = Field(None, description="the certificate presented when connecting "
+                                                              "(default: listen_certificate)")
+    connect_private_key: str | None = Field(None, description="its key (default: listen_private_key)")
+    verify_name_on_connect: bool = Field(True, description="the certificate must name the host connected to")
+
+
 class ZenohLink(RealLink):
-    """eclipse-zenoh peers joined by explicit TCP endpoints (no multicast scouting)."""
+    """eclipse-zenoh peers joined by explicit TCP endpoints (no multicast scouting), optionally TLS."""
 
     kind: Literal["zenoh"] = "zenoh"
+    added_without_effect: ClassVar[dict[str, Any]] = {**RealLink.added_without_effect, "tls": None}
     namespace: str = Field("cerebx", pattern=r"^[A-Za-z0-9_\-]+$", description="first part of the key expressions")
+    tls: ZenohTls | None = Field(None, description="zenoh's TLS (mTLS by default) on every endpoint; None: TCP")
 
 
 class UdpLink(RealLink):
@@ -136,4 +200,5 @@ class UdpLink(RealLink):
     kind: Literal["udp"] = "udp"
 
 
-__all__ = ["Address", "RealLink", "SheddingConfig", "SimLink", "UdpLink", "ZenohLink", "split_address"]
+__all__ = ["Address", "RealLink", "SheddingConfig", "SimLink", "UdpLink", "ZenohLink",
+           "ZenohTls", "is_loopback", "split_address"]

@@ -19,14 +19,17 @@ relay    r2c hop 1, c2r hop 1  r2c hop 0, c2r hop 0
 from __future__ import annotations
 
 import socket
+import sys
 import threading
 import time
 from abc import ABC, abstractmethod
-from collections import deque
+from collections import Counter, deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Literal
 
-from cerebx.link.schema import RealLink, split_address
+from cerebx.errors import CerebxError
+from cerebx.link.schema import RealLink, is_loopback, split_address
 
 Role = Literal["robot", "brain", "relay"]
 PATHS = ("r2c", "c2r")
@@ -44,23 +47,45 @@ class Arrival:
     recv_ns: int
 
 
-class Inbox:
-    """What the transport's threads received, for the loop's thread to take (thread-safe)."""
+INBOX_SLOTS = 256
+"""Packets the inbox holds at most (about half a second of both paths' traffic); more are dropped."""
 
-    def __init__(self) -> None:
-        self._items: deque[Arrival] = deque()
+
+class Inbox:
+    """What the transport's threads received, for the loop's thread to take (thread-safe, bounded).
+
+    ``admit``, when set (a side's :class:`~cerebx.link.channel.LinkEnd` sets it), runs on the transport's
+    thread for each arrival before it is queued: it checks and decodes the packet (the tag included) and
+    returns what to queue, or None to drop it. So nothing unauthenticated reaches the paced loop and the
+    loop's thread spends no time on it. A full inbox drops the newest arrival and counts it."""
+
+    def __init__(self, slots: int = INBOX_SLOTS) -> None:
+        self._items: deque[Any] = deque()
         self._cond = threading.Condition()
+        self.slots = slots
+        self.admit: Callable[[Arrival], Any] | None = None
+        self.dropped: Counter = Counter()
 
     def put(self, item: Arrival) -> None:
+        admit = self.admit
+        got: Any = admit(item) if admit is not None else item
+        if got is None:
+            return
         with self._cond:
-            self._items.append(item)
+            if len(self._items) >= self.slots:
+                self.dropped["queue_full"] += 1
+                return
+            self._items.append(got)
             self._cond.notify()
 
-    def take(self) -> list[Arrival]:
-        """Everything that has arrived (possibly nothing), without waiting."""
+    def take(self, limit: int | None = None) -> list[Any]:
+        """What has arrived (possibly nothing; at most ``limit`` items, oldest first), without waiting."""
         with self._cond:
-            out = list(self._items)
-            self._items.clear()
+            if limit is None or len(self._items) <= limit:
+                out = list(self._items)
+                self._items.clear()
+            else:
+                out = [self._items.popleft() for _ in range(limit)]
         return out
 
     def wait(self, timeout_s: float) -> bool:
@@ -95,6 +120,10 @@ class Transport(ABC):
         """The hop this role's incoming path arrives on."""
         return 1 if self.via_relay else 0
 
+    def lock_to_peer(self) -> None:
+        """After pairing: from now on take packets only from the paired peer's address, where the transport
+        can tell (UDP: the socket is connected to it, so the kernel drops every other sender's datagrams)."""
+
     def now_ns(self) -> int:
         return time.monotonic_ns()
 
@@ -105,6 +134,28 @@ def free_port(host: str, kind: int = socket.SOCK_STREAM) -> int:
     with socket.socket(family, kind) as s:
         s.bind((host, 0))
         return s.getsockname()[1]
+
+
+def resolve(address: str, kind: int = socket.SOCK_DGRAM) -> tuple[int, tuple]:
+    """The address family and socket address of ``host:port``; one line when the host cannot be resolved."""
+    host, port = split_address(address)
+    try:
+        family, _, _, _, sockaddr = socket.getaddrinfo(host, port, type=kind)[0]
+    except (OSError, UnicodeError) as err:
+        raise CerebxError(f"link: {address}: the host cannot be resolved "
+                          f"({getattr(err, 'strerror', None) or err})") from None
+    return family, sockaddr[:2]
+
+
+def announce_bind(cfg: RealLink, role: Role) -> None:
+    """The warning line of a side that listens beyond this machine (the schema already required the opt-in)."""
+    address = getattr(cfg, role)
+    host, _ = split_address(address)
+    if is_loopback(host):
+        return
+    where = "on every interface" if host in ("0.0.0.0", "::") else "beyond this machine"
+    print(f"warning: link: the {role} side listens {where} ({address}; link.beyond_loopback=true); only "
+          "packets signed with the shared key are used", file=sys.stderr)
 
 
 def with_free_ports(cfg: RealLink, udp: bool) -> RealLink:

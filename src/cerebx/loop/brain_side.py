@@ -8,16 +8,23 @@ newest sensor message that has arrived, as in simulated time. A sensor message o
 for its own tick. The output goes back as COMMAND stamped as the controller stamps it.
 
 Without sensor messages for ``sensor_timeout_ms`` the brain side holds the last one and says so; after
-``link_lost_after_ms`` without anything from the robot side the run ends (interrupted, link lost). The
-watchdog (``link/shedding.py``) sheds work when the brain side finishes its ticks late.
+``link_lost_after_ms`` without a sensor message of the session the run ends (interrupted, link lost).
+The watchdog (``link/shedding.py``) sheds work when the brain side finishes its ticks late. A robot side
+that reports all its trials completed (its BYE) ends the run as completed even when it arrives before
+the brain side's last tick: the brain side then computes its remaining ticks without waiting.
 
 ``cerebx run`` starts the robot side (``cerebx robot``, its files in ``RUN_DIR/robot``) and the delay
-relay (``cerebx relay``, in ``RUN_DIR/relay``) itself unless ``link.spawn_robot=false``.
+relay (``cerebx relay``, in ``RUN_DIR/relay``) itself unless ``link.spawn_robot=false``; their addresses
+(and the robot side's key) go to them as one JSON line on their stdin, not on their command line. A run
+that does not pair (no answer, a refusal, a port taken, a host that does not resolve) ends with one line
+and exit code 2, and leaves no run folder behind.
 """
 
 from __future__ import annotations
 
+import json
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -34,7 +41,7 @@ from cerebx.link import clock
 from cerebx.link.auth import Signer, key_from_env, new_key, require_key
 from cerebx.link.channel import Arrived, LinkEnd
 from cerebx.link.clock import now_ns
-from cerebx.link.pairing import controller_facts, fingerprint, hello, new_run_id, probe
+from cerebx.link.pairing import NotPaired, Pings, controller_facts, fingerprint, hello, new_run_id, within
 from cerebx.link.shedding import Watchdog, prepare_real_time, shed_targets
 from cerebx.link.stats import describe
 from cerebx.link.transport import with_free_ports
@@ -83,10 +90,13 @@ class BrainSide:
         self.watchdog = Watchdog(cfg.link.shedding, shed_targets(ctx.brain))
         ticks = cfg.trials * ctx.task.steps_per_trial
         self.log = TickLog(ticks, ("lag_ms", "compute_ms"))
-        self._probes: list[tuple[int, int, int, int]] = []
+        self.pings = Pings(end)
         self._next_sync_ns = self.t0() + int(cfg.link.resync_every_s * 1e9)
         self._pings_left = 0
         self.shared_clock = True
+        self.robot_done = False
+        self.clock_refused = 0
+        self._dropped = end.dropped()
 
     def t0(self) -> int:
         """Tick 0 on this side's clock (follows the offset estimate)."""
@@ -101,18 +111,20 @@ class BrainSide:
     # ------------------------------------------------------------------ link
     def _control(self, pkt: Packet) -> None:
         if pkt.kind == Kind.PONG:
-            self._probes.append(probe(pkt))
+            self.pings.answer(pkt)
         elif pkt.kind == Kind.TRIAL:
-            self.trials[int(pkt.info.get("trial", -1))] = pkt.info
-        elif pkt.kind == Kind.BYE:
+            self.trials[pkt.info["trial"]] = pkt.info
+        elif pkt.kind == Kind.BYE and self.robot_bye is None:
             self.robot_bye = pkt.info
-            status = str(pkt.info.get("status", "interrupted"))
+            status = pkt.info["status"]
+            if status == "completed" and pkt.info.get("trials_completed") == self.cfg.trials:
+                self.robot_done = True  # its last tick may come before ours: ours are computed without waiting
+                return
             raise PeerEnded(status, f"the robot side ended ({status}): {pkt.info.get('reason') or ''}")
 
     def _poll(self) -> None:
         data, control = self.end.poll()
         for pkt in control:
-            self._last_packet_ns = max(self._last_packet_ns, pkt.recv_ns)
             self._control(pkt)
         if data:
             self._pending += data
@@ -120,17 +132,25 @@ class BrainSide:
 
     def _resync(self, t: float, now: int) -> None:
         """One ping per tick while a burst is under way; an estimate when the burst is answered."""
+        pings = self.pings
         if self._pings_left == 0 and now >= self._next_sync_ns:
-            self._pings_left, self._probes = self.link.pings, []
+            self._pings_left = self.link.pings
+            pings.new_burst()
             self._next_sync_ns = now + int(self.link.resync_every_s * 1e9)
         if self._pings_left:
             self._pings_left -= 1
-            self.end.send_control(Kind.PING, {"n": self._pings_left, "offset_ns": self.end.offset_ns})
-        elif self._probes and len(self._probes) >= max(1, self.link.pings // 2):
-            est = clock.estimate(self._probes, now)
-            self._probes = []
+            pings.send(self._pings_left, self.end.offset_ns)
+        elif pings.probes and len(pings.probes) >= max(1, self.link.pings // 2):
+            est = clock.estimate(pings.probes, now)
+            pings.probes = []
             if est is not None:
-                record_estimate(self.rec, t, est, "ping" if not self.shared_clock else "ping (check)")
+                method = "ping" if not self.shared_clock else "ping (check)"
+                if not within(est, self.link.max_clock_uncertainty_ms):
+                    self.clock_refused += 1
+                    record_estimate(self.rec, t, est, method + " refused: uncertainty beyond "
+                                    f"{self.link.max_clock_uncertainty_ms:g} ms")
+                    return
+                record_estimate(self.rec, t, est, method)
                 if not self.shared_clock:
                     self.end.offset_ns = est.offset_ns
 
@@ -144,14 +164,14 @@ class BrainSide:
         inbox = end.transport.inbox
         while True:
             self._poll()
-            if self._pending and self._pending[-1].tick >= k:
+            if self.robot_done or (self._pending and self._pending[-1].tick >= k):
                 break
             now = now_ns()
             if now >= until:
                 break
             inbox.wait((until - now) / 1e9)
         began = now_ns()
-        lost0, refused0 = end.data.lost, sum(end.rejected.values())
+        lost0, refused0 = end.data.lost, sum(self._dropped.values())
         used = [a for a in self._pending if a.tick <= k]
         self._pending = [a for a in self._pending if a.tick > k]
         for a in used:
@@ -160,18 +180,23 @@ class BrainSide:
                       {"seq": a.seq, "tick": a.tick, "used_tick": k, "delay_ms": round(a.delay_ms, 4)})
         if used:
             self._sensed, self._r2c_ms = used[-1].message, used[-1].delay_ms
-            self._last_sensor_ns = used[-1].recv_ns
+            self._last_sensor_ns = self._last_packet_ns = used[-1].recv_ns
             if self.holding:
                 self.holding = False
                 self.events.add(t, "sensors_resumed")
+        elif self.robot_done:
+            pass
         elif not self.holding and began - self._last_sensor_ns > self.link.sensor_timeout_ms * 1e6:
             self.holding = True
             gap = (began - self._last_sensor_ns) / 1e6
             self.events.add(t, "holding", f"no sensor message for {gap:.0f} ms: holding the last one")
             print(f"brain side: no sensor message for {gap:.0f} ms at t = {t:.3f} s; holding the last one",
                   file=sys.stderr)
-        if began - self._last_packet_ns > self.link.link_lost_after_ms * 1e6:
-            raise LinkLost(f"link lost: nothing from the robot side for {(began - self._last_packet_ns) / 1e9:.1f} s")
+        if self._pending:
+            self._last_packet_ns = max(self._last_packet_ns, self._pending[-1].recv_ns)
+        if not self.robot_done and began - self._last_packet_ns > self.link.link_lost_after_ms * 1e6:
+            raise LinkLost(f"link lost: no sensor message from the robot side for "
+                           f"{(began - self._last_packet_ns) / 1e9:.1f} s")
         frame, signals = brain_phase(self.brain, k, t, q_des, qd_des, extra, self._sensed)
         out = {name: signals[name] for name in self._sent}
         end.send_message(Message(frame.stamp_s, out), k)
@@ -187,10 +212,14 @@ class BrainSide:
             for name, field in self._record_as:
                 msg[field] = out[name]
             rec.write("/control", "cerebx.Control", t, msg)
+        dropped = end.dropped()
         rec.write("/timing/brain", "cerebx.BrainTiming", t,
                   {"t": t, "tick": k, "lag_ms": round(lag_ms, 4), "compute_ms": round(compute_ms, 4),
                    "sensors": len(used), "lost": end.data.lost - lost0,
-                   "refused": sum(end.rejected.values()) - refused0, "level": self.watchdog.level})
+                   "refused": sum(dropped.values()) - refused0,
+                   "dropped": {r: n - self._dropped.get(r, 0) for r, n in dropped.items()
+                               if n != self._dropped.get(r, 0)}, "level": self.watchdog.level})
+        self._dropped = dropped
         self._resync(t, sent)
         self.tick += 1
 
@@ -206,11 +235,14 @@ class BrainSide:
             self.rec.write("/weights", "cerebx.WeightSummary", self.tick * self.dt_s, {"trial": trial, **out})
 
     def wait_for_end(self, timeout_s: float) -> None:
-        """After the last tick: trial metrics and the robot side's BYE (raises PeerEnded with it)."""
+        """After the last tick: trial metrics and the robot side's BYE (returns when it completed all trials,
+        raises PeerEnded with any other)."""
         deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
+        while not self.robot_done and time.monotonic() < deadline:
             self.end.transport.inbox.wait(0.05)
             self._poll()
+        if self.robot_done:
+            return
         raise LinkLost(f"link lost: the robot side did not finish within {timeout_s:g} s of the last tick")
 
     def metrics(self) -> list[TrialMetrics]:
@@ -223,7 +255,7 @@ class BrainSide:
 
     def timing(self) -> dict[str, Any]:
         out = self.log.totals()
-        out.update({"ticks": self.log.n, "sensors_lost": self.end.data.lost,
+        out.update({"ticks": self.log.n, "sensors_lost": self.end.data.lost, "clock_refused": self.clock_refused,
                     "shedding": {"max_level": self.watchdog.max_level,
                                  "max_lead_ms": round(self.watchdog.max_lead_ms, 3),
                                  "changes": [c.__dict__ for c in self.watchdog.changes]}})
@@ -237,30 +269,49 @@ def record_estimate(rec: Recorder, t: float, est: clock.OffsetEstimate, method: 
     return item
 
 
-def sync_clock(end: LinkEnd, cfg: Any, welcome: Packet) -> tuple[clock.OffsetEstimate, bool]:
-    """The offset at pairing: shared clock on one host (unless told to ping), else a ping burst."""
+SYNC_BURSTS = 3
+
+
+def sync_clock(end: LinkEnd, cfg: Any, welcome: Packet) -> tuple[list[clock.OffsetEstimate], bool]:
+    """The offset at pairing: shared clock on one host (unless told to ping), else up to :data:`SYNC_BURSTS`
+    ping bursts until one gives an estimate within ``link.max_clock_uncertainty_ms`` (the last estimate; the
+    list holds the refused ones before it)."""
     mine = clock.host_identity()
     same = bool(mine["boot_id"]) and welcome.info.get("boot_id") == mine["boot_id"]
     shared = cfg.link.clock_sync == "shared" or (cfg.link.clock_sync == "auto" and same)
     if shared:
-        return clock.shared(now_ns()), True
-    probes: list[tuple[int, int, int, int]] = []
-    deadline = time.monotonic() + 5.0
-    for n in range(cfg.link.pings * 2):
-        end.send_control(Kind.PING, {"n": n})
-        end.transport.inbox.wait(0.01)
+        return [clock.shared(now_ns())], True
+    pings = Pings(end)
+    tried: list[clock.OffsetEstimate] = []
+    deadline = time.monotonic() + cfg.link.pair_timeout_s
+    while len(tried) < SYNC_BURSTS and time.monotonic() < deadline:
+        pings.new_burst()
+        for n in range(cfg.link.pings * 2):
+            pings.send(n)
+            end.transport.inbox.wait(0.01)
+            _, control = end.poll()
+            for p in control:
+                if p.kind == Kind.PONG:
+                    pings.answer(p)
+            if len(pings.probes) >= cfg.link.pings or time.monotonic() > deadline:
+                break
+        time.sleep(0.02)
         _, control = end.poll()
-        probes += [probe(p) for p in control if p.kind == Kind.PONG]
-        if len(probes) >= cfg.link.pings or time.monotonic() > deadline:
-            break
-    time.sleep(0.02)
-    _, control = end.poll()
-    probes += [probe(p) for p in control if p.kind == Kind.PONG]
-    est = clock.estimate(probes, now_ns())
-    if est is None:
-        raise LinkLost("link lost: no answer to the clock-offset pings")
-    end.offset_ns = est.offset_ns
-    return est, False
+        for p in control:
+            if p.kind == Kind.PONG:
+                pings.answer(p)
+        est = clock.estimate(pings.probes, now_ns())
+        if est is None:
+            continue
+        tried.append(est)
+        if within(est, cfg.link.max_clock_uncertainty_ms):
+            end.offset_ns = est.offset_ns
+            return tried, False
+    if not tried:
+        raise NotPaired("link: no answer to the clock-offset pings")
+    raise NotPaired(f"link: the clock offset is uncertain by {tried[-1].uncertainty_ns / 1e6:.2f} ms after "
+                    f"{len(tried)} ping bursts, more than link.max_clock_uncertainty_ms="
+                    f"{cfg.link.max_clock_uncertainty_ms:g}")
 
 
 def start(end: LinkEnd, offset_ns: int, timeout_s: float) -> int:
@@ -274,33 +325,45 @@ def start(end: LinkEnd, offset_ns: int, timeout_s: float) -> int:
         end.transport.inbox.wait(0.02)
         _, control = end.poll()
         for pkt in control:
-            if pkt.kind == Kind.START:
-                return int(pkt.info["t0_ns"])
+            if pkt.kind == Kind.START and "t0_ns" in pkt.info:
+                return pkt.info["t0_ns"]
             if pkt.kind == Kind.BYE:
                 status = str(pkt.info.get("status"))
                 raise PeerEnded(status, f"the robot side ended ({status}): {pkt.info.get('reason')}")
     raise LinkLost(f"link lost: the robot side did not start within {timeout_s:g} s")
 
 
-def child_overrides(overrides: list[str], link: Any) -> list[str]:
-    """The command line of the robot side and the relay: the run's overrides with the resolved addresses."""
+def child_overrides(overrides: list[str], link: Any) -> tuple[list[str], list[str]]:
+    """The robot side's and the relay's overrides: (the run's own, for their command line; the resolved
+    addresses, for the private setup line on their stdin)."""
     keep = [o for o in overrides if o.lstrip("+~").split("=", 1)[0] not in CHILD_DROPS
             and not o.lstrip("+~").startswith("hydra")]
-    return keep + [f"link.robot={link.robot}", f"link.brain={link.brain}", f"link.relay={link.relay}",
-                   "recording.progress=off"]
+    return keep + ["recording.progress=off"], [f"link.robot={link.robot}", f"link.brain={link.brain}",
+                                               f"link.relay={link.relay}"]
 
 
-def spawn(command: str, args: list[str], folder: Path, env: dict[str, str], pipe: bool = False) -> subprocess.Popen:
-    """Start ``cerebx COMMAND ARGS`` with its output in ``folder/COMMAND.log``."""
+CHILD_ENV_DROPS = ("CEREBX_LINK_KEY", "CEREBX_LINK_KEY_FILE")
+
+
+def spawn(command: str, args: list[str], folder: Path, setup: dict[str, Any]) -> subprocess.Popen:
+    """Start ``cerebx COMMAND ARGS`` with its output in ``folder/COMMAND.log`` and ``setup`` (addresses, the
+    key) as one JSON line on its stdin, a pipe only the two processes hold; the pipe stays open (the relay
+    stops when it closes)."""
     folder.mkdir(parents=True, exist_ok=True)
     logf = open(folder / f"{command}.log", "wb")
-    full_env = {**os.environ, **env, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+    full_env = {k: v for k, v in os.environ.items() if k not in CHILD_ENV_DROPS}
+    full_env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
     try:
-        return subprocess.Popen([sys.executable, "-m", "cerebx.cli", command, *args], stdout=logf, stderr=logf,
-                                stdin=subprocess.PIPE if pipe else subprocess.DEVNULL, env=full_env,
-                                start_new_session=True)
+        proc = subprocess.Popen([sys.executable, "-m", "cerebx.cli", command, *args], stdout=logf, stderr=logf,
+                                stdin=subprocess.PIPE, env=full_env, start_new_session=True)
     finally:
         logf.close()
+    try:
+        proc.stdin.write(json.dumps(setup).encode() + b"\n")
+        proc.stdin.flush()
+    except OSError:
+        pass  # it died at once: its exit code and log say why
+    return proc
 
 
 def _last_line(path: Path) -> str:
@@ -353,64 +416,96 @@ class Children:
         return out
 
 
-def _signer(link: Any) -> tuple[Signer, dict[str, str]]:
-    """The run's key and the environment that hands it to the robot side this run starts."""
+def _signer(link: Any) -> Signer:
+    """The run's key: from the environment, or (when this run starts the robot side itself) a new one."""
     signer = key_from_env()
     if signer is None:
         signer = new_key() if link.spawn_robot else require_key()
-    return signer, signer.env()
+    return signer
+
+
+def leave_nothing(run_dir: Path) -> None:
+    """After a run that did not pair: remove what was written for it (Hydra's ``.hydra/`` and log, the robot
+    side's and the relay's folders with their logs), unless the folder holds a run."""
+    if any((run_dir / name).exists() for name in (runfiles.SUMMARY, runfiles.MCAP)):
+        return
+    for name in (".hydra", ROBOT_DIR, runfiles.RELAY):
+        path = run_dir / name
+        if path.is_dir() and all(p.suffix in (".log", ".yaml") for p in path.iterdir()):
+            shutil.rmtree(path, ignore_errors=True)
+    for log in run_dir.glob("*.log"):
+        log.unlink(missing_ok=True)
+    try:
+        run_dir.rmdir()
+    except OSError:
+        pass
 
 
 def run_brain_side(cfg: Any, run_dir: Path, resolved: dict | None = None, overrides: list[str] | None = None,
                    choices: dict[str, str] | None = None) -> dict[str, Any]:
     """The brain side of a wall-clock run into ``run_dir`` (starting the robot side and relay unless told not
-    to); writes run.mcap, summary.json (with the robot side's metrics and timing) and the controller state."""
+    to); writes run.mcap, summary.json (with the robot side's metrics and timing) and the controller state.
+    Raises :class:`NotPaired` (one line) when the sides did not pair."""
     run_dir = Path(run_dir)
-    run_dir.mkdir(parents=True, exist_ok=True)
     overrides = list(overrides or [])
     link = with_free_ports(cfg.link, udp=cfg.link.kind == "udp") if cfg.link.spawn_robot else cfg.link
     cfg = cfg.model_copy(update={"link": link})
     via_relay = link.relay_on(cfg.delay.kind)
-    signer, key_env = _signer(link)
     why = clock.realtime_process(link.rt_priority, "brain")
     if why:
         print(f"brain side: {why}", file=sys.stderr)
     children = Children()
-    args = child_overrides(overrides, link)
+    args, addresses = child_overrides(overrides, link)
     transport = None
+    paired = False
     try:
-        if link.spawn_robot:
-            folder = run_dir / ROBOT_DIR
-            children.procs["robot"] = (spawn("robot", ["--run-dir", str(folder), *args], folder, key_env), folder)
-        if via_relay:
-            folder = run_dir / runfiles.RELAY
-            children.procs["relay"] = (spawn("relay", ["--out", str(folder), "--parent-pipe", *args], folder,
-                                             {"CEREBX_LINK_KEY": "", "CEREBX_LINK_KEY_FILE": ""}, pipe=True), folder)
-        ctx = build_components(cfg, run_dir)
-        if cfg.init_from:
-            state = Path(cfg.init_from) / runfiles.STATE
-            if not state.exists():
-                raise CerebxError(f"init_from: {state} does not exist")
-            ctx.brain[0].load_state(state)
-        prepare_real_time(ctx.brain)
-        transport = registry.links.build(link, "brain", via_relay)
-        expected = {name: s.size for name, s in cfg.plant.sensor_signals().items()}
-        end = LinkEnd(transport, signer, "brain", expected, run_id=new_run_id())
         try:
-            welcome = hello(end, fingerprint(cfg), controller_facts(ctx), cfg.link.pair_timeout_s, children.alive)
+            signer = _signer(link)
+            transport = registry.links.build(link, "brain", via_relay)
+            if link.spawn_robot:
+                folder = run_dir / ROBOT_DIR
+                children.procs["robot"] = (spawn("robot", ["--run-dir", str(folder), "--from-parent", *args], folder,
+                                                 {"key": signer.hex(), "overrides": addresses}), folder)
+            if via_relay:
+                folder = run_dir / runfiles.RELAY
+                children.procs["relay"] = (spawn("relay", ["--out", str(folder), "--parent-pipe", *args], folder,
+                                                 {"overrides": addresses}), folder)
+            ctx = build_components(cfg, run_dir)
+            if cfg.init_from:
+                state = Path(cfg.init_from) / runfiles.STATE
+                if not state.exists():
+                    raise CerebxError(f"init_from: {state} does not exist")
+                ctx.brain[0].load_state(state)
+            prepare_real_time(ctx.brain)
+            expected = {name: s.size for name, s in cfg.plant.sensor_signals().items()}
+            end = LinkEnd(transport, signer, "brain", expected, run_id=new_run_id(),
+                          max_tick=cfg.trials * ctx.task.steps_per_trial)
+            try:
+                welcome = hello(end, fingerprint(cfg), controller_facts(ctx), cfg.link.pair_timeout_s,
+                                children.alive)
+            except CerebxError as err:
+                if not children.alive():
+                    raise NotPaired(f"link: {children.robot_exit_line()}") from None
+                raise err
+            estimates, shared = sync_clock(end, cfg, welcome)
+        except NotPaired:
+            raise
         except CerebxError as err:
-            if not children.alive():
-                raise CerebxError(f"link: {children.robot_exit_line()}") from None
-            raise err
-        return _run_paired(cfg, run_dir, ctx, end, welcome, resolved, overrides, choices, children)
+            raise NotPaired(str(err)) from None
+        paired = True
+        return _run_paired(cfg, run_dir, ctx, end, welcome, (estimates, shared), resolved, overrides, choices,
+                           children)
     finally:
         if transport is not None:
             transport.close()
-        children.finish()
+        children.finish(10.0 if paired else 0.5)
 
 
-def _run_paired(cfg: Any, run_dir: Path, ctx: BuildContext, end: LinkEnd, welcome: Packet, resolved: dict | None,
-                overrides: list[str], choices: dict[str, str] | None, children: Children) -> dict[str, Any]:
+def _run_paired(cfg: Any, run_dir: Path, ctx: BuildContext, end: LinkEnd, welcome: Packet,
+                clock_sync: tuple[list[clock.OffsetEstimate], bool], resolved: dict | None, overrides: list[str],
+                choices: dict[str, str] | None, children: Children) -> dict[str, Any]:
+    """``clock_sync``: the estimates made at pairing (the refused ones first) and whether the clock is shared."""
+    estimates, shared = clock_sync
     run_id = end.run_id or bytes(16)
     life = RunLifecycle(cfg, run_dir, compression=cfg.link.compression, overrides=overrides, resolved=resolved,
                         fields={"presets": dict(choices or {}), "side": "brain"},
@@ -432,8 +527,11 @@ def _run_paired(cfg: Any, run_dir: Path, ctx: BuildContext, end: LinkEnd, welcom
         _finish(life, side, end, events, sync, children)
 
     with life:
-        est, shared = sync_clock(end, cfg, welcome)
-        sync.append(record_estimate(rec, 0.0, est, est.method))
+        for i, est in enumerate(estimates):
+            refused = i < len(estimates) - 1
+            sync.append(record_estimate(rec, 0.0, est, est.method + (" refused: uncertainty beyond "
+                                        f"{cfg.link.max_clock_uncertainty_ms:g} ms" if refused else "")))
+        est = estimates[-1]
         t0 = start(end, est.offset_ns, cfg.link.pair_timeout_s)
         events.add(0.0, "paired", f"run {run_id.hex()} with {welcome.info.get('host')}")
         side = BrainSide(ctx, rec, end, t0, events)
@@ -445,11 +543,9 @@ def _run_paired(cfg: Any, run_dir: Path, ctx: BuildContext, end: LinkEnd, welcom
                 side.run_trial(trial)
                 life.progress(side.metrics(), side.tick * side.dt_s)
             side.wait_for_end(BYE_WAIT_S)
+            life.completed()
         except PeerEnded as err:
-            if err.status == "completed" and side.tick >= cfg.trials * ctx.task.steps_per_trial:
-                life.completed()
-            else:
-                life.summary.update(outcome(err), status="diverged" if err.status == "diverged" else "interrupted")
+            life.summary.update(outcome(err), status="diverged" if err.status == "diverged" else "interrupted")
     return life.summary
 
 

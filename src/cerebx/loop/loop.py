@@ -16,8 +16,9 @@ robot                 the receiver turns what arrived into this tick's command; 
                       order (supervisor, muscles, ...) read it and the plant's readings
 actuate               the plant takes its command signals (saturated)
 measure               true state, end-effector and command into the trial's metrics
-record                one ``/control`` and two joint-state messages (every ``decimation`` ticks);
-                      the 3-D scene when one is recorded or served (``scene``)
+record                one ``/control`` and two joint-state messages (every ``decimation`` ticks of
+                      the trials ``recording.trials`` holds); the 3-D scene when one is recorded
+                      or served (``scene``)
 physics               the plant advances one control step
 ====================  ========================================================================
 """
@@ -34,6 +35,7 @@ from cerebx.loop.phases import DIVERGENCE_CHECK_TICKS, brain_phase, check_diverg
 from cerebx.metrics import TrialAccumulator, TrialMetrics
 from cerebx.recording.cdr import JOINT_STATE
 from cerebx.recording.recorder import Recorder, stamps_ns, to_ns
+from cerebx.schema.window import trial_window
 from cerebx.signals import Message
 
 if TYPE_CHECKING:
@@ -63,6 +65,9 @@ class ClosedLoop:
         self.dt_s = cfg.control_dt_ms / 1000.0
         self.decimation = cfg.recording.decimation
         self.record_joints = recorder is not None and cfg.recording.joint_states
+        self.window = trial_window(cfg.recording.trials)  # a resumed run keeps its checkpoint's (resume.py)
+        self._steps_on = True  # whether this trial's control steps are recorded
+        self._last_held: tuple[int, int] | None = None  # the newest recorded trial's steps (ns), for a resumption
         self.metrics: list[TrialMetrics] = []
         self._weights_due: deque[tuple[float, int, list[Mapping[str, float]]]] = deque()  # /weights not yet written
         self.trials_done = 0
@@ -127,7 +132,7 @@ class ClosedLoop:
         if acc is not None:
             acc.add(q_des, q, qd_des, qd, applied, ee_des, ee)
         # record
-        if rec is not None and tick % self.decimation == 0:
+        if rec is not None and self._steps_on and tick % self.decimation == 0:
             if self.record_joints:
                 if desired is not None:
                     rec.log_encoded(DESIRED, JOINT_STATE, desired, to_ns(t))
@@ -141,7 +146,7 @@ class ClosedLoop:
             control_message(msg, self.robot, ee, ee_des)
             rec.write("/control", "cerebx.Control", t, msg)
         if self.scene is not None:
-            self.scene.step(tick, t, ee, ee_des)
+            self.scene.step(tick, t, ee, ee_des, self._steps_on)
         # physics
         plant.step()
         self.tick += 1
@@ -152,6 +157,7 @@ class ClosedLoop:
     def run_trial(self, trial: int) -> TrialMetrics:
         ref = self.task.trial(trial, self._task_rng)
         rec = self.rec
+        self._hold_steps(trial, ref.steps)
         acc = TrialAccumulator(self.plant.n_joints, ref.steps, self.cfg.control_dt_ms, n_command=self._n_command)
         for e, fire in self._trial_events:
             if e.at_trial == trial:
@@ -160,11 +166,11 @@ class ClosedLoop:
             rec.write("/task/cartesian_path", "cerebx.CartesianPath", 0.0,
                       {"x": ref.xyz[:, 0].copy(), "y": ref.xyz[:, 1].copy(), "z": ref.xyz[:, 2].copy()})
         if self.scene is not None:
-            self.scene.start_trial(self.tick * self.dt_s, trial, ref.xyz)
+            self.scene.start_trial(self.tick * self.dt_s, trial, ref.xyz, self._steps_on)
         xyz = ref.xyz
         extra = [(f"ref.{name}", v) for name, v in ref.extra.items()]
         desired: list[bytes] | list[None] = [None] * ref.steps
-        if rec is not None and self.record_joints:  # the trial's desired states, encoded at once
+        if rec is not None and self.record_joints and self._steps_on:  # the trial's desired states, encoded at once
             desired = rec.joint_state_messages(DESIRED, stamps_ns(self.tick, ref.steps, self.dt_s), ref.q, ref.qd)
         for i in range(ref.steps):
             self.step(ref.q[i], ref.qd[i], acc, trial, xyz[i] if xyz is not None else None,
@@ -182,6 +188,22 @@ class ClosedLoop:
         if self.scene is not None:
             self.scene.end_trial(self.tick * self.dt_s, m)
         return m
+
+    def _hold_steps(self, trial: int, steps: int) -> None:
+        """Whether ``trial``'s control steps are recorded (``recording.trials``); under a window the recorder
+        learns the simulated times of each recorded trial, for what is logged after the loop's tick (the
+        network's spikes)."""
+        if self.window is None:
+            return
+        self._steps_on = self.window.holds(trial, self.cfg.trials)
+        if self.rec is None:
+            return
+        if self.rec.held is None:  # a new recorder (a resumed run): the trial before may still log spikes
+            self.rec.restrict_steps(self._last_held)
+        if self._steps_on:
+            start, end = stamps_ns(self.tick, steps + 1, self.dt_s)[[0, -1]]
+            self._last_held = (int(start), int(end))
+            self.rec.restrict_steps(self._last_held)
 
     def settle(self) -> None:
         """Write every trial's ``/weights`` still waiting for its values (before a checkpoint and at the end:

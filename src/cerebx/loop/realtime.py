@@ -13,9 +13,10 @@ Extra channels (times are the tick's simulated time, as in every log):
 topic                 side        content
 ====================  ==========  ========================================================================
 /timing               robot       per tick: lateness of its start, compute time, time waited for the
-                                  command, commands that arrived (late: after their stamp), lost, refused
+                                  command, commands that arrived (late: after their stamp), lost, refused,
+                                  dropped (packets dropped during the tick, by reason)
 /timing/brain         brain       per tick: lag (finish - tick start), compute time, sensors that
-                                  arrived, shedding level
+                                  arrived, shedding level, dropped by reason
 /delays/r2c           brain       per sensor message: seq, tick sent, tick used, measured delay (ms)
 /delays/c2r           robot       per command message: the same
 /shedding             brain       each change of the shedding level, with the lead that caused it
@@ -40,10 +41,10 @@ _INT = {"type": "integer"}
 SCHEMAS.update({
     "cerebx.RobotTiming": {"type": "object", "properties": {
         "t": _NUM, "tick": _INT, "lateness_ms": _NUM, "compute_ms": _NUM, "wait_ms": _NUM, "commands": _INT,
-        "late": _INT, "lost": _INT, "refused": _INT, "state": {"type": "string"}}},
+        "late": _INT, "lost": _INT, "refused": _INT, "dropped": {"type": "object"}, "state": {"type": "string"}}},
     "cerebx.BrainTiming": {"type": "object", "properties": {
         "t": _NUM, "tick": _INT, "lag_ms": _NUM, "compute_ms": _NUM, "sensors": _INT, "lost": _INT,
-        "refused": _INT, "level": _INT}},
+        "refused": _INT, "dropped": {"type": "object"}, "level": _INT}},
     "cerebx.LinkDelay": {"type": "object", "properties": {
         "seq": _INT, "tick": _INT, "used_tick": _INT, "delay_ms": _NUM}},
     "cerebx.Shedding": {"type": "object", "properties": {

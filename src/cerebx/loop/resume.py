@@ -34,12 +34,13 @@ from cerebx.recording.reader import read_metadata
 from cerebx.recording.recorder import Recorder
 from cerebx.recording.segments import FIRST, add_segment
 from cerebx.schema.legacy import upgrade
+from cerebx.schema.window import trial_window
 
 log = logging.getLogger("cerebx")
 
 CHECKPOINT = runfiles.CHECKPOINT
 AUTO = "auto"  # resume=auto: reuse, continue or start the run in its own output folder
-_LOOP_FIELDS = ("tick", "trials_done", "metrics", "_sensed", "_task_rng", "_events")
+_LOOP_FIELDS = ("tick", "trials_done", "metrics", "_sensed", "_task_rng", "_events", "window", "_last_held")
 _RECORDER = "recorder"  # persistent id of the run's recorder inside the pickle
 
 
@@ -137,6 +138,9 @@ def load(cfg: Any, run_dir: Path, recorder: Recorder) -> tuple[ClosedLoop, float
     loop = ClosedLoop(ctx, recorder)
     for f, v in state["loop"].items():
         setattr(loop, f, v)
+    if loop.window != trial_window(cfg.recording.trials):
+        log.warning("resume: recording.trials stays as the run started (%s): a run keeps its windows",
+                    "every trial" if loop.window is None else loop.window.model_dump(mode="json"))
     log.info("resuming %s at trial %d (tick %d)", run_dir, loop.trials_done, loop.tick)
     return loop, float(head["wall_seconds"])
 

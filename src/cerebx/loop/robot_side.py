@@ -19,12 +19,18 @@ actuate   as in simulated time, then measure, record (with ``/timing``), physics
 ========  =====================================================================================
 
 The robot side ends when its trials are done (BYE to the brain side), when the brain side says it
-stopped, or when nothing came from it for ``link_lost_after_ms`` (status interrupted, reason link lost).
+stopped, or when no command came from it for ``link_lost_after_ms`` (status interrupted, reason link
+lost; only the session's data packets count as a sign of life, not its control packets).
+
+Before it writes anything it pairs (``link/pairing.py``): it builds its parts after the first matching
+HELLO, answers every matching HELLO with a session of its own, and opens its run folder only once the
+brain side has signed a packet with one of them and asked to start.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import logging
 import sys
 import time
@@ -38,10 +44,10 @@ from cerebx import registry
 from cerebx.build import BuildContext
 from cerebx.config import load
 from cerebx.errors import CerebxError, LinkLost, PeerEnded
-from cerebx.link.auth import require_key
-from cerebx.link.channel import Arrived, LinkEnd
+from cerebx.link.auth import Signer, require_key
+from cerebx.link.channel import POLL_BUDGET, Arrived, LinkEnd
 from cerebx.link.clock import host_identity, host_steal_ms, now_ns, pace, realtime_process
-from cerebx.link.pairing import START_LEAD_S, RemoteController, fingerprint, pong, wait_for_hello
+from cerebx.link.pairing import START_LEAD_S, NotPaired, RemoteController, fingerprint, pong, wait_for_hello, welcome
 from cerebx.link.stats import describe
 from cerebx.link.wire import Kind, Packet
 from cerebx.loop.lifecycle import RunLifecycle
@@ -134,6 +140,8 @@ class RobotSide:
         self.late = 0
         self.ended_ns = t0_ns
         self._steal0 = host_steal_ms()
+        self.welcome_facts: dict[str, Any] = {}
+        self._dropped = end.dropped()
 
     def start(self) -> None:
         q0 = self.task.first_sample() if self.cfg.start_at == "path" else self.task.start_position()
@@ -153,6 +161,8 @@ class RobotSide:
             pong(self.end, pkt)
         elif pkt.kind == Kind.START:  # our answer was lost: the same start time again
             self.end.send_control(Kind.START, {"t0_ns": self.t0})
+        elif pkt.kind == Kind.HELLO:
+            welcome(self.end, pkt, self.welcome_facts)
         elif pkt.kind == Kind.BYE:
             raise PeerEnded(str(pkt.info.get("status", "interrupted")),
                             f"the brain side ended: {pkt.info.get('reason') or pkt.info.get('status')}")
@@ -163,16 +173,17 @@ class RobotSide:
         that soon, and what arrived is taken at once."""
         end, inbox = self.end, self.end.transport.inbox
         got: list[Arrived] = []
+        budget = POLL_BUDGET
         while True:
-            data, control = end.poll()
+            data, control = end.poll(budget)
+            budget -= len(data) + len(control)
             for pkt in control:
-                self._last_packet_ns = max(self._last_packet_ns, pkt.recv_ns)
                 self._control(pkt)
             if data:
                 got += data
                 self._last_packet_ns = max(self._last_packet_ns, data[-1].recv_ns)
                 self._newest_tick = data[-1].tick
-            if self._newest_tick >= k or self._newest_tick < k - 1:
+            if self._newest_tick >= k or self._newest_tick < k - 1 or budget <= 0:
                 return got
             now = now_ns()
             if now >= until_ns:
@@ -236,13 +247,13 @@ class RobotSide:
             self._fire(*self._plant_events.pop(0), t)
         sensed = plant.sense()
         end.send_message(Message(t, sensed), k)
-        lost0, refused0 = end.data.lost, sum(end.rejected.values())
+        lost0, refused0 = end.data.lost, sum(self._dropped.values())
         waited0 = now_ns()
         arrived = self._collect(k, deadline + self.wait_ns)
         waited = now_ns() - waited0
         now = now_ns()
         if now - self._last_packet_ns > self.link.link_lost_after_ms * 1e6:
-            raise LinkLost(f"link lost: nothing from the brain side for {(now - self._last_packet_ns) / 1e9:.1f} s")
+            raise LinkLost(f"link lost: no command from the brain side for {(now - self._last_packet_ns) / 1e9:.1f} s")
         values = self.receiver.receive([a.message for a in arrived], t)
         self._starvation(t, now, arrived, sensed["joint.q"] if "joint.q" in sensed else np.zeros(0))
         if self.state == RUNNING or self.receiver.safe_stop:
@@ -282,11 +293,15 @@ class RobotSide:
         if done > deadline + self.dt_ns:
             self.overruns += 1
         self.log.put(k, lateness_ms=lateness_ms, compute_ms=compute_ms, wait_ms=waited / 1e6)
+        dropped = end.dropped()
         rec.write("/timing", "cerebx.RobotTiming", t,
                   {"t": t, "tick": k, "lateness_ms": round(lateness_ms, 4), "compute_ms": round(compute_ms, 4),
                    "wait_ms": round(waited / 1e6, 4), "commands": len(arrived), "late": late,
-                   "lost": end.data.lost - lost0, "refused": sum(end.rejected.values()) - refused0,
+                   "lost": end.data.lost - lost0, "refused": sum(dropped.values()) - refused0,
+                   "dropped": {r: n - self._dropped.get(r, 0) for r, n in dropped.items()
+                               if n != self._dropped.get(r, 0)},
                    "state": self.state})
+        self._dropped = dropped
         self.ended_ns = done
         self.tick += 1
         if k % DIVERGENCE_CHECK_TICKS == 0:
@@ -329,24 +344,25 @@ class RobotSide:
         return self.tick * self.dt_s
 
 
-def _start(end: LinkEnd, welcome: dict[str, Any], timeout_s: float) -> int:
-    """Answer pings until the brain side asks to start; return tick 0's time (this clock)."""
+def pair(end: LinkEnd, first: Packet, facts: dict[str, Any], timeout_s: float) -> None:
+    """Answer every matching HELLO (each with its own session) and the PINGs of the session the brain side
+    signs with, until that brain side asks to start (START, signed with its session key)."""
+    welcome(end, first, facts)
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         end.transport.inbox.wait(0.05)
         _, control = end.poll()
         for pkt in control:
-            if pkt.kind == Kind.HELLO:  # our WELCOME was lost
-                end.send_control(Kind.WELCOME, welcome)
+            if pkt.kind == Kind.HELLO:  # another brain side's, a replayed one, or ours again (our WELCOME lost)
+                if pkt.info["fingerprint"] == facts["fingerprint"]:
+                    welcome(end, pkt, facts)
             elif pkt.kind == Kind.PING:
                 pong(end, pkt)
             elif pkt.kind == Kind.START:
-                t0 = now_ns() + int(START_LEAD_S * 1e9)
-                end.send_control(Kind.START, {"t0_ns": t0})
-                return t0
+                return
             elif pkt.kind == Kind.BYE:
-                raise PeerEnded(str(pkt.info.get("status", "interrupted")), "the brain side ended before the start")
-    raise LinkLost(f"link lost: the brain side did not start within {timeout_s:g} s")
+                raise NotPaired("link: the brain side ended before the start")
+    raise NotPaired(f"link: no brain side started within {timeout_s:g} s")
 
 
 def prepare_real_time() -> None:
@@ -361,8 +377,9 @@ def prepare_real_time() -> None:
     _put_row(z, z, z, z, z, zz.copy(), zz.copy(), zz.copy(), 0)
 
 
-def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, hello: Any, overrides: list[str]) -> dict[str, Any]:
-    """Build the robot side, open its files, start with the brain side and run; returns the summary."""
+def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, ctx: BuildContext, facts: dict[str, Any],
+              overrides: list[str]) -> dict[str, Any]:
+    """Open the robot side's files (paired, asked to start), answer START and run; returns the summary."""
     run_id = end.run_id or bytes(16)
     life = RunLifecycle(cfg, run_dir, compression=cfg.link.compression, overrides=overrides,
                         fields={"side": "robot"},
@@ -370,6 +387,7 @@ def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, hello: Any, overrides: list
                                            "fingerprint": fingerprint(cfg),
                                            **{k: str(v) for k, v in end.transport.describe().items()}}})
     rec = life.rec
+    ctx.run_dir = run_dir
     events = LinkEvents("robot", rec)
     side: RobotSide | None = None
 
@@ -385,17 +403,15 @@ def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, hello: Any, overrides: list
         summary["setup_seconds"] = round(time.perf_counter() - life.wall0 - (wall if side is not None else 0), 3)
         summary["link"] = side_summary(cfg, "robot", run_id, end, timing, events)
         if not isinstance(summary.get("error"), str) or not summary["error"].startswith("the brain side ended"):
-            _bye(end, summary, timing)
+            _bye(end, summary, timing, side.tick if side is not None else 0)
 
     with life:
-        ctx = build_robot_parts(cfg, hello.info.get("controller") or {}, run_dir)
         rec.joint_names = tuple(ctx.plant.joint_names)
-        prepare_real_time()
-        welcome = {"fingerprint": fingerprint(cfg), **host_identity()}
-        end.send_control(Kind.WELCOME, welcome)
-        t0 = _start(end, welcome, cfg.link.pair_timeout_s)
+        t0 = now_ns() + int(START_LEAD_S * 1e9)
+        end.send_control(Kind.START, {"t0_ns": t0})
         events.add(0.0, "paired", f"run {run_id.hex()}")
         side = RobotSide(ctx, rec, end, t0, events)
+        side.welcome_facts = facts
         side.start()
         for trial in range(cfg.trials):
             side.run_trial(trial)
@@ -404,10 +420,10 @@ def run_robot(cfg: Any, run_dir: Path, end: LinkEnd, hello: Any, overrides: list
     return life.summary
 
 
-def _bye(end: LinkEnd, summary: dict[str, Any], timing: dict[str, Any]) -> None:
+def _bye(end: LinkEnd, summary: dict[str, Any], timing: dict[str, Any], ticks: int) -> None:
     info = {"status": summary["status"], "reason": summary.get("error"), "trials_completed":
             summary.get("trials_completed", 0), "wall_seconds": summary.get("wall_seconds"), "timing": timing,
-            "packets": end.counts(), "events": summary["link"]["events"][-50:]}
+            "packets": end.counts(), "events": summary["link"]["events"][-50:], "ticks": ticks}
     for _ in range(3):
         try:
             end.send_control(Kind.BYE, info)
@@ -421,15 +437,31 @@ def default_run_dir(cfg: Any) -> Path:
         datetime.now().strftime("%H-%M-%S-%f") + f"_{cfg.task.kind}_robot")
 
 
+def from_parent() -> tuple[Signer, list[str]]:
+    """Started by ``cerebx run``: the key and the addresses come as one JSON line on stdin, a pipe only the two
+    processes hold (not on the command line or in the environment, which other processes may read)."""
+    line = sys.stdin.buffer.readline(1 << 16)
+    try:
+        setup = json.loads(line)
+        return Signer(bytes.fromhex(setup["key"])), [str(o) for o in setup["overrides"]]
+    except (ValueError, KeyError, TypeError):
+        raise CerebxError("robot: --from-parent: no setup line on stdin") from None
+
+
 def main(argv: list[str]) -> int:
     """``cerebx robot [--run-dir DIR] OVERRIDES...``: the robot side of a wall-clock run."""
     ap = argparse.ArgumentParser(prog="cerebx robot", description="the robot side of a wall-clock run")
     ap.add_argument("--run-dir", help="folder for run.mcap and summary.json (default: runs/DATE/TIME_TASK_robot)")
+    ap.add_argument("--from-parent", action="store_true", help=argparse.SUPPRESS)
     args, overrides = ap.parse_known_args(argv)
+    signer = None
+    if args.from_parent:
+        signer, more = from_parent()
+        overrides = overrides + more
     cfg, _ = load(overrides)
     if not cfg.link.real:
         raise CerebxError("robot: needs a real link (link=zenoh or link=udp) and clock=wall")
-    signer = require_key()
+    signer = signer or require_key()
     why = realtime_process(cfg.link.rt_priority, "robot")
     if why:
         print(f"robot side: {why}", file=sys.stderr)
@@ -437,10 +469,17 @@ def main(argv: list[str]) -> int:
     transport = registry.links.build(cfg.link, "robot", via_relay)
     expected = {s.name: s.size for s in wire(cfg).sent}
     end = LinkEnd(transport, signer, "robot", expected)
+    run_dir = Path(args.run_dir) if args.run_dir else default_run_dir(cfg)
     try:
         hello = wait_for_hello(end, fingerprint(cfg), cfg.link.pair_timeout_s)
-        run_dir = Path(args.run_dir) if args.run_dir else default_run_dir(cfg)
-        summary = run_robot(cfg, run_dir, end, hello, overrides)
+        ctx = build_robot_parts(cfg, hello.info.get("controller") or {}, None)
+        end.max_tick = cfg.trials * ctx.task.steps_per_trial
+        prepare_real_time()
+        facts = {"fingerprint": fingerprint(cfg), **host_identity()}
+        pair(end, hello, facts, cfg.link.pair_timeout_s)
+        if end.committed is not None and end.committed.hello.info.get("controller") != hello.info.get("controller"):
+            ctx = build_robot_parts(cfg, end.committed.hello.info.get("controller") or {}, None)
+        summary = run_robot(cfg, run_dir, end, ctx, facts, overrides)
     finally:
         transport.close()
     status = summary["status"]

@@ -133,6 +133,8 @@ def run_experiment(cfg: Any, run_dir: Path, resolved: dict | None = None,
             if resume.due(loop):
                 with phase_clock.span("checkpoint"):
                     loop.settle()  # the checkpoint holds no /weights message still to write
+                    if loop.window is not None:  # few messages a trial: the log is on disk up to the checkpoint
+                        rec.flush()
                     ckpt.save(loop, wall_before + time.perf_counter() - life.wall0)
             if bar is not None:
                 bar.set_postfix_str(f"trial {trial + 1}/{cfg.trials}  MAE {m.mae:.4f} rad")

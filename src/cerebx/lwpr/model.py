@@ -1,6 +1,7 @@
 """``LWPR``: incremental locally weighted projection regression with one sub-model per output.
 The numeric work is in ``kernels.py``; this class owns the model buffer and doubles its RF slots when an
-output runs out of them. ``update`` and ``predict`` are one kernel call each, for every output at once."""
+output runs out of them. ``update`` and ``predict`` are one kernel call each, for every output at once,
+given the buffer's address and the caller's arrays as they are (others are converted once a call fails)."""
 
 from __future__ import annotations
 
@@ -20,12 +21,13 @@ def _per_dim(value: float | tuple[float, ...], n: int, name: str) -> np.ndarray:
 
 
 def _vector(v: Any) -> np.ndarray:
-    return np.asarray(v, float).reshape(-1)
+    """A writable C-contiguous float64 copy of v as one row (what the kernels take)."""
+    return np.array(v, float).reshape(-1)
 
 
 def _rows(a: Any, width: int) -> np.ndarray:
-    """Samples as C-contiguous rows; a 1-D array is one value per sample when width is 1."""
-    a = np.ascontiguousarray(a, float)
+    """Samples as writable C-contiguous rows; a 1-D array is one value per sample when width is 1."""
+    a = np.require(a, float, ["C", "W"])
     return a.reshape(len(a), -1) if a.ndim > 1 or width != 1 else a[:, None]
 
 
@@ -57,16 +59,22 @@ def _head(p: LWPRParams, n_in: int, n_out: int) -> np.ndarray:
 def _buffer(head: np.ndarray, norm_in: np.ndarray, norm_out: np.ndarray, capacity: int) -> tuple[np.ndarray, K.Store]:
     """A zeroed model buffer holding ``capacity`` RF slots per output, and numpy views of its RF arrays."""
     n_in, n_out = len(norm_in), len(norm_out)
-    o_in, o_out, o_count, _, o_mat, o_vec, o_sca, size = K.regions(n_in, n_out, capacity)
+    o_in, o_out, o_count, *_, size = K.regions(n_in, n_out, capacity)
     buf = np.zeros(size)
     buf[: K.N_HP] = head
     buf[K.H_CAPACITY] = capacity
     buf[o_in:o_out], buf[o_out:o_count] = norm_in, norm_out
-    store = K.Store(buf[o_mat:o_vec].reshape(n_out, capacity, K.N_MAT, n_in, n_in),
-                    buf[o_vec:o_sca].reshape(n_out, capacity, K.N_VEC, n_in),
-                    buf[o_sca:size].reshape(n_out, capacity, K.N_SCA),
-                    buf[o_count:o_count + n_out * K.N_COUNT].reshape(n_out, K.N_COUNT))
-    return buf, store
+    return buf, _views(buf, n_in, n_out)
+
+
+def _views(buf: np.ndarray, n_in: int, n_out: int) -> K.Store:
+    """numpy views of the RF arrays of a model buffer."""
+    capacity = int(buf[K.H_CAPACITY])
+    _, _, o_count, _, _, o_mat, o_vec, o_sca, size = K.regions(n_in, n_out, capacity)
+    return K.Store(buf[o_mat:o_vec].reshape(n_out, capacity, K.N_MAT, n_in, n_in),
+                   buf[o_vec:o_sca].reshape(n_out, capacity, K.N_VEC, n_in),
+                   buf[o_sca:size].reshape(n_out, capacity, K.N_SCA),
+                   buf[o_count:o_count + n_out * K.N_COUNT].reshape(n_out, K.N_COUNT))
 
 
 class LWPR:
@@ -95,15 +103,47 @@ class LWPR:
         self.params, self.n_in, self.n_out = p, n_in, n_out
         self.norm_in = _per_dim(p.norm_in, n_in, "norm_in")
         self.norm_out = _per_dim(p.norm_out, n_out, "norm_out")
-        K.compile_kernels()
+        self._update = K.entry_point("update", n_in, n_out)
+        self._predict = K.entry_point("predict", n_in, n_out)
         self._head = _head(p, n_in, n_out)
-        self._buf, self._store = _buffer(self._head, self.norm_in, self.norm_out, p.initial_capacity)
+        self._use(*_buffer(self._head, self.norm_in, self.norm_out, p.initial_capacity))
         self._no_act = np.empty((n_out, 0))
+
+    def _use(self, buf: np.ndarray, store: K.Store) -> None:
+        """Make ``buf`` the model's buffer: the kernels get its address, ``update`` and ``predict`` return
+        copies of its pred."""
+        self._buf, self._store, self._addr = buf, store, buf.ctypes.data
+        self._pred = buf[K.regions(self.n_in, self.n_out, 0)[3]:][: self.n_out]
+
+    def _kernel(self, name: str) -> Any:
+        return K.entry_point(name, self.n_in, self.n_out)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled (checkpoints) without what points into the buffer or at compiled code: the address, the
+        views (a pickle would hold them as copies) and the kernels."""
+        state = self.__dict__.copy()
+        for name in ("_store", "_addr", "_pred", "_update", "_predict"):
+            state.pop(name, None)
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """A state of :meth:`__getstate__`, or the pickled ``__dict__`` of earlier code, whose buffer had no
+        pred region: its RF arrays (``_store``) then go into a buffer of today's layout."""
+        old = state.pop("_store", None)  # only earlier code pickled it
+        self.__dict__.update(state)
+        self._update = K.entry_point("update", self.n_in, self.n_out)
+        self._predict = K.entry_point("predict", self.n_in, self.n_out)
+        if old is None:
+            self._use(self._buf, _views(self._buf, self.n_in, self.n_out))
+            return
+        self._use(*_buffer(self._head, self.norm_in, self.norm_out, old.mat.shape[1]))
+        for a, b in zip(old, self._store):
+            b[:] = a
 
     def _grow(self) -> None:
         """Move the model to a buffer with twice the RF slots per output."""
         old = self._store
-        self._buf, self._store = _buffer(self._head, self.norm_in, self.norm_out, 2 * old.mat.shape[1])
+        self._use(*_buffer(self._head, self.norm_in, self.norm_out, 2 * old.mat.shape[1]))
         for a, b in zip(old, self._store):
             b[:, : a.shape[1]] = a
 
@@ -115,18 +155,22 @@ class LWPR:
 
     def update(self, x: Any, y: Any) -> np.ndarray:
         """Train on one pair; returns the prediction at x of the RFs this pair updated (trustworthy ones)."""
-        if type(x) is not np.ndarray or x.ndim != 1:
-            x = _vector(x)
-        if type(y) is not np.ndarray or y.ndim != 1:
-            y = _vector(y)
-        out = np.empty(self.n_out)
-        status = K.update(self._buf, x, y, out)
+        try:
+            status = self._update(self._addr, x, y)
+        except TypeError:  # not both float64 C-contiguous writable 1-D arrays
+            x, y = _vector(x), _vector(y)
+            status = self._update(self._addr, x, y)
+        if status:
+            self._retry(status, x, y)
+        return self._pred.copy()
+
+    def _retry(self, status: int, x: np.ndarray, y: np.ndarray) -> None:
+        """After ``update`` returned ``status``: grow the buffer until the pair fits, or raise for bad input."""
         while status == K.FULL:
             self._grow()
-            status = K.update(self._buf, x, y, out)
+            status = self._update(self._addr, x, y)
         if status:
-            self._check(status, x, y)
-        return out
+            self._check(status, _vector(x), _vector(y))
 
     def update_many(self, X: Any, Y: Any) -> np.ndarray:
         """Train on the rows of X and Y in order (as ``update`` row by row, in one kernel call); returns
@@ -139,21 +183,22 @@ class LWPR:
         if Y.shape[1] != self.n_out:
             self._check(K.BAD_Y, X[0], Y[0])
         out = np.empty((len(X), self.n_out))
-        t = 0
+        t, update_many = 0, self._kernel("update_many")
         while t < len(X):
-            t = K.update_many(self._buf, X, Y, out, t)
+            t = update_many(self._addr, X, Y, out, t)
             if t < len(X):
                 self._grow()
         return out
 
     def predict(self, x: Any) -> np.ndarray:
         """Weighted prediction of the trustworthy RFs above the activation cutoff, per output."""
-        if type(x) is not np.ndarray or x.ndim != 1:
-            x = _vector(x)
-        out = np.empty(self.n_out)
-        if K.predict(self._buf, x, out, self._no_act):
-            self._check(K.BAD_X, x)
-        return out
+        try:
+            status = self._predict(self._addr, x)
+        except TypeError:  # not a float64 C-contiguous writable 1-D array
+            status = self._predict(self._addr, _vector(x))
+        if status:
+            self._check(K.BAD_X, _vector(x))
+        return self._pred.copy()
 
     def predict_many(self, X: Any) -> np.ndarray:
         """``predict`` at every row of X: (rows, n_out)."""
@@ -161,17 +206,18 @@ class LWPR:
         if X.shape[1] != self.n_in:
             self._check(K.BAD_X, X[0])
         out = np.empty((len(X), self.n_out))
-        K.predict_many(self._buf, X, out, self._no_act)
+        self._kernel("predict_many")(self._addr, X, out, self._no_act)
         return out
 
     def predict_with_activations(self, x: Any) -> tuple[np.ndarray, list[np.ndarray]]:
         """Prediction and, per output, the activation of every RF that took part (0 for the others)."""
         x = _vector(x)
-        out = np.empty(self.n_out)
-        act = np.zeros((self.n_out, max(1, int(self._store.count[:, K.N_RF].max()))))
-        if K.predict(self._buf, x, out, act):
+        if x.shape[0] != self.n_in:
             self._check(K.BAD_X, x)
-        return out, [act[d, :n] for d, n in enumerate(self.n_receptive_fields)]
+        out = np.empty((1, self.n_out))
+        act = np.zeros((self.n_out, max(1, int(self._store.count[:, K.N_RF].max()))))
+        self._kernel("predict_many")(self._addr, x[None], out, act)
+        return out[0], [act[d, :n] for d, n in enumerate(self.n_receptive_fields)]
 
     def activations(self, x: Any) -> list[np.ndarray]:
         """Kernel weight of every RF at x, per output (trustworthy or not)."""
@@ -179,7 +225,7 @@ class LWPR:
         if x.shape[0] != self.n_in:
             self._check(K.BAD_X, x)
         act = np.zeros((self.n_out, max(1, int(self._store.count[:, K.N_RF].max()))))
-        K.activations(self._buf, x, act)
+        self._kernel("activations")(self._addr, x, act)
         return [act[d, :n] for d, n in enumerate(self.n_receptive_fields)]
 
     @property
@@ -212,13 +258,13 @@ class LWPR:
             if mat.shape[1:] != self._store.mat.shape[2:]:
                 raise ValueError(f"LWPR state: {mat.shape[2]} inputs saved, this model has {self.n_in}")
         capacity = max(self.params.initial_capacity, 2 * max(len(m) for m in mats))
-        self._buf, st = _buffer(self._head, self.norm_in, self.norm_out, capacity)
+        buf, st = _buffer(self._head, self.norm_in, self.norm_out, capacity)
         for d, mat in enumerate(mats):
             n = len(mat)
             st.mat[d, :n], st.vec[d, :n], st.sca[d, :n] = mat, state[f"lwpr{d}_vec"], state[f"lwpr{d}_sca"]
             st.count[d, K.N_RF] = n
             st.count[d, [K.N_CREATED, K.N_PRUNED]] = state[f"lwpr{d}_counts"]
-        self._store = st
+        self._use(buf, st)
 
     def distance_metric(self, out: int, rf: int) -> np.ndarray:
         """D of RF ``rf`` of output ``out`` (in normalised input units)."""

@@ -145,6 +145,9 @@ class Recorder:
         self.joint_names = tuple(joint_names)
         self.live = live  # a LiveView (recording/live.py) whose server also gets every channel, or None
         self.closed = False
+        # under recording.trials: the [start, end) log times (ns) of the recorded trials' control steps, which
+        # the spikes logged after their tick are held to; None: every step is recorded
+        self.held: list[tuple[int, int]] | None = None
 
     def _channel(self, topic: str, schema: str) -> Callable[[bytes, int], None]:
         """The function that logs ``(data, log_time_ns)`` on ``topic``, creating the channel on first use."""
@@ -201,12 +204,31 @@ class Recorder:
         step s, logged at ``times_s[s]``."""
         stamps = [to_ns(t) for t in times_s]
         self._pending += len(data)
+        keep = None if self.held is None else [self.holds_step(ns) for ns in stamps]
         k = 0
         for topic in topics:
             log = self._channel(topic, SPIKES)
-            for ns in stamps:
-                log(data[starts[k]:starts[k + 1]], ns)
+            for s, ns in enumerate(stamps):
+                if keep is None or keep[s]:
+                    log(data[starts[k]:starts[k + 1]], ns)
                 k += 1
+
+    def restrict_steps(self, held: tuple[int, int] | None = None) -> None:
+        """Record control steps only in the trials given (``recording.trials``): from now on, and also for
+        ``held``, the [start, end) log times (ns) of a recorded trial's steps."""
+        if self.held is None:
+            self.held = []
+        if held is not None and held not in self.held:
+            self.held.append((int(held[0]), int(held[1])))
+
+    def holds_step(self, t_ns: int) -> bool:
+        """Whether a control step logged at ``t_ns`` belongs to a recorded trial (always without a window)."""
+        if self.held is None:
+            return True
+        for start, end in reversed(self.held):
+            if start <= t_ns:
+                return t_ns < end
+        return False
 
     def idle(self) -> None:
         """The caller is about to wait (the loop's thread, for the network's next chunk): a moment to compress
@@ -218,6 +240,13 @@ class Recorder:
         file stays the same from run to run; its messages are the same either way, only the chunks are
         smaller."""
         if self._early and self._pending >= self._early and not self.closed:
+            self._pending = 0
+            self._w.flush()
+
+    def flush(self) -> None:
+        """Finish the chunk being filled (what was logged is then on the disk: a windowed run logs so little
+        between its held trials that a chunk may hold many trials)."""
+        if not self.closed:
             self._pending = 0
             self._w.flush()
 

@@ -246,18 +246,19 @@ class SceneWriter:
                 live.channel(topic, schema)
 
     # ---- what the loop calls ------------------------------------------------------------------
-    def start_trial(self, t_s: float, trial: int, xyz: np.ndarray | None) -> None:
+    def start_trial(self, t_s: float, trial: int, xyz: np.ndarray | None, record: bool = True) -> None:
         """The robot's geometry and the trial's desired path (again at each trial, so a reader that
-        seeks finds them)."""
+        seeks finds them); into the file only when the trial is ``record``-ed (``recording.trials``)."""
         ns = int(round(t_s * 1e9))
         entities = robot_entities(self.model, ns) if self.model is not None else []
         if xyz is not None:
             entities.append(path_entity(ns, xyz))
         self._robot = entities
-        self._log(ROBOT, "foxglove.SceneUpdate", t_s, {"deletions": [], "entities": entities}, True, True)
+        self._log(ROBOT, "foxglove.SceneUpdate", t_s, {"deletions": [], "entities": entities}, record, True)
 
-    def step(self, tick: int, t_s: float, ee: np.ndarray | None, ee_des: np.ndarray | None) -> None:
-        to_file = self.rec is not None and tick % self.every == 0
+    def step(self, tick: int, t_s: float, ee: np.ndarray | None, ee_des: np.ndarray | None,
+             record: bool = True) -> None:
+        to_file = record and self.rec is not None and tick % self.every == 0
         to_live = False
         if self.live is not None:
             now = time.perf_counter()

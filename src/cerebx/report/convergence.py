@@ -25,10 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from cerebx.report.runs import Run, RunSet
+from cerebx.report.schema import MIN_WINDOW, TOLERANCE, WINDOW_FRACTION
 
-WINDOW_FRACTION = 0.1
-MIN_WINDOW = 5
-TOLERANCE = 0.10
 FULL_PROFILE = "run --profile full"
 
 

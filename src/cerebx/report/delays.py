@@ -38,8 +38,11 @@ def delay_rows(runs: RunSet) -> list[list[str]]:
         if not mae.size or r.delay == "none" and "delay" not in (r.summary.get("presets") or {}):
             continue
         tv = r.series("torque_variability_per_trial")
-        r2c, c2r = delays(r)
-        rt = f"{np.mean(r2c + c2r):.1f}" if r2c.size else "–"
+        if r.delay == "none":  # no link delay: nothing to read (its log may hold no control step, recording.trials)
+            rt = "0.0"
+        else:
+            r2c, c2r = delays(r)
+            rt = f"{np.mean(r2c + c2r):.1f}" if r2c.size else "–"
         delay_overrides = " ".join(o for o in r.summary.get("overrides", []) if o.startswith("delay"))
         rows.append([r.task, r.controller_preset, r.delay_preset, delay_overrides, rt,
                      f"{np.mean(mae):.4f} ± {np.std(mae):.4f}", f"{np.mean(mae[-10:]):.4f}",

@@ -16,26 +16,9 @@ import dataclasses
 import functools
 from pathlib import Path
 
-from pydantic import Field
-
 from cerebx.report.registry import EXPLANATION_FILES, Check, Figure, load_reports
+from cerebx.report.schema import Explanation, ExplanationsFile
 from cerebx.report.studies import read_yaml_model
-from cerebx.schema.base import Strict
-
-PROFILES = ("quick", "full")
-
-
-class Explanation(Strict):
-    """One check's explanation."""
-
-    figure: str = Field(min_length=1, description="the figure's registered name")
-    claim: str = Field(min_length=1, description="the start of the check's claim")
-    at: str = Field(pattern=r"^[\w./-]+\.md#[\w-]+$", description="docs-relative page and anchor (page.md#anchor)")
-    profiles: list[str] = Field(default_factory=lambda: list(PROFILES), description="the profiles it applies to")
-
-
-class ExplanationsFile(Strict):
-    explanations: list[Explanation] = Field(default_factory=list)
 
 
 def load_explanations(*paths: Path) -> list[Explanation]:

@@ -22,6 +22,7 @@ from cerebx.errors import CerebxError
 from cerebx.metrics import torque_variability_of_mean
 from cerebx.recording.reader import read_messages, read_metadata, read_summary
 from cerebx.schema.legacy import upgrade
+from cerebx.schema.window import TrialWindow
 
 
 @dataclass
@@ -174,10 +175,28 @@ class Run:
         for topic, t, msg in read_messages(self.dir, topics, start_ns=lo, end_ns=hi):
             yield topic, t / 1e9, msg
 
+    @property
+    def window(self) -> TrialWindow | None:
+        """The trials whose control steps the log holds (``recording.trials``); None: every trial."""
+        value = self.get("recording.trials")
+        if value in (None, "all"):
+            return None
+        try:
+            return TrialWindow.model_validate({} if value == "none" else value)
+        except ValueError:
+            return TrialWindow()
+
+    def holds_steps(self, trials: Iterable[int]) -> bool:
+        """Whether the log holds the control steps of every one of ``trials``."""
+        w = self.window
+        n = int(self.get("trials") or self.summary.get("trials") or self.trials)
+        return w is None or all(w.holds(k, n) for k in trials)
+
     def applied_torque(self) -> tuple[np.ndarray, float] | None:
         """The applied joint torque of the measured trials as trials x steps x joints (from
-        /joint_states/actual), with the recorded step in ms; None when joint states were not recorded."""
-        if self.n_measured == 0:
+        /joint_states/actual), with the recorded step in ms; None when joint states were not recorded, also
+        when the log's window (``recording.trials``) leaves out a measured trial."""
+        if self.n_measured == 0 or not self.holds_steps(range(self.warmup, self.trials)):
             return None
         t0 = self.warmup * self.period_s
         rows = [[j["effort"] for j in msg["joints"]] for _, _, msg in

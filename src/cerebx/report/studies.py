@@ -35,60 +35,37 @@ from hydra.core.global_hydra import GlobalHydra
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.errors import HydraException
 from omegaconf import OmegaConf
-from pydantic import Field, ValidationError
+from pydantic import ValidationError
 
 from cerebx.config import compose_with_choices, expand_sweep, load, to_plain
 from cerebx.errors import CerebxError, ConfigError
 from cerebx.loop.resume import stale
 from cerebx.loop.runner import run_experiment
 from cerebx.recording.summary import read_summary
-from cerebx.report.convergence import MIN_WINDOW, TOLERANCE, WINDOW_FRACTION, PlateauRule
+from cerebx.report.convergence import PlateauRule
 from cerebx.report.registry import STUDY_FILES, load_reports
+from cerebx.report.schema import PROFILES, ProfileSpec, StudiesFile, StudySpec
 from cerebx.schema.base import Strict
-from cerebx.schema.experiment import format_errors, validate
+from cerebx.schema.experiment import RecordingConfig, format_errors, validate
+from cerebx.schema.window import TrialWindow
 
-PROFILES = ("quick", "full")
 M = TypeVar("M", bound=Strict)
 
 
-class ProfileSpec(Strict):
-    """How a study runs in one profile."""
-
-    trials: int = Field(ge=1, description="trials of every job")
-    args: list[str] = Field(default_factory=list, description="extra overrides in this profile")
-    init_from: str | None = Field("inherit", description="start from this study's run instead (null: scratch)")
-    seeds: int = Field(1, ge=1, le=20, description="independently learned seeds (seed 0 .. seeds-1; each more "
-                       "seed k runs as the study <name>~seed<k>)")
-
-
-class PlateauSpec(Strict):
-    """The plateau test of a learning study's curves (``report.convergence``): the window is a fraction of the
-    full profile's trials (where the paper's shape appears); the last window may fall this much below the one
-    before."""
-
-    window_fraction: float = Field(WINDOW_FRACTION, gt=0, le=0.5, description="window, a fraction of the full "
-                                   "profile's trials")
-    min_window: int = Field(MIN_WINDOW, ge=1, description="window at least this many trials")
-    tolerance: float = Field(TOLERANCE, ge=0, description="largest relative fall from the window before to the last")
-
-
-class StudySpec(Strict):
-    """One experiment preset run once or as a sweep."""
-
-    args: list[str] = Field(min_length=1, description="overrides of every job, the experiment preset first (its "
-                            "hydra.sweeper.params make the study a sweep; an arg setting a swept key fixes it, "
-                            "or with a sweep value (seed=0,1,2) sweeps those values instead)")
-    init_from: str | None = Field(
-        None, description="study whose learned state starts each job: a single-run study, or one with the same "
-        "sweep (each job then starts from the job of the same sweep values)")
-    quick: ProfileSpec = Field(description="the quick profile (< 30 min on 2 cores in all)")
-    full: ProfileSpec = Field(description="the full profile (the paper's trial counts)")
-    plateau: PlateauSpec = Field(default_factory=PlateauSpec, description="when a run of this study that learns "
-                                 "has levelled off (the report's convergence badge)")
-
-
-class StudiesFile(Strict):
-    studies: dict[str, StudySpec] = Field(description="study name -> study")
+def study_recording(spec: StudySpec, profile: str) -> tuple[TrialWindow | None, bool]:
+    """The window (``recording.trials``; None: every trial) and ``recording.joint_states`` the runs of study
+    ``spec`` record in ``profile``, from its overrides (the last one given wins, as in Hydra)."""
+    window, joints = None, True
+    parser = OverridesParser.create()
+    for arg in [*spec.args, *getattr(spec, profile).args]:
+        key = _key(arg)
+        if key in ("recording.trials", "recording.joint_states"):
+            value = parser.parse_overrides([arg])[0].value()
+            if key == "recording.joint_states":
+                joints = bool(value)
+            else:
+                window = RecordingConfig(trials=value).trials
+    return window, joints
 
 
 def load_studies(*paths: Path) -> dict[str, StudySpec]:

@@ -11,6 +11,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
+from cerebx import registry
 from cerebx.registry import Plugin
 from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
 from cerebx.signals import Signal, StageIO, torque_controller_io
@@ -219,6 +220,22 @@ class CompositeController(ControllerConfig):
 
     kind: Literal["composite"] = "composite"
     parts: list[Plugin("controller")] = Field(min_length=1, description="controller parts, in order")
+
+    @classmethod
+    def complete(cls, experiment: dict[str, Any]) -> dict[str, Any]:
+        """Each part's own ``complete`` with the part in the controller's place; what a part's hook changes
+        outside the controller (e.g. the robot stages) is not taken over: set it in the experiment."""
+        ctrl = experiment.get("controller")
+        parts = ctrl.get("parts") if isinstance(ctrl, dict) else None
+        if not isinstance(parts, list):
+            return experiment
+        done = []
+        for part in parts:
+            kind = part.get("kind") if isinstance(part, dict) else None
+            if isinstance(kind, str) and kind in registry.controllers and kind != "composite":
+                part = registry.controllers[kind].schema.complete({**experiment, "controller": part})["controller"]
+            done.append(part)
+        return {**experiment, "controller": {**ctrl, "parts": done}}
 
     def cross_check(self, exp: Any) -> list[str]:
         return [f"controller.parts.{i}.{line}" for i, p in enumerate(self.parts) for line in p.cross_check(exp)]

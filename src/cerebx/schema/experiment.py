@@ -14,6 +14,7 @@ from cerebx.registry import Plugin
 from cerebx.schema.base import CONTROL_DT_MS, NonNegFloat, Strict
 from cerebx.schema.init_state import init_from_problems
 from cerebx.schema.live import LiveConfig
+from cerebx.schema.window import WindowValue, trial_window
 from cerebx.wiring import BODY_SLOTS, wire
 
 
@@ -62,6 +63,10 @@ class RecordingConfig(Strict):
     scene_every: int | None = Field(
         None, ge=0, description="control steps between frames of the plant's 3-D scene in run.mcap (/scene/*); "
         "null: every 10 steps when live.enabled, else none; 0: none")
+    trials: WindowValue = Field(
+        None, description="the trials whose control steps are recorded (joint states, /control, spikes, scene), "
+        "e.g. {first: 10, last: 20, every: 100, ranges: [[149, 160]]}; null or all: every trial, none: no trial; "
+        "per-trial data (/trial_metrics, /events, /weights, summary.json) are recorded for every trial")
 
 
 def _union(reg: registry.Registry) -> Any:
@@ -178,6 +183,9 @@ class _ExperimentBase(Strict):
             except ConfigError as err:
                 problems += err.problems
         problems += clock_problems(self)
+        if self.link.real and trial_window(self.recording.trials) is not None:
+            problems.append("recording.trials: a wall-clock run over a real link records every trial (windows are "
+                            "recorded by the simulated loop, link=sim)")
         if self.link.real and self.resume is not None:
             problems.append("resume: a wall-clock run over a real link cannot be continued from a checkpoint")
         if self.warmup_trials >= self.trials:

@@ -4,7 +4,8 @@ experiment (reports reuse it, ``resume`` continues it) when its recorded data wo
 Two changes are undone here: the spiking network used to be a top-level ``network`` key of every experiment
 (it now belongs to the controller that runs it: any controller kind whose schema has a ``network`` field,
 and nothing else), and options added since a run was recorded are filled in with the value that does what
-the run did (each controller kind lists them in ``added_without_effect``, the experiment schema its own keys)."""
+the run did (each controller kind and plasticity kind lists them in ``added_without_effect``, the experiment
+schema its own keys)."""
 
 from __future__ import annotations
 
@@ -34,12 +35,25 @@ def _fill(part: dict[str, Any], dotted: str, value: Any) -> None:
         node[last] = copy.deepcopy(value)
 
 
+def _upgrade_link(link: Any) -> None:
+    """A real link recorded before its newer fields: filled in by its kind's schema (``upgrade_recorded``)."""
+    kind = link.get("kind") if isinstance(link, dict) else None
+    if not isinstance(kind, str) or kind not in registry.links:
+        return
+    fill = getattr(registry.links[kind].schema, "upgrade_recorded", None)
+    if callable(fill):
+        fill(link)
+
+
 def upgrade(config: dict[str, Any]) -> dict[str, Any]:
     """A copy of a recorded experiment config in today's layout (unchanged when it already is)."""
     registry.load_plugins()
     out = copy.deepcopy(config)
     for key, value in ADDED_WITHOUT_EFFECT.items():
         out.setdefault(key, copy.deepcopy(value))
+    _upgrade_link(out.get("link"))
+    if isinstance(out.get("recording"), dict):
+        out["recording"].setdefault("trials", None)  # recording.trials: every trial, as before windows
     network = out.pop("network", None)
     controller = out.get("controller")
     if not isinstance(controller, dict):
@@ -52,4 +66,16 @@ def upgrade(config: dict[str, Any]) -> dict[str, Any]:
             part["network"] = copy.deepcopy(network)
         for dotted, value in schema.added_without_effect.items():
             _fill(part, dotted, value)
+        _fill_plasticity(part.get("network"))
     return out
+
+
+def _fill_plasticity(network: Any) -> None:
+    """Options added to a plasticity kind since a run was recorded (its schema's ``added_without_effect``)."""
+    projections = network.get("projections") if isinstance(network, dict) else None
+    for proj in projections.values() if isinstance(projections, dict) else ():
+        rule = proj.get("plasticity") if isinstance(proj, dict) else None
+        kind = rule.get("kind") if isinstance(rule, dict) else None
+        if isinstance(kind, str) and kind in registry.plasticity_rules:
+            for dotted, value in getattr(registry.plasticity_rules[kind].schema, "added_without_effect", {}).items():
+                _fill(rule, dotted, value)

@@ -13,9 +13,12 @@ a burst of floor(x / c_k) spikes (clipped to 1..max_burst), one per step.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numba
 import numpy as np
 
+from cerebx.kernel_struct import KernelStruct
 from cerebx.snn.schema import BoxEncoder, CFEncoder, PoissonEncoder
 
 STEP_S = 0.002
@@ -246,26 +249,66 @@ class ClimbingEncoder:
             self._u = np.zeros(self.burst_left.shape[0])
 
 
+class BoxCoding(NamedTuple):
+    """What :func:`_both_active` reads of a :class:`MossyEncoder` (its arrays, not copies)."""
+
+    lo: np.ndarray  # (n_joints, 4): the signals' ranges
+    hi: np.ndarray
+    step: np.ndarray  # (n_joints, 4): centre spacing
+    half_width: np.ndarray  # (n_joints, 4): half-width of a box
+    fibers: int  # fibres per signal
+    first: int  # global index of local fibre 0
+    out: np.ndarray  # int32 scratch of the active local indices
+
+
+class ErrorCoding(NamedTuple):
+    """What :func:`_both_active` reads of a :class:`ClimbingEncoder` (its arrays, not copies)."""
+
+    n_joints: int
+    kpos: np.ndarray  # error gains per joint
+    kvel: np.ndarray
+    centres: np.ndarray  # a side's fibre centres
+    width: float
+    rate_min_hz: float
+    rate_max_hz: float
+    max_burst: int
+    half: int  # fibres per side of a joint
+    burst_left: np.ndarray  # int64: spikes left in each fibre's burst
+    first: int  # global index of local fibre 0
+    out: np.ndarray  # int32 scratch of the spiking local indices
+
+
+class Coders(NamedTuple):
+    """Both encoders of an :class:`EncoderPair`."""
+
+    mf: BoxCoding
+    cf: ErrorCoding
+
+
+class CodersState(KernelStruct, fields=Coders):
+    """:class:`Coders` as the one numba object :func:`_both_active` takes."""
+
+
 @numba.njit(cache=True)
-def _both_active(q_des, qd_des, q_des_cf, qd_des_cf, q, qd, u, lo, hi, step, half_width, F, mf_first, mf_out, ncf,
-                 kpos, kvel, centres, width, r_min, r_max, max_burst, half, burst_left, cf_first,
-                 cf_out):  # pragma: no cover
+def _both_active(q_des, qd_des, q_des_cf, qd_des_cf, q, qd, u, coders):  # pragma: no cover
     """:meth:`MossyEncoder.active` on (q_des, q, qd_des, qd), :meth:`ClimbingEncoder.error` on (q_des_cf, q,
-    qd_des_cf, qd) and :meth:`ClimbingEncoder.active` on that error with the draws ``u``, in one call: the MF
-    and CF fibres' global indices (local + ``mf_first`` / ``cf_first``, int32) and the error; three empty
-    arrays and False when a signal has fewer values than the encoders read (``ncf``: the CF encoder's joints)."""
-    nj = lo.shape[0]
-    if min(q_des.size, q.size, qd_des.size, qd.size) < nj or min(q_des_cf.size, qd_des_cf.size, q.size, qd.size) < ncf:
+    qd_des_cf, qd) and :meth:`ClimbingEncoder.active` on that error with the draws ``u``, in one call
+    (``coders``: a :class:`CodersState`): the MF and CF fibres' global indices (local + ``first``, int32) and
+    the error; three empty arrays and False when a signal has fewer values than the encoders read."""
+    b, c = coders.mf, coders.cf
+    nj = b.lo.shape[0]
+    if min(q_des.size, q.size, qd_des.size, qd.size) < nj or min(q_des_cf.size, qd_des_cf.size, q.size,
+                                                                 qd.size) < c.n_joints:
         return np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros(0), False
-    n = _mf_active(q_des, q, qd_des, qd, lo, hi, step, half_width, F, mf_out)
+    n = _mf_active(q_des, q, qd_des, qd, b.lo, b.hi, b.step, b.half_width, b.fibers, b.out)
     mf = np.empty(n, np.int32)
     for i in range(n):
-        mf[i] = mf_out[i] + mf_first
-    e = _cf_error(q_des_cf, q, qd_des_cf, qd, kpos, kvel)
-    n = _cf_step(e, u, centres, width, r_min, r_max, max_burst, half, burst_left, cf_out)
+        mf[i] = b.out[i] + b.first
+    e = _cf_error(q_des_cf, q, qd_des_cf, qd, c.kpos, c.kvel)
+    n = _cf_step(e, u, c.centres, c.width, c.rate_min_hz, c.rate_max_hz, c.max_burst, c.half, c.burst_left, c.out)
     cf = np.empty(n, np.int32)
     for i in range(n):
-        cf[i] = cf_out[i] + cf_first
+        cf[i] = c.out[i] + c.first
     return mf, cf, e, True
 
 
@@ -277,14 +320,15 @@ class EncoderPair:
     stepped one by one). The pair keeps the encoders' arrays, not copies: make a new one when an encoder is
     replaced (a checkpoint restored); its state (bursts, random generator) stays the encoder's."""
 
-    __slots__ = ("cf", "_args")
+    __slots__ = ("cf", "_coders")
 
     def __init__(self, mf: MossyEncoder, cf: ClimbingEncoder, mf_first: int, cf_first: int):
         c = cf.cfg
         self.cf = cf
-        self._args = (mf.lo, mf.hi, mf.step, mf.half_width, mf.F, mf_first, mf._out, cf.n_joints, cf.kpos, cf.kvel,
-                      cf.centres, cf.width, c.rate_min_hz, c.rate_max_hz, c.max_burst, cf.half, cf.burst_left,
-                      cf_first, cf._out)
+        self._coders = CodersState.of(Coders(
+            BoxCoding(mf.lo, mf.hi, mf.step, mf.half_width, mf.F, mf_first, mf._out),
+            ErrorCoding(cf.n_joints, cf.kpos, cf.kvel, cf.centres, cf.width, c.rate_min_hz, c.rate_max_hz,
+                        c.max_burst, cf.half, cf.burst_left, cf_first, cf._out)))
 
     @classmethod
     def of(cls, mf: object, cf: object, mf_first: int, cf_first: int) -> EncoderPair | None:
@@ -298,5 +342,5 @@ class EncoderPair:
         which)."""
         cf = self.cf
         u = cf.rng.random(out=cf._u)
-        mf, cfi, e, ok = _both_active(q_des, qd_des, q_des_cf, qd_des_cf, q, qd, u, *self._args)
+        mf, cfi, e, ok = _both_active(q_des, qd_des, q_des_cf, qd_des_cf, q, qd, u, self._coders)
         return (mf, cfi, e) if ok else None

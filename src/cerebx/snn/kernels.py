@@ -52,9 +52,9 @@ import numpy as np
 from llvmlite import ir
 from numba import njit, prange, types
 from numba.core import cgutils
-from numba.experimental import structref
 from numba.extending import intrinsic, overload
 
+from cerebx.kernel_struct import KernelStruct
 from cerebx.snn.learning import NoLearning, SparseLearning, run_rules
 from cerebx.snn.topology import (
     I_COMPACT,
@@ -98,6 +98,13 @@ from cerebx.snn.topology import (
     P_URST,
     P_VT,
     P_VTH,
+    S_DELAY,
+    S_N_PRE,
+    S_POST_POP,
+    S_PRE_LO,
+    S_RECEPTOR,
+    S_ROW,
+    S_TEACHING,
 )
 
 G_FLOOR = np.float32(1e-12)  # conductances below this (nS) become exactly 0 (avoids denormals)
@@ -202,7 +209,7 @@ class Delivery(NamedTuple):
 
     ring_idx: np.ndarray  # int32 [R, n]: spiking neurons per substep slot (t % R)
     ring_n: np.ndarray  # int64 [R]: spikes in each slot
-    sp_i: np.ndarray  # int64 [proj, 7]: pre_lo, n_pre, row offset, receptor, delay, teaching, post pop
+    sp_i: np.ndarray  # int64 [proj, N_SPAR]: columns S_PRE_LO .. S_POST_POP (topology.py)
     sp_ptr: np.ndarray  # int64: CSR row pointers by presynaptic neuron, all sparse projections
     sp_post: np.ndarray  # int32: postsynaptic global index per synapse
     sp_w: np.ndarray  # float32: weight per synapse (nS)
@@ -252,35 +259,22 @@ class NetworkArrays(NamedTuple):
     learning: SparseLearning | NoLearning  # the sparse projections' rules (snn/learning.py), if any
 
 
-@structref.register
-class _KernelStateType(types.StructRef):
-    """numba type of :class:`KernelState`."""
-
-
-class KernelState(structref.StructRefProxy):
+class KernelState(KernelStruct, fields=NetworkArrays):
     """A network's :class:`NetworkArrays` as one numba object, the form :func:`run_step` and
     :func:`run_chunk` take (make it with :func:`kernel_state`). numba passes it as one pointer, so a
     call costs the same whatever the number of arrays: an empty step costs about half as much as
     with the 38 arrays as arguments and a quarter as much as with the named tuples, whose arrays and
     field names numba checks one by one on every call. Pickles as its arrays."""
 
-    def __reduce__(self):
-        return kernel_state, (self.arrays,)
-
-
-structref.define_proxy(KernelState, _KernelStateType, NetworkArrays._fields)
-
-
-@njit(cache=True)
-def _pack(arrays):
-    return KernelState(*arrays)
+    @property
+    def arrays(self) -> NetworkArrays:
+        """The :class:`NetworkArrays` it was made of."""
+        return self.source
 
 
 def kernel_state(arrays: NetworkArrays) -> KernelState:
     """The kernels' handle on ``arrays`` (the same array objects: writes either way are seen both ways)."""
-    state = _pack(arrays)
-    state.arrays = arrays
-    return state
+    return KernelState.of(arrays)
 
 
 def mg_block(v: np.ndarray) -> np.ndarray:
@@ -921,14 +915,14 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
     for s in range(n_sub):
         t = t0 + s
         tk = prof_lap(prof, pb + BOOKKEEPING, tk)
-        run_rules(t, learn, net.learning, dl)
+        run_rules(t, learn, net.learning, dl)  # before delivery: a synapse delivers its updated weight
         tk = prof_lap(prof, pb + PLASTICITY, tk)
         # sparse projections (CSR by presynaptic neuron); teaching ones carry no current
         for p in range(sp_i.shape[0]):
-            if sp_i[p, 5] != 0:
+            if sp_i[p, S_TEACHING] != 0:
                 continue
-            pre_lo, n_pre, off, rec, delay = sp_i[p, 0], sp_i[p, 1], sp_i[p, 2], sp_i[p, 3], sp_i[p, 4]
-            pp = sp_i[p, 6]
+            pre_lo, n_pre, off = sp_i[p, S_PRE_LO], sp_i[p, S_N_PRE], sp_i[p, S_ROW]
+            rec, delay, pp = sp_i[p, S_RECEPTOR], sp_i[p, S_DELAY], sp_i[p, S_POST_POP]
             ratio = pop_i[pp, I_RATIO]
             if t % ratio != 0:
                 continue
@@ -1046,11 +1040,11 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
         if learn:
             for pl in range(pl_i.shape[0]):
                 d, tp = pl_i[pl, 0], pl_i[pl, 1]
-                delay = sp_i[tp, 4]
+                delay = sp_i[tp, S_DELAY]
                 if t - delay < 0:
                     continue
                 sl = (t - delay) % R
-                pre_lo, n_pre, off = sp_i[tp, 0], sp_i[tp, 1], sp_i[tp, 2]
+                pre_lo, n_pre, off = sp_i[tp, S_PRE_LO], sp_i[tp, S_N_PRE], sp_i[tp, S_ROW]
                 post_lo, n_post = de_i[d, 2], de_i[d, 3]
                 n_col = 0
                 for k in range(ring_n[sl]):

@@ -10,6 +10,10 @@ partner side (pairing: events up to and including t; traces: before t); then eve
 history. So a pre arrival and a post spike in the same substep do not pair under pair STDP (NEST's
 ``stdp_synapse`` does not pair simultaneous spikes either) and pair once under the pairing family.
 
+With a dendritic delay (``TraceSpec.dendritic``, NEST's convention) a post spike reaches the synapse one delay d
+after it happened, and the pre arrival is d after the pre spike reaches the synapse: the partner events at t are
+the post spikes stamped t − 2d (``R_PDELAY``), and a pair then has NEST's Δt = t_post − t_pre + d.
+
 Traces are exact: a trace keeps its value and the substep of its last update and is decayed on read,
 x(t) = x(t_last) exp(−(t − t_last) dt / tau). Histories keep each neuron's last HISTORY_MAX spike times (a ring).
 """
@@ -22,11 +26,13 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
+from cerebx.snn.topology import S_DELAY, S_N_PRE, S_PRE_LO, S_ROW
+
 FAM_TRACE, FAM_PAIRING = 0, 1
 
 # columns of sr_i (int64 per rule)
-(R_FAM, R_PIECE, R_TLO, R_THI, R_POST_LO, R_NPOST, R_CSC, R_KOFF, R_KLEN, R_PRE_ROW, R_POST_ROW) = range(11)
-N_RI = 11
+(R_FAM, R_PIECE, R_TLO, R_THI, R_POST_LO, R_NPOST, R_CSC, R_KOFF, R_KLEN, R_PRE_ROW, R_POST_ROW, R_PDELAY) = range(12)
+N_RI = 12
 # columns of sr_f (float64 per rule)
 (R_WLO, R_WHI, R_FIXED, R_LAM, R_ALPHA, R_MUP, R_MUM, R_RATEP, R_RATEM) = range(9)
 N_RF = 9
@@ -111,25 +117,26 @@ def sparse_learning(t, learn, sl, dl):
     R = ring_idx.shape[0]
     for r in range(sr_i.shape[0]):
         pc = sr_i[r, R_PIECE]
-        pre_lo, n_pre, off, delay = sp_i[pc, 0], sp_i[pc, 1], sp_i[pc, 2], sp_i[pc, 4]
+        pre_lo, n_pre, off, delay = sp_i[pc, S_PRE_LO], sp_i[pc, S_N_PRE], sp_i[pc, S_ROW], sp_i[pc, S_DELAY]
         post_lo, n_post, co = sr_i[r, R_POST_LO], sr_i[r, R_NPOST], sr_i[r, R_CSC]
         pre_row, post_row = sr_i[r, R_PRE_ROW], sr_i[r, R_POST_ROW]
         w_lo, w_hi = sr_f[r, R_WLO], sr_f[r, R_WHI]
         # partner events at t
         ne = 0
         if sr_i[r, R_TLO] < 0:
-            s0 = t % R
-            for k in range(ring_n[s0]):
+            td = t - sr_i[r, R_PDELAY]  # the post spikes that reach the synapse now
+            s0 = td % R
+            for k in range(ring_n[s0] if td >= 0 else 0):
                 i = ring_idx[s0, k] - post_lo
                 if i >= 0 and i < n_post:
                     ev[ne] = i
                     ne += 1
         else:
             for tp in range(sr_i[r, R_TLO], sr_i[r, R_THI]):
-                if t - sp_i[tp, 4] < 0:
+                if t - sp_i[tp, S_DELAY] < 0:
                     continue
-                s1 = (t - sp_i[tp, 4]) % R
-                t_lo, t_n, t_off = sp_i[tp, 0], sp_i[tp, 1], sp_i[tp, 2]
+                s1 = (t - sp_i[tp, S_DELAY]) % R
+                t_lo, t_n, t_off = sp_i[tp, S_PRE_LO], sp_i[tp, S_N_PRE], sp_i[tp, S_ROW]
                 for k in range(ring_n[s1]):
                     j = ring_idx[s1, k] - t_lo
                     if j < 0 or j >= t_n:

@@ -17,7 +17,15 @@ from cerebx.snn.topology import (
     I_RATIO,
     KIND_INPUT,
     KIND_LIF_AMPA,
+    N_SPAR,
     P_EL,
+    S_DELAY,
+    S_N_PRE,
+    S_POST_POP,
+    S_PRE_LO,
+    S_RECEPTOR,
+    S_ROW,
+    S_TEACHING,
     Topology,
     build_topology,
     fill_dense,
@@ -88,7 +96,8 @@ def _sparse_learning(topo: Topology) -> learning.SparseLearning:
             sr_f[r, L.R_FIXED] = spec.fixed_nS
         t_lo, t_hi = rule.teachers
         teach_syn = max(teach_syn, sum(len(topo.sparse[k].post) for k in range(t_lo, t_hi)))
-        sr_i[r] = (fam, rule.piece, t_lo, t_hi, post_lo, n_post, csc, k_off, klen, rows, rows + s.n_pre)
+        pdelay = 2 * s.delay if isinstance(spec, TraceSpec) and spec.dendritic else 0
+        sr_i[r] = (fam, rule.piece, t_lo, t_hi, post_lo, n_post, csc, k_off, klen, rows, rows + s.n_pre, pdelay)
         sr_f[r, L.R_WLO], sr_f[r, L.R_WHI] = rule.w_lo, rule.w_hi
         ptrs.append(rule.csc_ptr + n_q)
         qs.append(rule.csc_q + base[rule.piece])
@@ -181,12 +190,14 @@ class Network:
         self.el = np.repeat(topo.par[:, P_EL], sizes).astype(np.float32)
         sp = topo.sparse
         ptr_parts, off = [], 0
-        sp_i = np.zeros((len(sp), 7), dtype=np.int64)
+        sp_i = np.zeros((len(sp), N_SPAR), dtype=np.int64)
         syn_base = 0
         pop_of = {int(lo): k for k, lo in enumerate(self.pop_lo)}
         for k, s in enumerate(sp):
             post_pop = int(np.searchsorted(self.pop_hi, s.post[0], side="right")) if len(s.post) else 0
-            sp_i[k] = (s.pre_lo, s.n_pre, off, s.receptor, s.delay, int(s.teaching), post_pop)
+            row = sp_i[k]
+            row[S_PRE_LO], row[S_N_PRE], row[S_ROW], row[S_RECEPTOR] = s.pre_lo, s.n_pre, off, s.receptor
+            row[S_DELAY], row[S_TEACHING], row[S_POST_POP] = s.delay, int(s.teaching), post_pop
             ptr_parts.append(s.ptr + syn_base)
             off += len(s.ptr)
             syn_base += len(s.post)

@@ -1,5 +1,5 @@
-"""Learning rules of sparse (CSR) projections (docs/models.md#plasticity) and the two rule families the engine
-runs on them.
+"""Learning rules of sparse (CSR) projections (docs/models.md#plasticity): the two rule families the engine
+runs on them and the builders of the built-in rule kinds (their schemas are in :mod:`cerebx.snn.schema`).
 
 A plasticity kind is registered (``registry.plasticity_rules``) with a builder ``builder(rule, dt_ms) -> spec``
 that turns its parameters into one of the engine's families, so a plugin's rule runs in the compiled kernels
@@ -18,12 +18,11 @@ The PF–PC rule (:class:`~cerebx.snn.schema.KernelSTDP`) keeps its own dense pa
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
-from pydantic import Field
 
-from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
+# the rules' schemas live with the network's; their names here are those older checkpoints pickled them by
+from cerebx.snn.schema import PairSTDP, SymmetricCos, SymmetricCosSTDP  # noqa: F401
 
 HISTORY_MAX = 64
 """Spikes kept per neuron for a pairing rule: enough for a window of 64 spikes (e.g. 100 ms at 640 Hz); older
@@ -46,6 +45,9 @@ class TraceSpec:
         Weight-dependence exponents of potentiation and depression (0: additive, 1: multiplicative).
     tau_plus_ms, tau_minus_ms : float
         Time constants of the presynaptic and postsynaptic traces (ms).
+    dendritic : bool
+        The synapse's delay d is dendritic (NEST's convention): a post spike reaches the synapse d after it
+        happened, so it pairs with the pre arrivals as a post spike 2 d later would under the axonal convention.
     """
 
     lam: float
@@ -54,6 +56,7 @@ class TraceSpec:
     mu_minus: float
     tau_plus_ms: float
     tau_minus_ms: float
+    dendritic: bool = False
 
 
 @dataclass(frozen=True)
@@ -81,44 +84,6 @@ class PairingSpec:
     teacher: str | None
 
 
-class PairSTDP(Strict):
-    """Pair-based STDP, NEST ``stdp_synapse`` (Gütig et al. 2003 form; docs/models.md#pair-stdp): all-to-all
-    pairing through a presynaptic trace (tau_plus) and a postsynaptic one (tau_minus, in NEST a parameter of the
-    post neuron). Weights bounded by the projection's ``weight_range_nS`` (W = its upper end)."""
-
-    kind: Literal["pair_stdp"] = "pair_stdp"
-    lam: PositiveFloat = Field(0.01, description="NEST lambda: step size of potentiation")
-    alpha: NonNegFloat = Field(1.0, description="depression / potentiation ratio")
-    mu_plus: NonNegFloat = Field(1.0, description="weight dependence exponent of potentiation (0: additive)")
-    mu_minus: NonNegFloat = Field(1.0, description="weight dependence exponent of depression (0: additive)")
-    tau_plus_ms: PositiveFloat = Field(20.0, description="presynaptic trace time constant")
-    tau_minus_ms: PositiveFloat = Field(20.0, description="postsynaptic trace time constant (NEST: the neuron's)")
-
-
-class SymmetricCos(Strict):
-    """MF–DCN rule of the distributed-plasticity models (docs/models.md#symmetric-cos): a fixed change per pre
-    spike, and a change scaled by a symmetric cosine kernel of the time to each teaching spike (PC spikes
-    arriving at the DCN): EDLUT SimetricCosAdditiveKernel, NEST stdp_cos_synapse."""
-
-    kind: Literal["symmetric_cos"] = "symmetric_cos"
-    fixed_nS: float = Field(0.001, description="change at each pre spike (EDLUT fixed_change; > 0: LTP)")
-    kernel_nS: float = Field(-0.010, description="scale of the kernel term (EDLUT kernel_change; < 0: LTD)")
-    tau_ms: PositiveFloat = Field(100.0, description="kernel half-width: k = 0 at |Δ| >= tau")
-    n: NonNegFloat = Field(2.0, description="exponential sharpening of the kernel")
-    teacher: str = Field(description="projection whose arrivals at the post neuron pair with the pre spikes")
-
-
-class SymmetricCosSTDP(Strict):
-    """PC–DCN rule of the distributed-plasticity models (docs/models.md#symmetric-cos): as ``symmetric_cos``
-    with the post neuron's own spikes as the partner (EDLUT SimetricCosSTDPAdditiveKernel)."""
-
-    kind: Literal["symmetric_cos_stdp"] = "symmetric_cos_stdp"
-    fixed_nS: float = Field(0.001, description="change at each pre spike (EDLUT fixed_change)")
-    kernel_nS: float = Field(-0.010, description="scale of the kernel term (EDLUT kernel_change)")
-    tau_ms: PositiveFloat = Field(100.0, description="kernel half-width: k = 0 at |Δ| >= tau")
-    n: NonNegFloat = Field(2.0, description="exponential sharpening of the kernel")
-
-
 def cos_kernel(tau_ms: float, n: float, dt_ms: float) -> np.ndarray:
     """k(Δ) = exp(−n|Δ|/τ) cos²(π|Δ|/(2τ)) for |Δ| < τ (0 beyond), sampled at Δ = m dt."""
     d = np.arange(int(np.ceil(tau_ms / dt_ms))) * dt_ms
@@ -126,7 +91,8 @@ def cos_kernel(tau_ms: float, n: float, dt_ms: float) -> np.ndarray:
 
 
 def pair_stdp(rule: PairSTDP, dt_ms: float) -> TraceSpec:
-    return TraceSpec(rule.lam, rule.alpha, rule.mu_plus, rule.mu_minus, rule.tau_plus_ms, rule.tau_minus_ms)
+    return TraceSpec(rule.lam, rule.alpha, rule.mu_plus, rule.mu_minus, rule.tau_plus_ms, rule.tau_minus_ms,
+                     rule.delay == "dendritic")
 
 
 def symmetric_cos(rule: SymmetricCos | SymmetricCosSTDP, dt_ms: float) -> PairingSpec:

@@ -1,4 +1,6 @@
-"""Spiking network topology as data: populations, projections, neuron models, plasticity.
+"""Spiking network topology as data: populations, projections, neuron models, connectors, weight and delay
+distributions, plasticity rules, and the encoders' schemas (the code of each: snn/topology.py, connectors.py,
+plasticity.py, encoders.py).
 
 A network preset is a table of populations and projections (``conf/network``). Validation checks
 that each projection's declared synapse count is what its connection rule produces from the
@@ -9,14 +11,15 @@ from __future__ import annotations
 
 import hashlib
 import json
-from typing import Annotated, ClassVar, Literal
+from pathlib import Path
+from typing import Annotated, Any, ClassVar, Literal
 
+import numpy as np
 from pydantic import Field, model_validator
 
 from cerebx.registry import Plugin
 from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
 from cerebx.schema.controller import GivenRanges, TaskRanges
-from cerebx.snn.connectors import Distribution, FromFile
 
 
 class Integration(Strict):
@@ -170,8 +173,218 @@ class JointCombinations(Strict):
     fibers_per_signal: int = Field(gt=0)
 
 
+SIGMAS = 5.0
+"""A declared synapse count of a random rule must lie within this many binomial standard deviations of the
+expectation (at 5 sigma a correct declaration is refused about once in 1.7 million draws)."""
+
+
+# ---- weight and delay distributions ----
+class _Dist(Strict):
+    low_clip: float | None = Field(None, description="values below are set to this")
+    high_clip: float | None = Field(None, description="values above are set to this")
+
+    def draw(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        x = self._draw(rng, n)
+        lo = -np.inf if self.low_clip is None else self.low_clip
+        hi = np.inf if self.high_clip is None else self.high_clip
+        return np.clip(x, lo, hi)
+
+    @property
+    def upper(self) -> float:
+        """The largest value a draw can take (inf when unbounded)."""
+        return np.inf if self.high_clip is None else self.high_clip
+
+
+class Normal(_Dist):
+    """Normal distribution (then clipped)."""
+
+    dist: Literal["normal"] = "normal"
+    mean: float
+    std: NonNegFloat
+
+    def _draw(self, rng, n):
+        return rng.normal(self.mean, self.std, n)
+
+
+class Uniform(_Dist):
+    """Uniform on [low, high) (then clipped)."""
+
+    dist: Literal["uniform"] = "uniform"
+    low: float
+    high: float
+
+    @model_validator(mode="after")
+    def _ordered(self) -> Uniform:
+        if self.low > self.high:
+            raise ValueError(f"low ({self.low}) is greater than high ({self.high})")
+        return self
+
+    def _draw(self, rng, n):
+        return rng.uniform(self.low, self.high, n)
+
+    @property
+    def upper(self) -> float:
+        return min(self.high, super().upper)
+
+
+class LogNormal(_Dist):
+    """exp(N(mu, sigma)) (then clipped)."""
+
+    dist: Literal["lognormal"] = "lognormal"
+    mu: float
+    sigma: NonNegFloat
+
+    def _draw(self, rng, n):
+        return rng.lognormal(self.mu, self.sigma, n)
+
+
+Distribution = Annotated[Normal | Uniform | LogNormal, Field(discriminator="dist")]
+
+
+# ---- random and listed connectors (their builders: snn/connectors.py) ----
+class FixedIndegree(Strict):
+    """Each post neuron receives ``indegree`` synapses from pre neurons drawn at random (NEST fixed_indegree,
+    PyNN FixedNumberPreConnector): indegree * n_post synapses."""
+
+    kind: Literal["fixed_indegree"] = "fixed_indegree"
+    indegree: int = Field(gt=0, description="synapses per post neuron")
+    allow_autapses: bool = Field(True, description="a neuron may connect to itself (pre and post one population)")
+    allow_multapses: bool = Field(False, description="a pair may be drawn twice (two synapses)")
+
+    def synapse_count(self, n_pre: int, n_post: int, same: bool) -> tuple[float, float]:
+        _room(self.indegree, n_pre, same and not self.allow_autapses, self.allow_multapses, "indegree", "pre")
+        return float(self.indegree * n_post), 0.0
+
+
+class FixedOutdegree(Strict):
+    """Each pre neuron makes ``outdegree`` synapses onto post neurons drawn at random (NEST fixed_outdegree,
+    PyNN FixedNumberPostConnector): outdegree * n_pre synapses."""
+
+    kind: Literal["fixed_outdegree"] = "fixed_outdegree"
+    outdegree: int = Field(gt=0, description="synapses per pre neuron")
+    allow_autapses: bool = Field(True, description="a neuron may connect to itself (pre and post one population)")
+    allow_multapses: bool = Field(False, description="a pair may be drawn twice (two synapses)")
+
+    def synapse_count(self, n_pre: int, n_post: int, same: bool) -> tuple[float, float]:
+        _room(self.outdegree, n_post, same and not self.allow_autapses, self.allow_multapses, "outdegree", "post")
+        return float(self.outdegree * n_pre), 0.0
+
+
+class FixedProbability(Strict):
+    """Every (pre, post) pair is connected with probability ``p``, independently (NEST pairwise_bernoulli, PyNN
+    FixedProbabilityConnector). The count is random: the declared ``synapses`` must be within 5 binomial
+    standard deviations of the expectation; the built count is recorded in the run's summary."""
+
+    kind: Literal["fixed_probability"] = "fixed_probability"
+    p: float = Field(gt=0, le=1, description="connection probability per pair")
+    allow_autapses: bool = Field(True, description="a neuron may connect to itself (pre and post one population)")
+
+    def synapse_count(self, n_pre: int, n_post: int, same: bool) -> tuple[float, float]:
+        pairs = n_pre * n_post - (min(n_pre, n_post) if same and not self.allow_autapses else 0)
+        return pairs * self.p, SIGMAS * float(np.sqrt(pairs * self.p * (1 - self.p)))
+
+
+class FromFile(Strict):
+    """Synapses listed in an ``.npz`` file: int arrays ``pre`` and ``post`` (local indices), optionally
+    ``weight_nS`` and ``delay_ms`` per synapse (they replace the projection's weight and delay). A relative path
+    is taken from the working directory. Checked at validation: the file exists and every index is in range."""
+
+    kind: Literal["from_file"] = "from_file"
+    path: str = Field(description=".npz file with arrays pre, post [, weight_nS, delay_ms]")
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        path = Path(self.path).expanduser()
+        if not path.is_file():
+            raise ValueError(f"path: {self.path} does not exist (relative paths start at {Path.cwd()})")
+        with np.load(path, allow_pickle=False) as f:
+            data = {k: f[k] for k in f.files}
+        missing = [k for k in ("pre", "post") if k not in data]
+        if missing:
+            raise ValueError(f"path: {self.path} has no array {', '.join(missing)}")
+        extra = sorted(set(data) - {"pre", "post", "weight_nS", "delay_ms"})
+        if extra:
+            raise ValueError(f"path: {self.path}: unknown arrays {', '.join(extra)}")
+        n = len(data["pre"])
+        for k, a in data.items():
+            if a.ndim != 1 or len(a) != n:
+                raise ValueError(f"path: {self.path}: {k} must be one-dimensional with {n} entries like pre")
+        for k in ("pre", "post"):
+            if not np.issubdtype(data[k].dtype, np.integer):
+                raise ValueError(f"path: {self.path}: {k} must hold integers, not {data[k].dtype}")
+        if "weight_nS" in data and (~np.isfinite(data["weight_nS"]) | (data["weight_nS"] < 0)).any():
+            raise ValueError(f"path: {self.path}: weight_nS must be finite and >= 0")
+        if "delay_ms" in data and (~np.isfinite(data["delay_ms"]) | (data["delay_ms"] <= 0)).any():
+            raise ValueError(f"path: {self.path}: delay_ms must be finite and > 0")
+        return data
+
+    def synapse_count(self, n_pre: int, n_post: int, same: bool) -> tuple[float, float]:
+        data = self.arrays()
+        for k, n in (("pre", n_pre), ("post", n_post)):
+            a = data[k]
+            if len(a) and (a.min() < 0 or a.max() >= n):
+                raise ValueError(f"path: {self.path}: {k} indices must be in [0, {n}), found "
+                                 f"[{a.min()}, {a.max()}]")
+        return float(len(data["pre"])), 0.0
+
+
+def _room(k: int, n: int, no_self: bool, multapses: bool, what: str, side: str) -> None:
+    room = n - (1 if no_self else 0)
+    if not multapses and k > room:
+        raise ValueError(f"{what} {k} is more than the {room} distinct {side} neurons (allow_multapses: true, or "
+                         f"a smaller {what})")
+    if room < 1:
+        raise ValueError(f"{what}: no {side} neuron to draw from")
+
+
 Rule = Plugin("connector")
-"""Any registered connector kind (``registry.connectors``): the three above and those of snn/connectors.py."""
+"""Any registered connector kind (``registry.connectors``): those above (their builders: snn/topology.py for the
+first three, snn/connectors.py) and a plugin's."""
+
+
+# ---- learning rules of sparse projections (their engine form: snn/plasticity.py) ----
+class PairSTDP(Strict):
+    """Pair-based STDP, NEST ``stdp_synapse`` (Gütig et al. 2003 form; docs/models.md#pair-stdp): all-to-all
+    pairing through a presynaptic trace (tau_plus) and a postsynaptic one (tau_minus, in NEST a parameter of the
+    post neuron). Weights bounded by the projection's ``weight_range_nS`` (W = its upper end)."""
+
+    kind: Literal["pair_stdp"] = "pair_stdp"
+    added_without_effect: ClassVar[dict[str, Any]] = {"delay": "axonal"}
+    """Fields added after runs were recorded, with the value that computes what those runs did
+    (``schema/legacy.py``)."""
+    lam: PositiveFloat = Field(0.01, description="NEST lambda: step size of potentiation")
+    alpha: NonNegFloat = Field(1.0, description="depression / potentiation ratio")
+    mu_plus: NonNegFloat = Field(1.0, description="weight dependence exponent of potentiation (0: additive)")
+    mu_minus: NonNegFloat = Field(1.0, description="weight dependence exponent of depression (0: additive)")
+    tau_plus_ms: PositiveFloat = Field(20.0, description="presynaptic trace time constant")
+    tau_minus_ms: PositiveFloat = Field(20.0, description="postsynaptic trace time constant (NEST: the neuron's)")
+    delay: Literal["axonal", "dendritic"] = Field(
+        "axonal", description="where the projection's delay d sits for the pairing: axonal (a pre spike pairs "
+        "on arrival with the post neuron's spikes as they happen: Δt = t_post − t_pre − d) or dendritic (NEST "
+        "stdp_synapse: the post spike reaches the synapse d later: Δt = t_post − t_pre + d)")
+
+
+class SymmetricCos(Strict):
+    """MF–DCN rule of the distributed-plasticity models (docs/models.md#symmetric-cos): a fixed change per pre
+    spike, and a change scaled by a symmetric cosine kernel of the time to each teaching spike (PC spikes
+    arriving at the DCN): EDLUT SimetricCosAdditiveKernel, NEST stdp_cos_synapse."""
+
+    kind: Literal["symmetric_cos"] = "symmetric_cos"
+    fixed_nS: float = Field(0.001, description="change at each pre spike (EDLUT fixed_change; > 0: LTP)")
+    kernel_nS: float = Field(-0.010, description="scale of the kernel term (EDLUT kernel_change; < 0: LTD)")
+    tau_ms: PositiveFloat = Field(100.0, description="kernel half-width: k = 0 at |Δ| >= tau")
+    n: NonNegFloat = Field(2.0, description="exponential sharpening of the kernel")
+    teacher: str = Field(description="projection whose arrivals at the post neuron pair with the pre spikes")
+
+
+class SymmetricCosSTDP(Strict):
+    """PC–DCN rule of the distributed-plasticity models (docs/models.md#symmetric-cos): as ``symmetric_cos``
+    with the post neuron's own spikes as the partner (EDLUT SimetricCosSTDPAdditiveKernel)."""
+
+    kind: Literal["symmetric_cos_stdp"] = "symmetric_cos_stdp"
+    fixed_nS: float = Field(0.001, description="change at each pre spike (EDLUT fixed_change)")
+    kernel_nS: float = Field(-0.010, description="scale of the kernel term (EDLUT kernel_change)")
+    tau_ms: PositiveFloat = Field(100.0, description="kernel half-width: k = 0 at |Δ| >= tau")
+    n: NonNegFloat = Field(2.0, description="exponential sharpening of the kernel")
 
 
 class KernelSTDP(Strict):

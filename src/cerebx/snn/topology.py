@@ -53,6 +53,11 @@ METHODS = {"euler": 0, "rk2": 1, "rk4": 2}
 # Columns of the per-population integer table.
 I_LO, I_HI, I_KIND, I_RATIO, I_COMPACT, I_NFINE = range(6)
 N_IPAR = 6
+# Columns of the sparse projections' integer table (``Delivery.sp_i``, one row per projection): the first
+# presynaptic neuron and their count, the projection's first row in sp_ptr, receptor, delay (substeps),
+# teaching (1: a pairing rule's partner, delivered by the rule, not as current), the post population.
+S_PRE_LO, S_N_PRE, S_ROW, S_RECEPTOR, S_DELAY, S_TEACHING, S_POST_POP = range(7)
+N_SPAR = 7
 N_COEF = 7  # polynomial coefficients (degree <= 6 in g) of a one-step update of an AMPA-only LIF
 ORDER = {"euler": 1, "rk2": 2, "rk4": 4}  # degree in g0 of one step of each method
 
@@ -488,7 +493,8 @@ def build_topology(cfg: NetworkConfig, fill: bool = True, seed: int = 0) -> Topo
             ptr, q, j = _csc(sparse[k], int(lo[b]), int(sizes[b]))
             sparse_rules.append(SparseRule(name, k, span, spec, w_lo, w_hi, ptr, q, j))
 
-    max_delay = max([s.delay for s in sparse] + [d.delay for d in dense] + [1])
+    dendritic = [2 * sparse[r.piece].delay for r in sparse_rules if getattr(r.spec, "dendritic", False)]
+    max_delay = max([s.delay for s in sparse] + [d.delay for d in dense] + dendritic + [1])  # the ring's reach
     topo = Topology(cfg, n_sub, dt, names, lo, hi, kind, par, ipar, poly, sparse, dense, dense_w, plastic,
                     max_delay, index, sparse_rules, built, dense_init)
     if fill:

@@ -26,13 +26,14 @@ The MN rates are the muscle excitations: the plant's MuJoCo muscles integrate th
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numba
 import numpy as np
 
 from cerebx.builders import BuildContext
 from cerebx.errors import ConfigError
+from cerebx.kernel_struct import KernelStruct
 from cerebx.schema.base import CONTROL_DT_MS
 from cerebx.schema.spinal import DirectMusclesConfig, SpinalCordConfig, SplitPairsConfig, _MuscleMap
 from cerebx.signals import Frame
@@ -83,19 +84,61 @@ def _sigmoid(x: float, k: float, x0: float) -> float:
     return 1.0 / (1.0 + math.exp(-k * (x - x0)))
 
 
-@numba.njit(cache=True)
-def ia_rate(length, velocity, prm):  # pragma: no cover - numba
-    """Eq. 4.3 before normalisation; prm = (a, p, b, c, V): velocity clipped to +-V, odd power for shortening."""
-    v = min(max(velocity, -prm[4]), prm[4])
-    sv = prm[0] * abs(v) ** prm[1]
-    return (sv if v >= 0 else -sv) + prm[2] * length + prm[3]
+class IaLaw(NamedTuple):
+    """Eq. 4.3's constants: r = velocity_gain sign(v) |v|^exponent + length_gain l + offset, |v| <= v_max."""
+
+    velocity_gain: float
+    exponent: float
+    length_gain: float
+    offset: float
+    v_max: float  # mm/s
+
+
+class RateNeurons(NamedTuple):
+    """The leaky rate neurons' constants (Eq. 4.1-4.2): the decay exp(-dt / tau_m) of a 2 ms step, the input
+    weights and the sigmoid's slope and centre."""
+
+    decay: float
+    w_exc: float
+    w_inh: float
+    slope: float
+    centre: float
+
+
+class Cord(NamedTuple):
+    """Everything :func:`cord_tick` reads and writes besides the step's signals (the stage's arrays)."""
+
+    cmd_map: np.ndarray  # (n_muscles, 2 n_joints): [ag, at] -> command
+    ant: np.ndarray  # (n_muscles, n_muscles): antagonists' weights
+    fifo: np.ndarray  # (delay, 2, n_muscles): delayed length and velocity
+    delay: int  # afferent delay in ticks
+    r_lo: np.ndarray  # Ia rate normalisation per muscle
+    r_hi: np.ndarray
+    ia_law: IaLaw
+    neurons: RateNeurons
+    ia: np.ndarray  # outputs: Ia rates, Ia IN and MN rates
+    ia_in: np.ndarray
+    mn: np.ndarray
+
+
+class CordState(KernelStruct, fields=Cord):
+    """:class:`Cord` as the one numba object :func:`cord_tick` takes."""
 
 
 @numba.njit(cache=True)
-def cord_tick(ag, at, length, velocity, cmd_map, ant, fifo, head, delay, r_lo, r_hi, ia_prm, neuron_prm,
-              ia, ia_in, mn):  # pragma: no cover - numba
-    """One 2 ms step in place: the Ia afferents of the sample pushed ``delay`` ticks ago (this one stored),
-    then the Ia INs, then the MNs. neuron_prm = (decay, w_exc, w_inh, k, x0). Returns the FIFO's new head."""
+def ia_rate(length, velocity, law):  # pragma: no cover - numba
+    """Eq. 4.3 before normalisation (``law``: an :class:`IaLaw`): velocity clipped to +-v_max, odd power for
+    shortening."""
+    v = min(max(velocity, -law.v_max), law.v_max)
+    sv = law.velocity_gain * abs(v) ** law.exponent
+    return (sv if v >= 0 else -sv) + law.length_gain * length + law.offset
+
+
+@numba.njit(cache=True)
+def cord_tick(ag, at, length, velocity, cord, head):  # pragma: no cover - numba
+    """One 2 ms step in place (``cord``: a :class:`CordState`): the Ia afferents of the sample pushed
+    ``cord.delay`` ticks ago (this one stored), then the Ia INs, then the MNs. Returns the FIFO's new head."""
+    fifo, delay, ia, ia_in, mn = cord.fifo, cord.delay, cord.ia, cord.ia_in, cord.mn
     n = mn.shape[0]
     nj = ag.shape[0]
     if head < 0:  # first sample: the history before t = 0 is the arm at rest as it is now
@@ -110,11 +153,13 @@ def cord_tick(ag, at, length, velocity, cmd_map, ant, fifo, head, delay, r_lo, r
             fifo[head, 0, i], fifo[head, 1, i] = length[i], velocity[i]
         else:
             l_del, v_del = length[i], velocity[i]
-        r = (ia_rate(l_del, v_del, ia_prm) - r_lo[i]) / (r_hi[i] - r_lo[i])
+        r = (ia_rate(l_del, v_del, cord.ia_law) - cord.r_lo[i]) / (cord.r_hi[i] - cord.r_lo[i])
         ia[i] = min(max(r, 0.0), 1.0)
     if delay > 0:
         head = (head + 1) % delay
-    decay, w_exc, w_inh, k, x0 = neuron_prm[0], neuron_prm[1], neuron_prm[2], neuron_prm[3], neuron_prm[4]
+    nrn = cord.neurons
+    decay, w_exc, w_inh, k, x0 = nrn.decay, nrn.w_exc, nrn.w_inh, nrn.slope, nrn.centre
+    cmd_map, ant = cord.cmd_map, cord.ant
     for i in range(n):
         s = _sigmoid(w_exc * ia[i], k, x0)
         ia_in[i] = s + (ia_in[i] - s) * decay
@@ -146,18 +191,36 @@ class SpinalCord(Stage):
             raise ConfigError("spinal_cord: the plant's muscle.length signal must declare each muscle's length range")
         v = cfg.velocity_range_mm_per_s
         self.ia_prm = np.array([cfg.ia_velocity_gain, cfg.ia_velocity_exponent, cfg.ia_length_gain, cfg.ia_offset, v])
-        self.r_lo = np.array([ia_rate(x, -v, self.ia_prm) for x in l_lo]) if cfg.normalise == "range" else np.zeros(n)
-        self.r_hi = np.array([ia_rate(x, v, self.ia_prm) for x in l_hi])
+        law = IaLaw(*map(float, self.ia_prm))
+        self.r_lo = np.array([ia_rate(x, -v, law) for x in l_lo]) if cfg.normalise == "range" else np.zeros(n)
+        self.r_hi = np.array([ia_rate(x, v, law) for x in l_hi])
         self.delay_steps = int(round(cfg.afferent_delay_ms / 1000.0 / CONTROL_DT_S))
         decay = math.exp(-CONTROL_DT_S / (cfg.tau_m_ms / 1000.0))
         self.neuron_prm = np.array([decay, cfg.w_exc, cfg.w_inh, cfg.sigmoid_slope, cfg.sigmoid_centre])
         self.mn, self.ia_in, self.ia = np.zeros(n), np.zeros(n), np.zeros(n)
         self._fifo = np.zeros((max(self.delay_steps, 1), 2, n))
         self._head = -1  # -1: empty (the first sample fills it)
+        self._cord = self._kernel_state()
+
+    def _kernel_state(self) -> CordState:
+        """The kernel's handle on this stage's arrays (``ia_prm`` and ``neuron_prm`` by name)."""
+        return CordState.of(Cord(self.cmd, self.ant, self._fifo, self.delay_steps, self.r_lo, self.r_hi,
+                                 IaLaw(*map(float, self.ia_prm)), RateNeurons(*map(float, self.neuron_prm)),
+                                 self.ia, self.ia_in, self.mn))
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = dict(self.__dict__)
+        state.pop("_cord", None)  # made again from the arrays restored
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._cord = self._kernel_state()
 
     def afferent(self, length_mm: np.ndarray, velocity_mm_per_s: np.ndarray) -> np.ndarray:
         """Normalised Ia rate in [0, 1] for a length and velocity (no delay)."""
-        r = np.array([ia_rate(x, v, self.ia_prm) for x, v in zip(length_mm, velocity_mm_per_s)])
+        law = IaLaw(*map(float, self.ia_prm))
+        r = np.array([ia_rate(x, v, law) for x, v in zip(length_mm, velocity_mm_per_s)])
         return np.clip((r - self.r_lo) / (self.r_hi - self.r_lo), 0.0, 1.0)
 
     def reset(self, rng: np.random.Generator) -> None:
@@ -168,9 +231,8 @@ class SpinalCord(Stage):
 
     def step(self, frame: Frame) -> None:
         s = frame.signals
-        self._head = cord_tick(s["muscle.ag"], s["muscle.at"], s["muscle.length"], s["muscle.velocity"], self.cmd,
-                               self.ant, self._fifo, self._head, self.delay_steps, self.r_lo, self.r_hi, self.ia_prm,
-                               self.neuron_prm, self.ia, self.ia_in, self.mn)
+        self._head = cord_tick(s["muscle.ag"], s["muscle.at"], s["muscle.length"], s["muscle.velocity"], self._cord,
+                               self._head)
         self.emit(frame, "muscle.activation", self.mn.copy())
 
     def record(self) -> dict[str, Any]:

@@ -29,10 +29,11 @@ HISTORY = 256  # remembered spikes per input cell (enough for 100 Hz over a 2.5 
 DESIRED_TICKS = 4096  # desired states remembered for pairing with delayed measurements (8 s)
 
 
-def lif_params(cell: ConductanceLIF, dt_ms: float) -> np.ndarray:
-    return np.array([cell.capacitance_pF, cell.rest_conductance_nS, cell.rest_mV, cell.threshold_mV,
-                     round(cell.refractory_ms / dt_ms), math.exp(-dt_ms / cell.tau_exc_ms),
-                     math.exp(-dt_ms / cell.tau_inh_ms), cell.e_exc_mV, cell.e_inh_mV])
+def lif_params(cell: ConductanceLIF, dt_ms: float) -> k.LIFConstants:
+    return k.LIFConstants(float(cell.capacitance_pF), float(cell.rest_conductance_nS), float(cell.rest_mV),
+                          float(cell.threshold_mV), round(cell.refractory_ms / dt_ms),
+                          math.exp(-dt_ms / cell.tau_exc_ms), math.exp(-dt_ms / cell.tau_inh_ms), float(cell.e_exc_mV),
+                          float(cell.e_inh_mV))
 
 
 class Luque2011Stage(Stage):
@@ -51,10 +52,12 @@ class Luque2011Stage(Stage):
         self.kern = k.kernel_table(self.kernel_peak_ms, dt_ms)
         self.p_pc, self.p_dcn = lif_params(cfg.pc, dt_ms), lif_params(cfg.dcn, dt_ms)
         pl, t = cfg.plasticity, cfg.teaching
-        self.pars = np.array([round(STEP_MS / dt_ms), dt_ms, math.exp(-dt_ms / cfg.inputs.tau_ms),
-                              cfg.inputs.drive_at_centre, n_per, pl.weight_max_nS, pl.ltp_nS, pl.ltd_nS,
-                              float(pl.enabled), cfg.pf_dcn_nS, cfg.pc_dcn_nS, t.eps_full_scale,
-                              t.rate_max_hz * STEP_MS / 1000.0])
+        self.pars = k.Constants(
+            n_sub=round(STEP_MS / dt_ms), dt_ms=float(dt_ms), input_decay=math.exp(-dt_ms / cfg.inputs.tau_ms),
+            drive_at_centre=float(cfg.inputs.drive_at_centre), n_per=n_per, w_max_nS=float(pl.weight_max_nS),
+            ltp_nS=float(pl.ltp_nS), ltd_nS=float(pl.ltd_nS), learn=bool(pl.enabled), w_dcn_nS=float(cfg.pf_dcn_nS),
+            w_inh_nS=float(cfg.pc_dcn_nS), eps_full_scale=float(t.eps_full_scale),
+            io_p_max=t.rate_max_hz * STEP_MS / 1000.0)
         self.kp, self.kv = np.asarray(t.kp, float), np.asarray(t.kv, float)
         self.buffer = max(1, int(round(cfg.output.buffer_ms / STEP_MS)))
         self.gain = np.asarray(cfg.output.gain_Nm_per_hz, float)

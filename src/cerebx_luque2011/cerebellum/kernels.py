@@ -16,8 +16,9 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, types
-from numba.experimental import structref
+from numba import njit
+
+from cerebx.api import KernelStruct
 
 PEAK_X = math.atan(20.0)  # e^-x sin(x)^20 peaks where tan x = 20
 
@@ -32,6 +33,20 @@ class InputCells(NamedTuple):
     head: np.ndarray  # int64 [n_in]: next ring position per cell
 
 
+class LIFConstants(NamedTuple):
+    """A conductance-LIF population's constants for a sub-step of ``dt`` ms."""
+
+    capacitance_pF: float
+    rest_conductance_nS: float
+    rest_mV: float
+    threshold_mV: float
+    refractory_steps: int
+    decay_exc: float  # exp(-dt / tau_exc)
+    decay_inh: float  # exp(-dt / tau_inh)
+    e_exc_mV: float
+    e_inh_mV: float
+
+
 class LIFCells(NamedTuple):
     """State and parameters of a conductance-LIF population (PC or DCN)."""
 
@@ -39,14 +54,32 @@ class LIFCells(NamedTuple):
     ge: np.ndarray  # excitatory conductance (nS)
     gi: np.ndarray  # inhibitory conductance (nS)
     refr: np.ndarray  # int64: refractory sub-steps left
-    par: np.ndarray  # (C pF, g_rest nS, E_rest, threshold, refractory steps, decay_exc, decay_inh, E_exc, E_inh)
+    par: LIFConstants
+
+
+class Constants(NamedTuple):
+    """The network's constants."""
+
+    n_sub: int  # sub-steps of a 2 ms tick
+    dt_ms: float  # sub-step
+    input_decay: float  # exp(-dt / tau) of the input cells' integrator
+    drive_at_centre: float  # input drive of a signal at an RBF's centre
+    n_per: int  # input cells per signal
+    w_max_nS: float  # PF-PC weight bound
+    ltp_nS: float  # PF-PC increase per PF spike
+    ltd_nS: float  # PF-PC decrease per IO spike and unit of kernel
+    learn: bool  # plasticity on
+    w_dcn_nS: float  # input cell -> DCN weight
+    w_inh_nS: float  # PC -> DCN weight
+    eps_full_scale: float  # error at which the IO fires at its highest rate
+    io_p_max: float  # IO spike probability per tick at that rate
 
 
 class Circuit(NamedTuple):
     """Everything :func:`tick` reads and writes besides the step's own inputs and output (it gets
     them as one :class:`CircuitState`)."""
 
-    pars: np.ndarray  # network constants, see :func:`tick`
+    pars: Constants
     clock: np.ndarray  # int64: sub-step index, tick index, IO spike count
     inputs: InputCells
     pc: LIFCells
@@ -58,33 +91,30 @@ class Circuit(NamedTuple):
     gain: np.ndarray  # [n_joints]: torque per DCN rate difference (N m / Hz)
 
 
-@structref.register
-class _CircuitStateType(types.StructRef):
-    """numba type of :class:`CircuitState`."""
-
-
-class CircuitState(structref.StructRefProxy):
+class CircuitState(KernelStruct, fields=Circuit):
     """A :class:`Circuit` as one numba object, the form :func:`tick` takes (make it with
-    :func:`circuit_state`): numba passes it as one pointer, where separate arrays or named tuples of
-    them are checked and unboxed one by one on every tick. Pickles as its circuit."""
-
-    def __reduce__(self):
-        return circuit_state, (self.circuit,)
+    :func:`circuit_state`). Pickles as its circuit."""
 
 
-structref.define_proxy(CircuitState, _CircuitStateType, Circuit._fields)
+def _named(circuit: Circuit) -> Circuit:
+    """``circuit`` with its constants named: a checkpoint made before they were carries them as arrays (the
+    fields' order)."""
+    if not isinstance(circuit.pars, np.ndarray):
+        return circuit
 
+    def lif(cells: LIFCells) -> LIFCells:
+        p = [float(x) for x in cells.par]
+        p[4] = int(p[4])
+        return cells._replace(par=LIFConstants(*p))
 
-@njit(cache=True)
-def _pack(circuit):
-    return CircuitState(*circuit)
+    p = [float(x) for x in circuit.pars]
+    p[0], p[4], p[8] = int(p[0]), int(p[4]), p[8] > 0.0
+    return circuit._replace(pars=Constants(*p), pc=lif(circuit.pc), dcn=lif(circuit.dcn))
 
 
 def circuit_state(circuit: Circuit) -> CircuitState:
     """The kernel's handle on ``circuit`` (the same array objects)."""
-    state = _pack(circuit)
-    state.circuit = circuit
-    return state
+    return CircuitState.of(_named(circuit))
 
 
 def ltd_kernel(age_ms: np.ndarray, peak_ms: float) -> np.ndarray:
@@ -121,7 +151,8 @@ def _lif(cells, dt):
     n = v.shape[0]
     spiked = np.empty(n, np.int64)
     ns = 0
-    c, gl, el, th, nref, de, di, ee, ei = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8]
+    c, gl, el, th, nref = p.capacitance_pF, p.rest_conductance_nS, p.rest_mV, p.threshold_mV, p.refractory_steps
+    de, di, ee, ei = p.decay_exc, p.decay_inh, p.e_exc_mV, p.e_inh_mV
     for i in range(n):
         if refr[i] > 0:
             refr[i] -= 1
@@ -186,19 +217,19 @@ def tick(x, eps, uniform, circuit, torque):
     ``torque``.
 
     ``x``: desired (q1..q3, qd1..qd3); ``eps``: teaching error per joint (NaN: no measurement arrived);
-    ``uniform``: a uniform number per IO cell; ``circuit.pars`` = (n_sub, dt_ms, input decay, drive at centre, n_per,
-    w_max, ltp, ltd, learn, w_dcn, w_inh, eps full scale, IO p_max per step)."""
+    ``uniform``: a uniform number per IO cell; ``circuit.pars``: the :class:`Constants`."""
     pars, clock, w, io_spike, counts = circuit.pars, circuit.clock, circuit.w, circuit.io_spike, circuit.counts
     cells = circuit.inputs
     v_in, drive, hist, head = cells.v, cells.drive, cells.hist, cells.head
     ge_pc, ge_dcn, gi_dcn = circuit.pc.ge, circuit.dcn.ge, circuit.dcn.gi
-    n_sub, dt, in_decay, scale, n_per = int(pars[0]), pars[1], pars[2], pars[3], int(pars[4])
-    w_max, ltp, ltd, learn, w_dcn, w_inh = pars[5], pars[6], pars[7], pars[8] > 0.0, pars[9], pars[10]
+    n_sub, dt, in_decay, scale, n_per = pars.n_sub, pars.dt_ms, pars.input_decay, pars.drive_at_centre, pars.n_per
+    w_max, ltp, ltd, learn = pars.w_max_nS, pars.ltp_nS, pars.ltd_nS, pars.learn
+    w_dcn, w_inh = pars.w_dcn_nS, pars.w_inh_nS
     n_in, n_pc, depth = v_in.shape[0], ge_pc.shape[0], hist.shape[1]
     now = clock[0]
     _encode(x, cells.enc[0], cells.enc[1], n_per, scale, drive)
     if not math.isnan(eps[0]):
-        if _olive(eps, uniform, pars[11], pars[12], n_pc // 6, io_spike):
+        if _olive(eps, uniform, pars.eps_full_scale, pars.io_p_max, n_pc // 6, io_spike):
             for i in range(n_pc):
                 clock[2] += io_spike[i]
             if learn and ltd > 0.0:

@@ -61,6 +61,16 @@ def _k(r: Run) -> float | None:
     return None if k is None else float(k)
 
 
+def _s1_spring(r: Run) -> bool:
+    """A diagnostic run of panel B with a linear spring on s1 (study fig4_6b_spring), not panel B itself."""
+    return bool(r.get("plant.s1_spring.enabled")) and bool(r.get("plant.s1_spring.stiffness_Nm_per_rad"))
+
+
+def _spring_label(runs: list[Run]) -> str:
+    k = sorted({float(r.get("plant.s1_spring.stiffness_Nm_per_rad")) for r in runs})
+    return f"+ shoulder spring {', '.join(f'{v:g}' for v in k)} N·m/rad"
+
+
 def payload_sag_cm(r: Run) -> float | None:
     """End-effector z just before the payload is attached minus its mean z over the run's last second (cm)."""
     at = [e["at_s"] for e in r.events if (e.get("action") or {}).get("kind") == "attach_payload" and e.get("at_s")]
@@ -127,14 +137,16 @@ def fig4_6_intervals(runs: RunSet) -> dict[str, Interval]:
 
 
 @figure("fig4_6", "Baxter with Ekeberg muscles: MAE and payload sag per cocontraction",
-        studies=("fig4_6a", "fig4_6b"))
+        studies=("fig4_6a", "fig4_6b", "fig4_6b_spring"))
 def fig4_6(runs: RunSet, stem: Path) -> Figure:
     """A: MAE per cocontraction from a learned state; B: payload sag per cocontraction at rest."""
     muscles = runs.where(lambda r: r.completed and _table_4_1(r))
     eight = muscles.where(lambda r: r.controller == "snn" and r.task == "eight")
     learned = evaluated(runs)
     learn_trials = sorted({r.trials for r in eight.where(lambda r: r.learned_from is None).by(_k).values()})
-    rest = muscles.where(lambda r: r.controller == "muscle_rest" and bool(r.events)).by(_k)
+    at_rest = muscles.where(lambda r: r.controller == "muscle_rest" and bool(r.events))
+    rest = at_rest.where(lambda r: not _s1_spring(r)).by(_k)
+    sprung = at_rest.where(_s1_spring).by(_k)
     if not learned and not rest:
         raise MissingRuns("no Ekeberg-muscle runs of the eight from a learned state or with a payload at rest "
                           "(studies fig4_6a, fig4_6b)")
@@ -161,6 +173,11 @@ def fig4_6(runs: RunSet, stem: Path) -> Figure:
     got = {k: v for k, v in sag.items() if v is not None}
     if got:
         ax_b.plot(list(got), list(got.values()), "o-", color="C1", label="cerebx")
+    sag_sprung = {k: v for k, r in sprung.items() if (v := payload_sag_cm(r)) is not None}
+    spring_label = _spring_label(list(sprung.values()))
+    if sag_sprung:
+        ax_b.plot(list(sag_sprung), list(sag_sprung.values()), "o:", color="C2",
+                  label=f"cerebx {spring_label} (diagnostic)")
     ax_b.set_xlabel("cocontraction c (multiple of the x1 baseline)")
     ax_b.set_ylabel("end-effector sag Δz with 2 kg (cm)")
     for letter, ax in (("A", ax_a), ("B", ax_b)):
@@ -194,6 +211,10 @@ def fig4_6(runs: RunSet, stem: Path) -> Figure:
         checks.append(Check("B: sag falls monotonically with c", falls,
                             " → ".join(f"x{k:g} {v:.1f}" for k, v in sorted(got.items())) + " cm"))
     checks += _sag_values(got)
+    for k in ks:
+        if (v := sag_sprung.get(float(k))) is not None:
+            table.append([f"B (diagnostic, {spring_label}): sag at c = x{k} (cm)", f"{THESIS_SAG_CM[k]:.1f}",
+                          fmt(v, 1)])
     n_seeds = max((iv.n for iv in intervals.values()), default=1)
     caption = ("Fig. 4.6. (A) Position MAE of the cerebellar SNN driving one Ekeberg muscle pair per joint "
                "(Eq. 4.6, Table 4.1) on the eight-like trajectory, each cocontraction profile learnt from scratch "

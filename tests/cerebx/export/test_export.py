@@ -164,3 +164,141 @@ def test_drawn_connectors_weights_and_delays_are_exported_as_drawn(tmp_path):
     assert meta["projections"]["mf_dcn"]["max_delay_ms"] == max(engine)
     other = synapse_tables(build_topology(cfg, seed=8))["mf_dcn"]
     assert not np.array_equal(np.sort(other["w"]), np.sort(t["w"]))
+
+
+def _with_plasticity(d: dict, name: str, rule: dict, w_range: tuple[float, float] = (0.0, 1.0)) -> None:
+    d["projections"][name].update(plasticity=rule, weight_range_nS=list(w_range))
+
+
+PAIR = {"kind": "pair_stdp", "lam": 0.02, "alpha": 1.1, "mu_plus": 0.0, "mu_minus": 1.0, "tau_plus_ms": 15.0,
+        "tau_minus_ms": 30.0}
+
+
+def test_pair_stdp_with_a_dendritic_delay_is_nest_stdp_synapse():
+    d = network_dict(joints=1, fibers=2, per_joint=4)
+    _with_plasticity(d, "pc_dcn", dict(PAIR, delay="dendritic"))
+    p = plan(NetworkConfig.model_validate(d), static=True, approximate=True)
+    pp = p.projections["pc_dcn"]
+    assert pp.synapse == "stdp_synapse" and not pp.plastic
+    assert pp.synapse_params == {"lambda": 0.02, "alpha": 1.1, "mu_plus": 0.0, "mu_minus": 1.0, "tau_plus": 15.0,
+                                 "Wmax": -1.0}  # GABA: NEST's weights and their bound are negative
+    assert p.populations["dcn"].nest_params["tau_minus"] == 30.0
+    assert "tau_minus" not in p.populations["pc"].nest_params
+
+
+def test_rules_nest_cannot_express_are_refused_in_one_line_naming_them(tmp_path):
+    """kernel_stdp, symmetric_cos, symmetric_cos_stdp and pair_stdp with the axonal delay: each named, one line."""
+    d = network_dict(joints=1, fibers=2, per_joint=4)
+    d["projections"]["mf_dcn"].update(rule={"kind": "fixed_indegree", "indegree": 2}, synapses=8)
+    _with_plasticity(d, "mf_dcn", {"kind": "symmetric_cos", "teacher": "pc_dcn"})
+    _with_plasticity(d, "pc_dcn", {"kind": "symmetric_cos_stdp"})
+    _with_plasticity(d, "cf_dcn_ampa", dict(PAIR))
+    cfg = NetworkConfig.model_validate(d)
+    with pytest.raises(Exception) as err:
+        export(cfg, tmp_path / "x")
+    msg = str(err.value)
+    assert "\n" not in msg
+    for kind in ("kernel_stdp", "symmetric_cos'", "symmetric_cos_stdp", "pair_stdp", "nmda"):
+        assert kind in msg, kind
+    assert "set delay: dendritic" in msg
+    assert [p.split(":")[0] for p in plan(cfg, static=True).problems] == ["projections.cf_dcn_nmda"]
+    assert any("pair_stdp" in n and "approximated" in n for n in plan(cfg, approximate=True).notes)
+
+
+def test_stdp_synapse_bounds_and_its_post_neuron_trace_are_checked():
+    d = network_dict(joints=1, fibers=2, per_joint=4)
+    _with_plasticity(d, "cf_dcn_ampa", dict(PAIR, delay="dendritic"), (0.1, 1.0))
+    d["projections"]["cf_dcn_ampa"]["weight_nS"] = 0.5
+    problems = plan(NetworkConfig.model_validate(d)).problems
+    assert any("cf_dcn_ampa.plasticity: kind 'pair_stdp'" in p and "bounds weights at 0" in p for p in problems)
+    d = network_dict(joints=1, fibers=2, per_joint=4)
+    _with_plasticity(d, "cf_dcn_ampa", dict(PAIR, delay="dendritic"))
+    _with_plasticity(d, "pc_dcn", dict(PAIR, delay="dendritic", tau_minus_ms=10.0))
+    problems = plan(NetworkConfig.model_validate(d)).problems
+    assert any("cf_dcn_ampa.plasticity: tau_minus 30.0 differs from 10.0 of projections.pc_dcn" in p
+               for p in problems)
+
+
+def test_a_plugin_registers_its_kinds_export_through_the_api():
+    import cerebx.api as api
+    from cerebx.export import mapping
+
+    with pytest.raises(ValueError, match="already registered"):
+        api.register_export("plasticity", "kernel_stdp", api.Refused("no"))
+    with pytest.raises(ValueError, match="group 'synapses'"):
+        api.register_export("synapses", "x", "y")
+    with pytest.raises(TypeError, match="a NeuronMap or Refused"):
+        api.register_export("neurons", "my_neuron", "iaf_psc_alpha")
+    try:
+        api.register_export("connectors", "my_rule", "fixed_total_number / FixedTotalNumberConnector")
+        assert mapping.CONNECTORS["my_rule"].startswith("fixed_total_number")
+    finally:
+        mapping.CONNECTORS.pop("my_rule", None)
+
+
+def test_learned_weights_of_a_run_are_exported(tmp_path, capsys):
+    """``--weights RUN``: the npz holds the saved state's weights (count and sum per projection), not the initial
+    ones; a state of another network is refused in one line."""
+    from cerebx.persistence.state import save_state_npz
+    from cerebx.snn.network import Network
+
+    d = network_dict(joints=1, fibers=2, per_joint=4)
+    d["projections"]["mf_dcn"].update(rule={"kind": "fixed_indegree", "indegree": 2}, synapses=8)
+    _with_plasticity(d, "mf_dcn", dict(PAIR, delay="dendritic"))
+    cfg = NetworkConfig.model_validate(d)
+    net = Network(cfg, parallel=False)
+    rng = np.random.default_rng(4)
+    net.dense_w[:] = rng.uniform(0, 5, net.dense_w.size)
+    net.sp_w[:] = rng.uniform(0, 1, net.sp_w.size)
+    state = {f"net_{k}": v for k, v in net.state_arrays().items()}
+    save_state_npz(tmp_path / "controller_state.npz", {"fingerprint": cfg.fingerprint(), "network": cfg.name}, **state)
+    src = tmp_path / "net.yaml"
+    src.write_text(yaml.safe_dump(cfg.model_dump(), sort_keys=False))  # the synapses' order is the projections'
+    assert main(["export", str(src), "--weights", str(tmp_path / "controller_state.npz"), "--static", "--approximate",
+                 "--out", str(tmp_path / "out")]) == 0
+    assert "weights: learned, from" in capsys.readouterr().out
+    _, tables = read_npz(tmp_path / "out" / "network.npz")
+    for name in tables:
+        if name in ("mf_dcn", "mf_gc", "pc_dcn", "cf_pc", "cf_dcn_ampa"):
+            pre, post, w = net.sparse_weights(name)
+            assert len(tables[name]["w"]) == len(w)
+            assert float(tables[name]["w"].sum(dtype=np.float64)) == pytest.approx(float(w.sum(dtype=np.float64)))
+    block = net.topo.dense_block(next(x for x in net.topo.dense if x.name == "pf_pc"))
+    assert tables["pf_pc"]["w"].shape == block.shape
+    np.testing.assert_array_equal(tables["pf_pc"]["w"], block)
+    assert float(tables["mf_dcn"]["w"].sum()) != pytest.approx(float(build_topology(cfg).sparse[0].w.sum()))
+    other = network_dict(joints=1, fibers=2, per_joint=6)
+    src.write_text(yaml.safe_dump(NetworkConfig.model_validate(other).model_dump()))
+    assert main(["export", str(src), "--weights", str(tmp_path / "controller_state.npz"), "--static",
+                 "--approximate", "--out", str(tmp_path / "o2")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "of another structure" in err
+
+
+def test_a_network_file_takes_overrides_of_its_keys():
+    from pathlib import Path
+
+    from cerebx.errors import CerebxError
+    from cerebx.export.source import load_network
+
+    vocab = Path(__file__).parents[2] / "configs" / "nest_vocab.yaml"
+    cfg = load_network(str(vocab), ["dt_ms=0.1", "projections.pf_pc.plasticity.lam=0.02"])
+    assert cfg.dt_ms == 0.1 and cfg.projections["pf_pc"].plasticity.lam == 0.02
+    assert cfg.projections["goc_gc"].rule.kind == "fixed_indegree" and cfg.projections["mf_gc"].rule.p == 0.1
+    with pytest.raises(CerebxError, match="override 'nope.x=1': not key=value"):
+        load_network(str(vocab), ["nope.x=1"])
+
+
+def test_a_network_written_per_joint_is_sized_for_the_composed_plant(tmp_path):
+    """`cerebx export/crosscheck small_golgi` sizes the per-joint preset as a run on its plant would; a bare
+    network file written per joint names no plant and is refused in one line."""
+    from cerebx.errors import CerebxError
+    from cerebx.export.source import load_network
+
+    six = load_network("small_golgi")
+    two = load_network("small_golgi", ["plant=planar2"])
+    assert six.populations["pc"].size // 6 == two.populations["pc"].size // 2 > 0 and two.populations["pc"].size < 60
+    bare = tmp_path / "net.yaml"
+    bare.write_text("populations: {}\nprojections: {}\nper_joint: {pc: 10}\n")
+    with pytest.raises(CerebxError, match="per_joint: the network is sized from a plant"):
+        load_network(str(bare))

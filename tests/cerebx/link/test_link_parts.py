@@ -93,7 +93,8 @@ def test_pace_never_wakes_early():
 def test_fingerprint_covers_what_both_sides_compute_from(load):
     base = fingerprint(load(PD_WALL))
     assert fingerprint(load(PD_WALL + ["link.robot=10.0.0.1:7447", "link.spawn_robot=false",
-                                       "recording.progress=off", "link.rt_priority=50"])) == base
+                                       "link.beyond_loopback=true", "recording.progress=off",
+                                       "link.rt_priority=50"])) == base
     assert fingerprint(load(PD_WALL + ["trials=11"])) != base
     assert fingerprint(load(PD_WALL + ["delay=gamma45"])) != base
 

@@ -159,7 +159,7 @@ class FakeTransport:
 
 def test_link_end_counts_and_drops_what_it_refuses():
     t = FakeTransport()
-    end = LinkEnd(t, KEY, "robot", SIGNALS, run_id=RUN)
+    end = LinkEnd(t, OTHER, "robot", SIGNALS, run_id=RUN, session=KEY)
     good = [command(seq=s, tick=s) for s in (0, 1, 3)]  # 2 never arrives
     bad = [command(signer=OTHER, seq=9), command(run=bytes(16), seq=9), b"junk", command(seq=1, tick=1),
            command({"joint.torque": np.zeros(2)}, seq=10), command(kind=Kind.SENSOR, seq=11)]
@@ -175,7 +175,7 @@ def test_link_end_counts_and_drops_what_it_refuses():
 
 def test_link_end_sends_signed_packets_and_measures_delay():
     t = FakeTransport()
-    end = LinkEnd(t, KEY, "brain", {"joint.q": 2, "joint.qd": 2}, run_id=RUN)
+    end = LinkEnd(t, OTHER, "brain", {"joint.q": 2, "joint.qd": 2}, run_id=RUN, session=KEY)
     end.send_message(Message(0.004, {"joint.torque": np.ones(6)}), 2)
     path, hop, raw = t.sent[0]
     assert (path, hop) == ("c2r", 0)

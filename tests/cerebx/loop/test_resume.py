@@ -7,13 +7,13 @@ import functools
 import json
 import os
 import signal
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from run_processes import cerebx_run as _cerebx
+from run_processes import wait_for_checkpoint as _wait_for_checkpoint
 
 from cerebx.controllers.snn.schema import SNNController
 from cerebx.errors import ConfigError
@@ -29,29 +29,8 @@ pytestmark = pytest.mark.integration
 RUN = ["+experiment=demo", "delay=gamma25", "recording.progress=off"]
 
 
-def _cerebx(*args: str, cwd: Path) -> subprocess.Popen:
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[3] / "src")}
-    return subprocess.Popen([sys.executable, "-m", "cerebx", "run", *args], cwd=cwd, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-
-
 def _summary(run_dir: Path) -> dict:
     return json.loads((run_dir / "summary.json").read_text())
-
-
-def _wait_for_checkpoint(run_dir: Path, trials: int, proc: subprocess.Popen, timeout_s: float = 120) -> None:
-    head = run_dir / (resume.CHECKPOINT + ".json")
-    t0 = time.monotonic()
-    while time.monotonic() - t0 < timeout_s:
-        if proc.poll() is not None:
-            pytest.fail(f"run ended before its checkpoint: {proc.stdout.read()}")
-        try:
-            if json.loads(head.read_text())["trials_done"] >= trials:
-                return
-        except (OSError, ValueError):
-            pass
-        time.sleep(0.05)
-    pytest.fail(f"no checkpoint at trial {trials} within {timeout_s} s")
 
 
 def test_sigkilled_run_resumes_to_the_same_trials(tmp_path):

@@ -131,3 +131,65 @@ def test_far_distance_bounds_the_skipped_activations():
         q = far_distance(w, bisquare=True)
         assert q == pytest.approx(4 * (1 - np.sqrt(w)), rel=1e-8) and (1 - q / 4) ** 2 < w
     assert far_distance(0.0, bisquare=False) == np.inf
+
+
+def test_any_array_like_input_learns_what_float64_rows_learn():
+    """``update`` and ``predict`` take the caller's float64 C-contiguous rows as they are and convert anything
+    else (lists, float32, read-only, strided, 2-D single rows) to the same values: the same model bit for bit.
+    Two models of one shape share their compiled kernels but not their state."""
+    rng = np.random.default_rng(8)
+    xs = rng.uniform(-1, 1, (400, 2)).astype(np.float32).astype(np.float64)  # exact in float32 too
+    ys = cross(xs)[:, None]
+    ref, other = LWPR(2, 1, initial_capacity=2), LWPR(2, 1, initial_capacity=2)
+    for x, y in zip(xs, ys):
+        ref.update(x, y)
+    frozen = xs.copy()
+    frozen.flags.writeable = False
+    strided = np.asfortranarray(xs)  # its rows are not contiguous
+    for t, (x, y) in enumerate(zip(xs, ys)):
+        form = t % 5
+        if form == 0:
+            other.update(list(x), float(y[0]))
+        elif form == 1:
+            other.update(x.astype(np.float32).reshape(1, 2), y)
+        elif form == 2:
+            other.update(frozen[t], y)
+        elif form == 3:
+            other.update(strided[t], y.reshape(1, 1))
+        else:
+            other.update(x, y)
+    assert other.n_receptive_fields == ref.n_receptive_fields and ref.n_receptive_fields[0] > 2
+    for x in rng.uniform(-1, 1, (20, 2)):
+        want = ref.predict(x)
+        for form in (list(x), x.reshape(1, 2), np.asfortranarray(np.stack([x, x]))[0], x):
+            np.testing.assert_array_equal(other.predict(form), want)
+    assert ref.predict(xs[0]) is not ref.predict(xs[0])  # a new array each call
+
+
+def test_a_pickled_model_learns_on_as_the_original():
+    """Checkpoints pickle the controllers, LWPR included: the unpickled model (and one pickled by earlier code,
+    whose ``__dict__`` held the RF arrays as ``_store`` beside a buffer without the pred region) has its own
+    buffer and learns on bit for bit as the original does."""
+    import pickle
+
+    from cerebx.lwpr import kernels as K
+
+    rng = np.random.default_rng(9)
+    xs = rng.uniform(-1, 1, (1500, 2))
+    ys = cross(xs)[:, None]
+    model = LWPR(2, 1, initial_capacity=2)
+    model.update_many(xs[:500], ys[:500])
+    old = {k: v for k, v in model.__dict__.items() if k not in ("_addr", "_pred", "_update", "_predict")}
+    old["_store"] = K.Store(*(a.copy() for a in model._store))
+    old["_buf"] = np.full(K.regions(2, 1, model._store.mat.shape[1])[-1] - 1, np.nan)  # the old layout's size
+    earlier = LWPR.__new__(LWPR)
+    earlier.__setstate__(pickle.loads(pickle.dumps(old)))
+    copies = [pickle.loads(pickle.dumps(model)), earlier]
+    for x, y in zip(xs[500:], ys[500:]):  # the storage grows on the way
+        want = model.update(x, y)
+        for c in copies:
+            np.testing.assert_array_equal(c.update(x, y), want)
+    test = rng.uniform(-1, 1, (30, 2))
+    for c in copies:
+        assert c.n_receptive_fields == model.n_receptive_fields and c._buf is not model._buf
+        np.testing.assert_array_equal(c.predict_many(test), model.predict_many(test))

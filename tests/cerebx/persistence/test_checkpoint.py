@@ -378,7 +378,7 @@ def test_the_checkpointer_writes_ahead_only_when_a_checkpoint_is_due(tmp_path):
         cfg = SimpleNamespace(trials=trials, recording=SimpleNamespace(checkpoint_every=every),
                               model_dump=lambda **_: {})
         return SimpleNamespace(cfg=cfg, trials_done=done, ctx={"net": net}, tick=0, dt_s=0.01, metrics=[],
-                               _sensed=None, _task_rng=None, _events=[])
+                               _sensed=None, _task_rng=None, _events=[], window=None, _last_held=None)
 
     for done, trials, every, expect in [(0, 10, 10, None), (0, 11, 10, 10), (3, 30, 10, 10), (10, 30, 10, 20),
                                         (0, 30, 0, None)]:

@@ -166,3 +166,18 @@ def test_built_count_recorded():
     net = Network(cfg, parallel=False, seed=4)
     built = net.built_synapses["p"]
     assert built == len(pairs(cfg, seed=4)[0]) and built != 300  # (this seed's draw is not the expectation)
+
+
+def test_a_schema_pickled_under_its_old_module_still_loads():
+    """The connectors' and rules' schemas moved to snn/schema.py; a checkpoint that pickled one as
+    ``cerebx.snn.connectors.X`` / ``cerebx.snn.plasticity.X`` still loads it."""
+    import pickle
+
+    from cerebx.snn import schema
+
+    for old, cls in (("cerebx.snn.connectors", schema.FixedIndegree(indegree=4)),
+                     ("cerebx.snn.connectors", schema.Normal(mean=1.0, std=0.5)),
+                     ("cerebx.snn.plasticity", schema.PairSTDP())):
+        data = pickle.dumps(cls, protocol=2).replace(b"cerebx.snn.schema", old.encode())
+        assert old.encode() in data
+        assert pickle.loads(data) == cls

@@ -91,6 +91,28 @@ def test_pair_stdp_traces_add_over_pairs():
     assert weight(net) == pytest.approx(W0 + 0.01 * (np.exp(-0.5) + np.exp(-1.0)), abs=1e-6)
 
 
+@pytest.mark.parametrize("delay_ms", [0.5, 5.0, 10.0])
+@pytest.mark.parametrize("gap", [-4, 6])
+def test_pair_stdp_dendritic_delay_pairs_as_nest(delay_ms, gap):
+    """delay: dendritic (NEST stdp_synapse): the pair's Δt is t_post − t_pre + d, whichever side of the post spike
+    the pre spike arrives (``gap``: arrival minus post spike, substeps); the axonal default pairs t_post − arrival."""
+    d = int(delay_ms / DT)
+    t_post = post_spike_time(STDP, 10)
+    step = (t_post + gap - d) // 4
+    t_pre = 4 * step
+    weights = {}
+    for conv in ("axonal", "dendritic"):
+        net = pair_net(dict(STDP, delay=conv), delay_ms)
+        assert run(net, {10: ["drv"], step: ["pre"]}, (t_post + 2 * d) // 4 + 3) == [t_post]
+        weights[conv] = weight(net)
+
+    def nest_pair(dt_ms: float) -> float:
+        return W0 + 0.01 * ((1 - W0) if dt_ms > 0 else -W0) * np.exp(-abs(dt_ms) / 20.0)
+
+    assert weights["dendritic"] == pytest.approx(nest_pair((t_post - t_pre + d) * DT), abs=1e-6)
+    assert weights["axonal"] == pytest.approx(nest_pair((t_post - t_pre - d) * DT), abs=1e-6)
+
+
 def test_pair_stdp_frozen_when_not_learning():
     net = pair_net(dict(STDP), 1.0)
     net.learn = False

@@ -151,3 +151,20 @@ def test_upper_limb_runs_in_the_loop(load, tmp_path, spinal):
     s = run_experiment(cfg, tmp_path)
     assert s["status"] == "completed", s
     assert s["mae_per_trial"][-1] < 0.3
+
+
+def test_a_restored_cord_goes_on_as_the_original(arm):
+    """The stage pickles as its arrays (its kernel struct is made again on load): after a round trip in the middle
+    of a stretch, both copies give the same activations bit for bit, and neither writes into the other."""
+    import pickle
+
+    lo, hi = _bounds(arm)
+    st = _cord(arm)
+    for t in range(10):
+        _tick(st, lo + (hi - lo) * 0.05 * t, np.full(len(lo), 30.0), ag=(0.2, 0.0))
+    again = pickle.loads(pickle.dumps(st))
+    for t in range(30):
+        length, velocity = lo + (hi - lo) * (0.5 + 0.01 * t), np.full(len(lo), 20.0 - t)
+        np.testing.assert_array_equal(_tick(st, length, velocity, at=(0.1, 0.3)),
+                                      _tick(again, length, velocity, at=(0.1, 0.3)))
+    assert again.mn is not st.mn and np.array_equal(again.mn, st.mn)

@@ -13,6 +13,7 @@ from cerebx.registry import Plugin
 from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
 from cerebx.schema.controller import ControllerConfig, muscle_command_signals
 from cerebx.signals import StageIO, torque_controller_io
+from cerebx.snn import sizing
 from cerebx.snn.schema import BoxEncoder, CFEncoder, NetworkConfig
 
 DELAYED_RECEIVER = {"kind": "future_past", "min_future_samples": 2, "past_samples": 10, "decay_per_step": 0.998}
@@ -113,8 +114,11 @@ class SNNController(ControllerConfig):
 
     @classmethod
     def complete(cls, experiment: dict[str, Any]) -> dict[str, Any]:
-        """Resolve ``efferent: auto``: with any delay other than ``none`` the torques are stamped and a
-        ``mean`` receiver becomes ``delayed_receiver``; without delay the torques are held."""
+        """Size a ``per_joint`` network for the plant (:mod:`cerebx.snn.sizing`; then one-entry per-joint gains
+        are given to every joint), and resolve ``efferent: auto``: with any delay other than ``none`` the
+        torques are stamped and a ``mean`` receiver becomes ``delayed_receiver``; without delay the torques are
+        held."""
+        experiment = _sized_for_plant(experiment)
         ctrl, delay = experiment.get("controller"), experiment.get("delay")
         if not (isinstance(ctrl, dict) and ctrl.get("efferent") == "auto"):
             return experiment
@@ -168,6 +172,22 @@ class SNNController(ControllerConfig):
                            f"spikes, but one side of a joint of {io.output!r} can fire {most} in a 2 ms step (M "
                            "would exceed 1, unless controller.decoder.saturate caps it)")
         return out
+
+
+def _sized_for_plant(experiment: dict[str, Any]) -> dict[str, Any]:
+    ctrl = experiment.get("controller")
+    net = ctrl.get("network") if isinstance(ctrl, dict) else None
+    if not (isinstance(net, dict) and sizing.KEY in net):
+        return experiment
+    n = sizing.plant_joints(experiment)
+    if n is None:
+        return experiment
+    ctrl = {**ctrl, "network": sizing.sized_network(net, n)}
+    for group, fields in (("error", ("kpos", "kvel")), ("decoder", ("alpha_Nm_per_spike", "spikes_full_scale"))):
+        part = ctrl.get(group)
+        if isinstance(part, dict):
+            ctrl[group] = {**part, **{f: sizing.broadcast_per_joint(part[f], n) for f in fields if f in part}}
+    return {**experiment, "controller": ctrl}
 
 
 def max_spikes_per_step(neuron: Any, network_dt_ms: float, step_ms: float = 2.0) -> int:

@@ -4,6 +4,7 @@ it with the input spike trains stored there and record every population's spikes
     python nest_network.py --ms 1000                  # simulate 1 s, spikes to spikes_nest.npz
     python nest_network.py --ms 1000 --slice-ms 2     # the same in 2 ms slices (as cerebx's 500 Hz loop)
     python nest_network.py --connections              # synapse count and weight sum per projection (JSON)
+    python nest_network.py --ms 1000 --weights        # with the plastic projections' weights (STDP)
 
 Neurons: ``iaf_cond_exp`` (cerebx lif_cond; V_reset = E_L), inputs: ``spike_train_injector``. Every projection
 has its own copy of its synapse model (``cx_NAME``) so that ``nest.GetConnections(synapse_model="cx_NAME")``
@@ -33,8 +34,9 @@ def load(path: Path = HERE / "network.npz") -> tuple[dict, dict[str, np.ndarray]
     return json.loads(str(arrays.pop("meta"))), arrays
 
 
-def build(meta: dict, arrays: dict[str, np.ndarray], threads: int = 1) -> dict:
-    """Populations, input spike trains and synapses; returns name -> NodeCollection. Ends at cerebx time 0."""
+def build(meta: dict, arrays: dict[str, np.ndarray], threads: int = 1, weights: dict | None = None) -> dict:
+    """Populations, input spike trains and synapses; returns name -> NodeCollection. Ends at cerebx time 0.
+    ``weights``: receives a weight recorder per plastic projection (every weight a spike transmits)."""
     nest.ResetKernel()
     nest.verbosity = nest.VerbosityLevel.ERROR
     nest.set(resolution=meta["resolution_ms"], local_num_threads=threads)
@@ -50,7 +52,11 @@ def build(meta: dict, arrays: dict[str, np.ndarray], threads: int = 1) -> dict:
         pops[name].set([{"spike_times": t[a:b].tolist()} for a, b in zip(bounds[:-1], bounds[1:])])
     for name, pr in meta["projections"].items():
         syn = f"cx_{name}"
-        nest.CopyModel(pr["synapse"], syn, pr["synapse_params"] or {})
+        params = dict(pr["synapse_params"])
+        if weights is not None and pr["synapse"] != "static_synapse":
+            weights[name] = nest.Create("weight_recorder")
+            params["weight_recorder"] = weights[name]
+        nest.CopyModel(pr["synapse"], syn, params)
         pre, post = pops[pr["pre"]], pops[pr["post"]]
         w = arrays[f"w/{name}"].astype(np.float64) * pr["sign"]
         if pr["layout"] == "dense":
@@ -100,6 +106,28 @@ def spikes(meta: dict, pops: dict, recs: dict) -> dict[str, np.ndarray]:
     return out
 
 
+def plastic(meta: dict, pops: dict, weights: dict) -> dict[str, np.ndarray]:
+    """Each plastic projection's weights as its spikes transmitted them (``wr/NAME/{pre,post,t,w}``, cerebx time
+    of the presynaptic spike) and at the end (``w_end/NAME/{pre,post,w,d,kplus}``); local indices, cerebx's sign."""
+    out = {}
+    for name, rec in weights.items():
+        pr = meta["projections"][name]
+        pre0, post0 = pops[pr["pre"]][0].global_id, pops[pr["post"]][0].global_id
+        ev = rec.get("events")
+        out[f"wr/{name}/pre"] = (np.asarray(ev["senders"]) - pre0).astype(np.int32)
+        out[f"wr/{name}/post"] = (np.asarray(ev["targets"]) - post0).astype(np.int32)
+        out[f"wr/{name}/t"] = np.asarray(ev["times"], dtype=np.float64) - meta["t_offset_ms"]
+        out[f"wr/{name}/w"] = np.asarray(ev["weights"], dtype=np.float64) * pr["sign"]
+        conns = nest.GetConnections(synapse_model=f"cx_{name}")
+        st = {k: np.asarray(conns.get(k)).reshape(-1) for k in ("source", "target", "weight", "delay", "Kplus")}
+        out[f"w_end/{name}/pre"] = (st["source"] - pre0).astype(np.int32)
+        out[f"w_end/{name}/post"] = (st["target"] - post0).astype(np.int32)
+        out[f"w_end/{name}/w"] = st["weight"].astype(np.float64) * pr["sign"]
+        out[f"w_end/{name}/d"] = st["delay"].astype(np.float64)
+        out[f"w_end/{name}/kplus"] = st["Kplus"].astype(np.float64)
+    return out
+
+
 def connections(meta: dict) -> dict[str, dict[str, float]]:
     """Synapse count, weight sum (nS, cerebx's sign) and delay sum (ms) of every projection, as NEST holds them."""
     out = {}
@@ -122,17 +150,20 @@ def main() -> None:
     ap.add_argument("--npz", default=str(HERE / "network.npz"))
     ap.add_argument("--out", default=str(HERE / "spikes_nest.npz"), help="recorded spikes")
     ap.add_argument("--connections", action="store_true", help="print synapse counts and weight sums (JSON)")
+    ap.add_argument("--weights", action="store_true", help="also record the plastic projections' weights (at every "
+                    "transmitted spike and at the end) into the spikes file")
     args = ap.parse_args()
     meta, arrays = load(Path(args.npz))
     t0 = time.perf_counter()
-    pops = build(meta, arrays, args.threads)
+    weights: dict = {}
+    pops = build(meta, arrays, args.threads, weights if args.weights else None)
     build_s = time.perf_counter() - t0
     if args.connections:
         print(json.dumps(connections(meta)))
         return
     recs = record(pops)
     wall, cpu = run(args.ms, args.slice_ms, args.mode)
-    np.savez(args.out, **spikes(meta, pops, recs))
+    np.savez(args.out, **spikes(meta, pops, recs), **plastic(meta, pops, weights))
     print(json.dumps({"build_s": build_s, "sim_s": wall, "sim_cpu_s": cpu, "ms": args.ms, "slice_ms": args.slice_ms,
                       "mode": args.mode, "threads": args.threads}))
 

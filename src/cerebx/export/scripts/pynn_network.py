@@ -4,7 +4,8 @@
     python pynn_network.py --ms 1000                  # spikes to spikes_pynn.npz
     python pynn_network.py --backend pyNN.neuron      # another PyNN backend
 
-Neurons: ``IF_cond_exp`` (cerebx lif_cond; PyNN units: nF, uS, mV, ms), inputs: ``SpikeSourceArray``. All-to-all
+Neurons: ``IF_cond_exp`` (cerebx lif_cond; PyNN units: nF, uS, mV, ms), inputs: ``SpikeSourceArray``; synapses
+static, or pair STDP (NEST's stdp_synapse) as an ``STDPMechanism`` on excitatory input. All-to-all
 projections use ``AllToAllConnector`` with cerebx's weight matrix, the others ``FromListConnector`` over cerebx's
 synapse list. As in the NEST script, the simulator runs ``t_offset_ms`` ahead of cerebx (no spike can be emitted at
 t = 0); recorded times are cerebx times. Requires numpy and PyNN with a backend.
@@ -52,14 +53,34 @@ def build(sim, meta: dict, arrays: dict[str, np.ndarray]) -> dict:
     for name, pr in meta["projections"].items():
         pre, post = pops[pr["pre"]], pops[pr["post"]]
         w = arrays[f"w/{name}"].astype(np.float64) / 1000.0  # nS -> uS
+        tau_minus = meta["populations"][pr["post"]]["nest_params"].get("tau_minus", 20.0)
         if pr["layout"] == "dense":
-            conn, syn = sim.AllToAllConnector(), sim.StaticSynapse(weight=w, delay=pr["delay_ms"])
+            conn, syn = sim.AllToAllConnector(), synapse(sim, name, pr, tau_minus, weight=w, delay=pr["delay_ms"])
         else:
             d = arrays.get(f"d/{name}", np.full(len(w), pr["delay_ms"]))
             rows = np.column_stack([arrays[f"pre/{name}"], arrays[f"post/{name}"], w, d])
-            conn, syn = sim.FromListConnector(rows, column_names=["weight", "delay"]), sim.StaticSynapse()
+            conn = sim.FromListConnector(rows, column_names=["weight", "delay"])
+            syn = synapse(sim, name, pr, tau_minus)
         sim.Projection(pre, post, conn, syn, receptor_type=pr["pynn_receptor"], label=name)
     return pops
+
+
+def synapse(sim, name: str, pr: dict, tau_minus: float, **kw):
+    """The projection's PyNN synapse type: static, or NEST's stdp_synapse as an STDPMechanism (pair rule with
+    Gütig weight dependence; the whole delay dendritic, as in NEST)."""
+    if pr["synapse"] == "static_synapse":
+        return sim.StaticSynapse(**kw)
+    if pr["synapse"] == "stdp_synapse" and pr["sign"] > 0:
+        q = pr["synapse_params"]
+        mu = {"mu_plus": q["mu_plus"], "mu_minus": q["mu_minus"]}
+        dependence = sim.GutigWeightDependence(w_min=0.0, w_max=q["Wmax"] / 1000.0, **mu)
+        dependence.parameter_space.update(**mu)  # pyNN.nest 0.13's __init__ drops them (keeps 0.5)
+        return sim.STDPMechanism(
+            timing_dependence=sim.SpikePairRule(tau_plus=q["tau_plus"], tau_minus=tau_minus, A_plus=q["lambda"],
+                                                A_minus=q["alpha"] * q["lambda"]),
+            weight_dependence=dependence, dendritic_delay_fraction=1.0, **kw)
+    raise SystemExit(f"projections.{name}: {pr['synapse']} on {pr['pynn_receptor']} input has no PyNN synapse type "
+                     "in this script (use nest_network.py)")
 
 
 def spikes(pops: dict, off: float) -> dict[str, np.ndarray]:

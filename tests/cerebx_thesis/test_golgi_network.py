@@ -1,0 +1,64 @@
+"""Worked network A (docs/networks/golgi.md): the thesis network plus Golgi cells. The preset is thesis_ch2 with
+a GoC layer and the PF-PC start weight that gives the PCs back their rate; the Golgi cells inhibit the granule
+layer by about a third (open loop, the reduced size); (slow) the reduced network learns the circle."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cerebx.loop.runner import run_experiment
+from cerebx.snn.network import Network
+
+SMALL = ["controller.mf.fibers_per_signal=5", "controller.decoder.alpha_Nm_per_spike=[7.5,10.0,3.75,5.0,0.5,0.5]"]
+
+
+def test_thesis_golgi_is_thesis_ch2_plus_a_golgi_layer(load):
+    golgi = load(["+experiment=learn_circle_golgi"]).controller.network
+    ch2 = load(["+experiment=learn_circle"]).controller.network
+    assert golgi.n_neurons == ch2.n_neurons + 600 == 62640
+    assert set(golgi.projections) - set(ch2.projections) == {"mf_goc", "gc_goc", "goc_gc"}
+    goc_gc = golgi.projections["goc_gc"]
+    assert (goc_gc.rule.kind, goc_gc.rule.indegree, goc_gc.receptor) == ("fixed_indegree", 4, "gaba")
+    assert goc_gc.synapses == 4 * 60000
+    for name, p in ch2.projections.items():
+        want = p.model_dump()
+        if name == "pf_pc":
+            want["weight_nS"] = 2.2
+        assert golgi.projections[name].model_dump() == want, name
+    assert golgi.populations["gc"].neuron == ch2.populations["gc"].neuron  # the GABA values are the defaults
+
+
+def _spikes(cfg, steps=600):
+    """Spikes per population under the box code of a slow sweep (one active fibre per joint signal)."""
+    net = Network(cfg, parallel=False, seed=0)
+    net.learn = False
+    counts: dict[str, int] = {}
+    for t in range(steps):
+        ph = 2 * np.pi * t / 500
+        bins = [(j, s, int(round(2 + 2 * np.sin(ph + 0.7 * s + j)))) for j in range(6) for s in range(4)]
+        idx = np.array([j * 20 + s * 5 + b for j, s, b in bins], np.int32)
+        sp = net.step(idx).idx
+        if t >= 100:
+            for pop in cfg.populations:
+                sl = net.index(pop)
+                counts[pop] = counts.get(pop, 0) + int(((sp >= sl.start) & (sp < sl.stop)).sum())
+    return counts
+
+
+@pytest.mark.integration
+def test_golgi_cells_cut_the_granule_spikes_by_a_third_and_the_pcs_keep_their_rate(load):
+    """Open-loop calibration of the preset's constructed weights (measured: GC spikes -33 %, GoC ~50 Hz, PC
+    rate within 20 % of small_ch2's)."""
+    golgi = _spikes(load(["+experiment=learn_circle", "network=small_golgi", *SMALL]).controller.network)
+    plain = _spikes(load(["+experiment=learn_circle", "network=small_ch2", *SMALL]).controller.network)
+    assert 0.5 * plain["gc"] < golgi["gc"] < 0.85 * plain["gc"], (golgi, plain)
+    assert 20 < golgi["goc"] / 36 / 1.0 < 100  # Hz over the 1 s measured
+    assert abs(golgi["pc"] - plain["pc"]) < 0.25 * plain["pc"], (golgi, plain)
+
+
+@pytest.mark.slow
+def test_the_reduced_golgi_network_learns_the_circle(load, tmp_path):
+    s = run_experiment(load(["+experiment=learn_circle", "network=small_golgi", *SMALL, "trials=20"]), tmp_path)
+    mae = np.asarray(s["mae_per_trial"])
+    assert s["status"] == "completed" and mae[-3:].mean() < 0.8 * mae[0], mae  # measured: 0.224 -> ~0.14
