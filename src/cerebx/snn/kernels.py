@@ -58,6 +58,7 @@ from cerebx.kernel_struct import KernelStruct
 from cerebx.snn.learning import NoLearning, SparseLearning, run_rules
 from cerebx.snn.topology import (
     I_COMPACT,
+    I_HI,
     I_KIND,
     I_LO,
     I_NFINE,
@@ -194,8 +195,8 @@ class Neurons(NamedTuple):
     n_rest: np.ndarray  # int64 [pop]: listed neurons found at rest by the last step
     pop_ep: np.ndarray  # int64 [pop]: version of the compact list (every compaction increments it)
     w: np.ndarray  # float32 [n]: adaptation current of adex_cond neurons (pA; 0 elsewhere), global index order
-    lz_g: np.ndarray  # float32 [n]: GABA conductance of unlisted neurons of lazy-GABA populations (nS), global index
-    lz_t: np.ndarray  # int64 [n]: the population's step (boundary substep step * ratio) lz_g is current at
+    g_rest: np.ndarray  # float32 [n]: GABA conductance of the unlisted neurons of rest-GABA populations (nS),
+    # global index order, decayed with every step of the population
 
 
 class Populations(NamedTuple):
@@ -204,7 +205,7 @@ class Populations(NamedTuple):
     pop_i: np.ndarray  # int64 [pop, I_*]: kind, bounds, step ratio, compact, bifixed sub-steps
     pop_par: np.ndarray  # float64 [pop, P_*]: membrane, synapse and step constants
     poly: np.ndarray  # float32 [pop, 2, 2, N_COEF]: step polynomials of AMPA-only populations
-    lazy: np.ndarray  # float64 [pop]: largest GABA conductance a listed-off neuron keeps lazily (nS; 0: none)
+    lazy: np.ndarray  # float64 [pop]: largest GABA conductance an unlisted neuron at rest holds (nS; 0: none)
     nmda: np.ndarray  # uint8 [pop]: 1 where the population has NMDA input
 
 
@@ -294,39 +295,6 @@ def _decay(g, d):
     for i in range(g.shape[0]):
         x = g[i] * d
         g[i] = x if x > G_FLOOR else zero
-
-
-@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _lazy_decay(x, k, d):
-    """x decayed by k steps of the integration loop (x <- x d, values below G_FLOOR flushed to 0, each step in
-    float32 as :func:`_end_full` does it): the same number, not the closed form x d^k."""
-    zero = np.float32(0.0)
-    for _ in range(k):
-        x = x * d
-        x = x if x > G_FLOOR else zero
-        if x == zero:
-            break
-    return x
-
-
-@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
-def _lazy_take(lz_g, lz_t, i, st, d):
-    """The GABA conductance of unlisted neuron i at the start of its population's step st (its lazily kept value
-    decayed by the steps since), taken out of the store (a neuron's listed state holds it from now)."""
-    x = lz_g[i]
-    if x != np.float32(0.0):
-        x = _lazy_decay(x, st - lz_t[i], d)
-        lz_g[i] = np.float32(0.0)
-    return x
-
-
-@njit(cache=True, boundscheck=False)
-def lazy_gaba_at(lz_g, lz_t, st, d, out):
-    """out[i] = the lazily kept GABA conductance of each neuron i of a population slice at the start of its step
-    st (for reading the state; the store is left as it is)."""
-    for i in range(lz_g.shape[0]):
-        if lz_g[i] != np.float32(0.0):
-            out[i] = _lazy_decay(lz_g[i], st - lz_t[i], d)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
@@ -659,6 +627,18 @@ def _lif_full_listed(u, gA, gN, gG, ref, flag, out, p, nf):
     return _end_full(u, ref, flag, (gA, gN, gG), p)
 
 
+@njit(cache=True, parallel=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _lif_full_listed_par(u, gA, gN, gG, ref, flag, out, p, nf, nch):
+    """:func:`_lif_full_listed` on numba threads: ``nch`` contiguous chunks."""
+    n = u.shape[0]
+    cnt = 0
+    for ch in prange(nch):
+        a = ch * n // nch
+        b = (ch + 1) * n // nch
+        cnt += _lif_full_listed(u[a:b], gA[a:b], gN[a:b], gG[a:b], ref[a:b], flag[a:b], out[a:b], p, nf)
+    return cnt
+
+
 def lif_step(u, gA, gN, gG, ref, p, nf, listed=False):
     """One step of a lif_cond population with NMDA/GABA input by :func:`_lif_full_fine` (``listed``:
     :func:`_lif_full_listed`) on copies, for tests: (u, gA, gN, gG, ref, flag)."""
@@ -847,7 +827,7 @@ def _collect(flag, ids, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp, so
 
 
 @njit(cache=True, boundscheck=False)
-def _compact(lo, na, nrn, buf, full, gmax, st):
+def _compact(lo, na, nrn, buf, full, gmax):
     """Drop the neurons at rest from the ``na`` listed neurons of the compact population
     starting at ``lo`` and put the others in global index order (the order of the list does not
     affect any result: every per-neuron operation is independent and collected spikes are sorted;
@@ -856,11 +836,10 @@ def _compact(lo, na, nrn, buf, full, gmax, st):
     are still in index order, those activated since follow in the order they came and are sorted
     (keys global index << 32 | position, so a key's order is its index's), then merged in.
     ``full``: the population has NMDA/GABA conductances (moved too); a neuron at rest whose GABA conductance is
-    in (0, gmax] leaves the list with it, kept in the lazy store (``lz_g``) as current at the start of the
-    population's step st.
+    in (0, gmax] leaves the list with it, kept in ``g_rest``.
     Returns the new count."""
     u, g, ref, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot
-    lz_g, lz_t = nrn.lz_g, nrn.lz_t
+    g_rest = nrn.g_rest
     sf, key, merged = buf.scr_f, buf.scr_i, buf.col_buf
     j = 0
     for k in range(lo, lo + na):
@@ -870,9 +849,7 @@ def _compact(lo, na, nrn, buf, full, gmax, st):
             gn, gb = g[1, k], g[2, k]
             if x == 0.0 and gk == 0.0 and r == 0.0 and gn == 0.0 and gb >= 0.0 and gb <= gmax:
                 slot[i] = -1
-                if gb > 0.0:
-                    lz_g[i] = gb
-                    lz_t[i] = st
+                g_rest[i] = gb
                 continue
             sf[3, j] = gn
             sf[4, j] = gb
@@ -920,13 +897,12 @@ def _compact(lo, na, nrn, buf, full, gmax, st):
 
 
 @njit(cache=True, boundscheck=False)
-def _build_runs(qa, qb, plo, pp, nrn, dl, st, dg):
+def _build_runs(qa, qb, plo, pp, nrn, dl):
     """Positions in the compact list of population pp (starting at plo) of the targets
     sp_post[qa:qb] of one presynaptic neuron (activating the ones at rest), as runs of consecutive
     positions: c_k start position, c_q first synapse, c_l length, stored from qa on. Returns the
-    number of runs. Valid until the population is compacted again (activation only appends). An activated
-    neuron takes its lazily kept GABA conductance at the start of its population's step st (``dg``: the GABA
-    decay per step)."""
+    number of runs. Valid until the population is compacted again (activation only appends; an activated
+    neuron takes its GABA conductance from ``g_rest``)."""
     u, g, ref, cid, slot, n_act = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot, nrn.n_act
     sp_post, c_k, c_q, c_l = dl.sp_post, dl.c_k, dl.c_q, dl.c_l
     nr = 0
@@ -946,7 +922,8 @@ def _build_runs(qa, qb, plo, pp, nrn, dl, st, dg):
             u[kq] = 0.0
             g[0, kq] = 0.0
             g[1, kq] = 0.0
-            g[2, kq] = _lazy_take(nrn.lz_g, nrn.lz_t, i, st, dg)
+            g[2, kq] = nrn.g_rest[i]
+            nrn.g_rest[i] = 0.0
             ref[kq] = 0.0
         if kq == prev + 1:
             ln += 1
@@ -1032,7 +1009,7 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
     nrn, pops, dl, plast, buf = net.neurons, net.populations, net.delivery, net.plasticity, net.buffers
     u, g, ref, flag, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.flag, nrn.cid, nrn.slot
     n_act, n_rest, pop_ep = nrn.n_act, nrn.n_rest, nrn.pop_ep
-    lz_g, lz_t = nrn.lz_g, nrn.lz_t
+    g_rest = nrn.g_rest
     pop_i, pop_par, pop_lazy = pops.pop_i, pops.pop_par, pops.lazy
     ring_idx, ring_n = dl.ring_idx, dl.ring_n
     sp_i, sp_ptr, sp_post, sp_w, sp_c = dl.sp_i, dl.sp_ptr, dl.sp_post, dl.sp_w, dl.sp_c
@@ -1067,7 +1044,7 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
             plo = pop_i[pp, I_LO]
             compact = pop_i[pp, I_COMPACT] != 0
             lazy = compact and rec == 2 and pop_lazy[pp] > 0.0
-            gmax, dg, st = np.float32(pop_lazy[pp]), np.float32(pop_par[pp, P_DG]), t // ratio
+            gmax = np.float32(pop_lazy[pp])
             dec = pop_par[pp, P_D1A + rec]
             scale = 1.0
             for a in range(ratio):  # arrivals since the population's previous step boundary
@@ -1088,12 +1065,11 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                             if kq >= 0:
                                 g[2, kq] += sp_w[q] * sc
                                 continue
-                            x = _lazy_take(lz_g, lz_t, i, st, dg)
-                            x += sp_w[q] * sc
-                            if x >= 0.0 and x <= gmax:  # stays at rest: kept lazily
-                                lz_g[i] = x
-                                lz_t[i] = st
+                            x = g_rest[i] + sp_w[q] * sc
+                            if x >= 0.0 and x <= gmax:  # stays exactly at rest: unlisted
+                                g_rest[i] = x
                                 continue
+                            g_rest[i] = 0.0
                             kq = plo + n_act[pp]
                             n_act[pp] += 1
                             slot[i] = kq
@@ -1108,7 +1084,7 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                         cj = off + j
                         qa = sp_ptr[cj]
                         if sp_c[cj, 0] != pop_ep[pp]:
-                            sp_c[cj, 1] = _build_runs(qa, sp_ptr[cj + 1], plo, pp, nrn, dl, st, dg)
+                            sp_c[cj, 1] = _build_runs(qa, sp_ptr[cj + 1], plo, pp, nrn, dl)
                             sp_c[cj, 0] = pop_ep[pp]
                         gr = g[rec]
                         for r in range(qa, qa + sp_c[cj, 1]):
@@ -1132,7 +1108,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                             u[kq] = 0.0
                             g[0, kq] = 0.0
                             g[1, kq] = 0.0
-                            g[2, kq] = _lazy_take(lz_g, lz_t, i, st, dg)
+                            g[2, kq] = g_rest[i]
+                            g_rest[i] = 0.0
                             ref[kq] = 0.0
                         g[rec, kq] += sp_w[q] * sc
         # dense (all-to-all) projections: a spike adds its weight row; plastic rows get LTP
@@ -1143,7 +1120,6 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
             if t % ratio != 0:
                 continue
             compact = pop_i[pp, I_COMPACT] != 0
-            dg, st = np.float32(pop_par[pp, P_DG]), t // ratio
             dec = pop_par[pp, P_D1A + rec]
             scale = 1.0
             for a in range(ratio):
@@ -1170,7 +1146,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                                 u[kq] = 0.0
                                 g[0, kq] = 0.0
                                 g[1, kq] = 0.0
-                                g[2, kq] = _lazy_take(lz_g, lz_t, i, st, dg)
+                                g[2, kq] = g_rest[i]
+                                g_rest[i] = 0.0
                                 ref[kq] = 0.0
                             g[rec, kq] += dense_w[row + q] * sc
                     elif a == 0:  # (1D slices: these loops vectorise)
@@ -1230,6 +1207,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
             if kind == KIND_INPUT or (t + 1) % pop_i[pi, I_RATIO] != 0:
                 continue
             lo = pop_i[pi, I_LO]
+            if pop_lazy[pi] > 0.0:  # the unlisted neurons' GABA decays as the loop would decay it
+                _decay(g_rest[lo : pop_i[pi, I_HI]], np.float32(pop_par[pi, P_DG]))
             na = n_act[pi]
             if na == 0:
                 continue
@@ -1246,8 +1225,12 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                 cnt = _adex(u[lo:hi], nrn.w[lo:hi], g[0, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp,
                             pop_i[pi, I_NFINE])
             elif pop_i[pi, I_NFINE] > 1 and pop_i[pi, I_COMPACT] != 0 and pops.nmda[pi] == 0:
-                cnt = _lif_full_listed(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi],
-                                       buf.scr_f[0], pp, pop_i[pi, I_NFINE])
+                if par > 1 and na >= PAR_MIN:
+                    cnt = _lif_full_listed_par(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi],
+                                               flag[lo:hi], buf.scr_f[0, :na], pp, pop_i[pi, I_NFINE], par)
+                else:
+                    cnt = _lif_full_listed(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi],
+                                           buf.scr_f[0], pp, pop_i[pi, I_NFINE])
             elif pop_i[pi, I_NFINE] > 1:
                 cnt = _lif_full_fine(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp,
                                      pop_i[pi, I_NFINE])
@@ -1265,7 +1248,7 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
     for pi in range(pop_i.shape[0]):
         if pop_i[pi, I_COMPACT] != 0 and n_rest[pi] > 0 and COMPACT_FRACTION * n_rest[pi] >= n_act[pi]:
             n_act[pi] = _compact(pop_i[pi, I_LO], n_act[pi], nrn, buf, pop_i[pi, I_KIND] != KIND_LIF_AMPA,
-                                 np.float32(pop_lazy[pi]), (t0 + n_sub) // pop_i[pi, I_RATIO])
+                                 np.float32(pop_lazy[pi]))
             pop_ep[pi] += 1
             n_rest[pi] = 0
     prof_lap(prof, pb + BOOKKEEPING, tk)

@@ -19,7 +19,6 @@ from cerebx.snn.topology import (
     KIND_LIF_AMPA,
     KIND_LIF_FULL,
     N_SPAR,
-    P_DG,
     P_EL,
     S_DELAY,
     S_N_PRE,
@@ -174,8 +173,7 @@ class Network:
         self._g = np.zeros((3, n), dtype=np.float32)
         self._ref = np.zeros(n, dtype=np.float32)
         self.w = np.zeros(n, dtype=np.float32)  # adex_cond adaptation currents (pA), global index order
-        self.lz_g = np.zeros(n, dtype=np.float32)  # lazily kept GABA conductances (kernels), global index order
-        self.lz_t = np.zeros(n, dtype=np.int64)
+        self.g_rest = np.zeros(n, dtype=np.float32)  # GABA of unlisted neurons at rest (kernels), global index order
         self.flag = np.zeros(n, dtype=np.uint8)
         self.cid = np.arange(n, dtype=np.int32)
         self.slot = np.arange(n, dtype=np.int32)
@@ -260,7 +258,7 @@ class Network:
         written in place, so it stays valid for the network's life)."""
         return kernels.NetworkArrays(
             neurons=kernels.Neurons(self.u, self._g, self._ref, self.flag, self.cid, self.slot, self.n_act,
-                                    self.n_rest, self.pop_ep, self.w, self.lz_g, self.lz_t),
+                                    self.n_rest, self.pop_ep, self.w, self.g_rest),
             populations=kernels.Populations(self.pop_i, self.pop_par, self.poly, self.pop_lazy, self.pop_nmda),
             delivery=kernels.Delivery(self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
                                       self.sp_c, self.c_k, self.c_q, self.c_l, self.de_i, self.dense_w),
@@ -274,10 +272,10 @@ class Network:
     # ------------------------------------------------------------------ state
     def _set_neurons(self, V: np.ndarray, g: np.ndarray, ref: np.ndarray) -> None:
         """Kernel state from full per-neuron arrays: compact populations keep their non-resting
-        neurons, in index order; a neuron at rest but for a GABA conductance the kernels may keep lazily
-        (``pop_lazy``) has it kept so, as current at ``t_sub``."""
+        neurons, in index order; a neuron at rest but for a GABA conductance it may hold unlisted
+        (``pop_lazy``) has it in ``g_rest``."""
         n = len(self.u)
-        self.lz_g[:] = 0
+        self.g_rest[:] = 0
         self.u[:] = (V - self.el).astype(np.float32)
         self._g[:] = g
         self._ref[:] = ref
@@ -294,8 +292,7 @@ class Network:
             gmax = np.float32(self.pop_lazy[pi])
             kept = (gg[2] > 0) & (gg[2] <= gmax) & (u == 0) & (gg[:2] == 0).all(axis=0) & (r == 0)
             live = np.flatnonzero(((u != 0) | (gg != 0).any(axis=0) | (r != 0)) & ~kept)
-            self.lz_g[lo:hi][kept] = gg[2, kept]
-            self.lz_t[lo:hi][kept] = self.t_sub // int(self.pop_i[pi, I_RATIO])
+            self.g_rest[lo:hi][kept] = gg[2, kept]
             na = len(live)
             self.n_act[pi] = na
             self.slot[lo:hi] = -1
@@ -315,10 +312,8 @@ class Network:
             V[idx] = self.el[idx] + self.u[lo : lo + na]
             g[:, idx] = self._g[:, lo : lo + na]
             ref[idx] = self._ref[lo : lo + na]
-            if self.pop_lazy[pi] > 0:
-                hi = int(self.pop_hi[pi])
-                kernels.lazy_gaba_at(self.lz_g[lo:hi], self.lz_t[lo:hi], self.t_sub // int(self.pop_i[pi, I_RATIO]),
-                                     np.float32(self.pop_par[pi, P_DG]), g[2, lo:hi])
+            rest = self.g_rest[lo : int(self.pop_hi[pi])]
+            g[2, lo : int(self.pop_hi[pi])] = np.where(rest != 0, rest, g[2, lo : int(self.pop_hi[pi])])
         return V, g, ref
 
     @property
@@ -446,7 +441,7 @@ class Network:
         if "pop_lazy" not in state:  # pickled before lazy GABA: its populations keep the lists they had
             self.pop_lazy = np.zeros(len(self.pop_lo))
             self.pop_nmda = np.ones(len(self.pop_lo), np.uint8)
-            self.lz_g, self.lz_t = np.zeros_like(self._ref), np.zeros(len(self._ref), np.int64)
+            self.g_rest = np.zeros_like(self._ref)
         if self.scr_f.shape[0] < 5:  # its compaction scratch had 3 rows
             self.scr_f = np.zeros((5, self.scr_f.shape[1]), np.float32)
         self.prof = None

@@ -1,7 +1,8 @@
 """Granule cells under Golgi inhibition skipped at rest (issue #43): a large lif_cond population with NMDA/GABA
 input keeps a list of the neurons off rest, and a neuron at rest whose only nonzero state is a GABA conductance
-stays off that list, its conductance decayed when it is next touched by the same float32 products the
-integration loop applies. Every result equals the network that integrates every neuron, bit for bit."""
+stays off that list, its conductance decayed by the same float32 products the integration loop applies, in one
+vectorised pass over the population. Every result equals the network that integrates every neuron, bit for
+bit."""
 
 from __future__ import annotations
 
@@ -58,10 +59,10 @@ def test_a_gc_inhibited_once_is_skipped_then_driven_exactly_like_the_integrated_
         net.step(goc)  # one Golgi spike: arrives 1 ms later
     d = np.float32(lazy.pop_par[lazy.topo.index["gc"], P_DG])
     want = np.float32(0.2)  # arrives at substep 2, the start of GC step 1 (GC steps are 1 ms, two substeps)
-    for k in range(40):  # skipped: no GC is listed, its conductance kept lazily
+    for k in range(40):  # skipped: no GC is listed, its conductance held unlisted
         for net in (lazy, dense):
             net.step(none)
-        assert lazy.n_act[lazy.topo.index["gc"]] == 0 and (lazy.lz_g[gc] > 0).all()
+        assert lazy.n_act[lazy.topo.index["gc"]] == 0 and (lazy.g_rest[gc] > 0).all()
         _same(lazy, dense)
         # known answer: after control step k + 1 (t_sub = 4 (k + 2)) GC steps 1 .. 2k + 3 have decayed it once each
         for _ in range(3 if k == 0 else 2):
@@ -146,8 +147,8 @@ def test_a_golgi_granular_layer_steps_exactly_like_the_integrated_one_and_resume
     indeg = lambda k: {"kind": "fixed_indegree", "indegree": k}  # noqa: E731
     cfg = NetworkConfig.model_validate({
         "name": "layer", "dt_ms": 0.5,
-        "populations": {"mf": {"size": 100, "neuron": {"kind": "input"}}, "goc": {"size": 40, "neuron": {"kind": "input"}},
-                        "gc": {"size": 2000, "neuron": GC_GABA}},
+        "populations": {"mf": {"size": 100, "neuron": {"kind": "input"}},
+                        "goc": {"size": 40, "neuron": {"kind": "input"}}, "gc": {"size": 2000, "neuron": GC_GABA}},
         "projections": {
             "mf_gc": {"pre": "mf", "post": "gc", "rule": indeg(4), "receptor": "ampa", "synapses": 8000,
                       "weight_nS": 0.6},
@@ -161,7 +162,7 @@ def test_a_golgi_granular_layer_steps_exactly_like_the_integrated_one_and_resume
     _drive([lazy, dense], 300, *args)
     _same(lazy, dense)
     gc = lazy.topo.index["gc"]
-    assert 0 < lazy.n_act[gc] < 2000 and (lazy.lz_g != 0).sum() > 100  # some listed, many kept lazily
+    assert 0 < lazy.n_act[gc] < 2000 and (lazy.g_rest != 0).sum() > 100  # some listed, many held unlisted
     resumed = Network(cfg, parallel=False, compact_min=1)
     resumed.load_arrays(lazy.state_arrays())
     pickled = pickle.loads(pickle.dumps(lazy))
