@@ -28,7 +28,7 @@ Populations with NMDA/GABA input (DCN) run the RK stages in float32 with a branc
 (max abs error 1e-6 against the exact expression), so that loop vectorises too.
 
 Resting neurons are skipped exactly: a neuron with u == 0, g == 0 and not refractory stays so
-until input arrives (every RK stage is exactly 0). Large AMPA-only populations ("compact") keep
+until input arrives (every RK stage is exactly 0). Large lif_cond populations ("compact") keep
 their non-resting neurons packed in the front of the population's slice of u/g/ref, with
 ``cid`` (compact position -> global index) and ``slot`` (global index -> compact position, -1 at
 rest); delivered input activates a resting neuron by appending it, and neurons that came back
@@ -41,6 +41,16 @@ run), rebuilt after each compaction; each target receives exactly the same float
 the same order as without the cache. Conductances below 1e-12 nS and
 |u| below 1e-6 mV become exactly 0 (V itself is only resolved to 7.6e-6 mV in float32 near -65
 mV), so a neuron returns to rest a few tens of ms after its last input.
+
+Rest under GABA (the granule layer under Golgi inhibition): in a compact population with
+``clamp_at_rest`` and E_GABA <= E_L, a neuron at rest whose only input is a GABA conductance up to
+``Populations.lazy`` (``topology.lazy_gaba_nS``: the step from rest is then negative and clamped to
+exactly 0) stays unlisted. Its conductance lives in ``g_rest`` (global index order), takes the
+deliveries there in the same order and float32 operations as a listed neuron's, and decays with each
+step of the population in one vectorised pass (the integration loop's product, flushed below
+G_FLOOR). Activation moves it into the list; a compaction moves a listed neuron back. The listed
+neurons of a population without NMDA input compute their one-step estimates in a vectorised pass
+(``_lif_full_listed``, bit for bit ``_lif_full_fine``).
 """
 
 from __future__ import annotations
