@@ -653,18 +653,16 @@ def _lif_full_listed(u, gA, gN, gG, ref, flag, out, p, nf):
         _full_estimates(u, gA, gN, gG, est, h, dec, 1, m)
     else:
         _full_estimates(u, gA, gN, gG, est, h, dec, 0, m)
-    if nf > 1:
-        for i in range(n):
-            x = u[i]
-            if (x > ufine) | (est[i] > ufine):
-                a0, n0, b0 = gA[i], gN[i], gG[i]
-                un = x
-                for _ in range(nf):
-                    un = _full_rk(un, (a0, n0, b0), hf, fdec, method, m)
-                    a0, n0, b0 = a0 * fA, n0 * fN, b0 * fG
-                est[i] = un
     for i in range(n):
-        un = max(est[i], lo_u)
+        x = u[i]
+        un = est[i]
+        if nf > 1 and ((x > ufine) | (un > ufine)):
+            a0, n0, b0 = gA[i], gN[i], gG[i]
+            un = x
+            for _ in range(nf):
+                un = _full_rk(un, (a0, n0, b0), hf, fdec, method, m)
+                a0, n0, b0 = a0 * fA, n0 * fN, b0 * fG
+        un = max(un, lo_u)
         u[i] = un if abs(un) >= U_FLOOR else zero
     return _end_full(u, ref, flag, (gA, gN, gG), p)
 
