@@ -104,6 +104,52 @@ def _schema_problem(key: str, overrides: list[str], config_dir: str | None) -> s
     return None
 
 
+def _override_key(override: str) -> str:
+    return override.lstrip("+~").split("=", 1)[0]
+
+
+def through_references(overrides: list[str], config_dir: str | None, others: list[str] | None = None) -> list[str]:
+    """One line per override of ``overrides`` whose key passes through a reference of the composed config, such
+    as a population's ``neuron: ${...neurons.gc}``: Hydra cannot set a key inside one (it says "Could not
+    override", then with a '+' "already set", and with '++' replaces the reference). The line names the key to
+    set instead. ``others``: the whole command line (default ``overrides``)."""
+    dotted = [o for o in overrides if not _is_hydra(o) and "." in _override_key(o)]
+    if not dotted:
+        return []
+    base = [o for o in (others or overrides) if not _is_hydra(o) and "." not in _override_key(o)]
+    try:
+        with _COMPOSING, _hydra(config_dir):
+            cfg = hydra_compose(config_name="config", overrides=base)
+    except (HydraException, OmegaConfBaseException, ValueError):
+        return []
+    lines = []
+    for o in dotted:
+        parts = _override_key(o).split(".")
+        node: Any = cfg
+        for i, part in enumerate(parts[:-1]):
+            if not isinstance(node, DictConfig) or part not in node:
+                break
+            if OmegaConf.is_interpolation(node, part):
+                lines.append(_reference_line(o, parts, i, str(node._get_node(part)._value())))
+                break
+            node = node[part]
+    return lines
+
+
+def _reference_line(override: str, parts: list[str], i: int, text: str) -> str:
+    """The line for ``override`` whose key passes through the reference ``text`` at ``parts[i]``."""
+    key, ref, rest = ".".join(parts), ".".join(parts[: i + 1]), ".".join(parts[i + 1 :])
+    m = re.fullmatch(r"\$\{(\.*)([\w.]+)\}", text)
+    if m is None:
+        return f"{key}: {ref} is computed ({text}); a key inside it cannot be overridden: replace {ref} whole"
+    dots, path = len(m.group(1)), m.group(2)
+    target = path if dots == 0 else ".".join([*parts[: i - dots + 1], path])
+    value = override.split("=", 1)[1] if "=" in override else None
+    use = f"~{target}.{rest}" if value is None else f"{target}.{rest}={value}"
+    return (f"{key}: {ref} is a reference ({text}), and a key inside one cannot be overridden; use {use} (it "
+            f"applies to everything that refers to {target}), or replace {ref} whole")
+
+
 def _groups() -> list[str]:
     """Config groups of cerebx and its plugins (Hydra's own left out)."""
     return sorted({d.name for root in conf_roots() for d in root.iterdir() if d.is_dir() and d.name[0] not in "_."}
@@ -154,7 +200,8 @@ def compose_with_choices(overrides: list[str], config_dir: str | None = None) ->
             cfg = hydra_compose(config_name="config", overrides=[o for o in overrides if not _is_hydra(o)],
                                 return_hydra_config=True)
     except (HydraException, OmegaConfBaseException, ValueError) as err:
-        raise ConfigError(_hydra_lines(err, overrides, config_dir)) from None
+        lines = through_references(overrides, config_dir) or _hydra_lines(err, overrides, config_dir)
+        raise ConfigError(lines) from None
     choices = user_choices(cfg.hydra.runtime.choices)
     with open_dict(cfg):
         del cfg["hydra"]
@@ -245,7 +292,9 @@ def load(overrides: list[str], config_dir: str | None = None) -> tuple[Any, dict
         try:
             return validate(plain), plain
         except ConfigError as err:
-            raise ConfigError(_with_hints(err.problems, plain)) from None
+            added = [o for o in overrides if o.startswith("+") and "." in _override_key(o)]
+            raise ConfigError((added and through_references(added, config_dir, overrides))
+                              or _with_hints(err.problems, plain)) from None
 
 
 def _with_hints(problems: list[str], plain: dict[str, Any]) -> list[str]:

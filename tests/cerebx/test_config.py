@@ -115,6 +115,11 @@ INVALID = [
     (["+task=circle", "biodelay=d100", "spinal=[{kind:x}]"],
      "spinal: a config group takes option names, got {'kind': 'x'} in the list"),
     (["+task=circle", "delay=[45]"], "delay: a config group takes option names, got 45 in the list"),
+    # a key inside a reference (a population's `neuron: ${...neurons.pc}`): Hydra said "already set; drop the '+'"
+    *[(["+task=circle", f"{plus}controller.network.populations.pc.neuron.t_ref_ms=3"],
+       "controller.network.populations.pc.neuron.t_ref_ms: controller.network.populations.pc.neuron is a reference "
+       "(${...neurons.pc}), and a key inside one cannot be overridden; use controller.network.neurons.pc.t_ref_ms=3")
+      for plus in ("", "+", "++")],
 ]
 
 

@@ -41,21 +41,40 @@ def recorded_network(run: Path) -> tuple[dict, int]:
 
 def load_learned(cfg: NetworkConfig, topo: Topology, run: Path) -> Path:
     """Write the weights ``run`` learned into ``topo`` (built from ``cfg`` with the run's seed); returns the
-    state file. Refuses (one line) a state saved from a network of another structure."""
+    state file. Refuses (one line) a state saved from a network of another structure. The saved arrays hold the
+    projections' weights in the order the saving network listed them (recorded in the state's ``layout``; a
+    state saved before that follows ``cfg``'s order): each projection's block is found by its name, so ``cfg``
+    may list its projections in another order."""
     path = state_file(run)
     data, meta = load_state_npz(path, "SNN")
     if meta.get("fingerprint") != cfg.fingerprint():
         raise CerebxError(f"{path}: saved from network {meta.get('network')!r} of another structure than "
                           f"{cfg.name!r} (fingerprint {meta.get('fingerprint')}, not {cfg.fingerprint()})")
+    order = list((meta.get("layout") or {}).get("projections") or cfg.projections)
+    if sorted(order) != sorted(cfg.projections):
+        raise CerebxError(f"{path}: its projections ({', '.join(order)}) are not those of {cfg.name!r}")
+    dense_n = {d.name: d.n_pre * d.n_post for d in topo.dense}
     dense = data["net_dense_w"] if "net_dense_w" in data.files else None
     if dense is None or dense.shape != topo.dense_w.shape:
         raise CerebxError(f"{path}: its dense weights do not fit {cfg.name!r}")
-    topo.dense_w[:] = dense
-    pieces = np.cumsum([0] + [len(s.w) for s in topo.sparse])
+    at = _blocks(order, dense_n)
+    for d in topo.dense:
+        topo.dense_w[d.w_off : d.w_off + dense_n[d.name]] = dense[at[d.name] : at[d.name] + dense_n[d.name]]
     if "net_sp_w" in data.files:
-        sp_w = data["net_sp_w"]
-        if len(sp_w) != pieces[-1]:
-            raise CerebxError(f"{path}: its {len(sp_w)} sparse weights do not fit the {pieces[-1]} of {cfg.name!r}")
-        for k, s in enumerate(topo.sparse):
-            s.w[:] = sp_w[pieces[k] : pieces[k + 1]]
+        sparse_n: dict[str, int] = {}
+        for s in topo.sparse:
+            sparse_n[s.name] = sparse_n.get(s.name, 0) + len(s.w)
+        sp_w, total = data["net_sp_w"], sum(sparse_n.values())
+        if len(sp_w) != total:
+            raise CerebxError(f"{path}: its {len(sp_w)} sparse weights do not fit the {total} of {cfg.name!r}")
+        at = _blocks(order, sparse_n)
+        for s in topo.sparse:  # the pieces of a projection are consecutive, in the same order in both
+            s.w[:] = sp_w[at[s.name] : at[s.name] + len(s.w)]
+            at[s.name] += len(s.w)
     return path
+
+
+def _blocks(order: list[str], length: dict[str, int]) -> dict[str, int]:
+    """Where each projection's block starts in an array of blocks laid out in ``order`` (those in ``length``)."""
+    starts = np.cumsum([0] + [length[n] for n in order if n in length])
+    return {n: int(a) for n, a in zip([n for n in order if n in length], starts)}

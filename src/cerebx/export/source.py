@@ -31,16 +31,24 @@ def load_network(source: str, overrides: list[str] | None = None) -> NetworkConf
         for item in overrides or []:
             _override(net, item, source)
         return _validate(_sized(net, doc if isinstance(doc, dict) else {}, source), source)
-    from cerebx.config import compose, to_plain  # Hydra only when a preset is composed
+    from cerebx.config import compose, through_references, to_plain  # Hydra only when a preset is composed
 
+    args = ["+task=circle", f"network={source}", *(overrides or [])]
     try:
-        plain = to_plain(compose(["+task=circle", f"network={source}", *(overrides or [])]))
+        plain = to_plain(compose(args))
     except ConfigError as err:
         raise CerebxError(err.problems[0]) from None
     net = _network_part(plain)
     if net is None:
         raise CerebxError(f"{source}: the composed controller has no network")
-    return _validate(_sized(net, plain, f"network={source}"), f"network={source}")
+    try:
+        return _validate(_sized(net, plain, f"network={source}"), f"network={source}")
+    except CerebxError:
+        added = [o for o in args if o.startswith("+") and "." in o.split("=", 1)[0]]
+        problems = through_references(added, None, args) if added else []
+        if problems:
+            raise CerebxError(problems[0]) from None
+        raise
 
 
 def _sized(net: dict, experiment: dict, where: str) -> dict:

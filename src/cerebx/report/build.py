@@ -313,9 +313,25 @@ a MuJoCo model); the shapes and orderings are what should hold.</p>
     return index, problems + missing, len(runs)
 
 
+def borrowed_missing(jobs: list) -> str | None:
+    """The line saying which studies a quick report draws from the full profile lack runs there (None: none)."""
+    lacking = list(dict.fromkeys(j.study for j in jobs if j.borrowed and not j.done()))
+    if not lacking:
+        return None
+    return (f"report: {len(lacking)} studies cannot converge in this profile and are drawn from the full profile's "
+            f"runs, which are missing ({', '.join(lacking)}): run cerebx report --profile full to draw their figures")
+
+
 def dry_run(jobs: list, folder: Path, parallel: int) -> None:
-    """Print each job (reused or to run) and the estimate of those to run: on a quiet machine
-    (``cerebx.estimate``) and at the pace of the profile's finished runs (``report/pace.py``) when some are."""
+    """Print each job (reused or to run; ``full``: a full-profile run a quick report draws on, ``lacks``: one that
+    does not exist yet) and the estimate of those to run: on a quiet machine (``cerebx.estimate``) and at the pace
+    of the profile's finished runs (``report/pace.py``) when some are."""
+    lent = [j for j in jobs if j.borrowed]
+    for j in lent:
+        print(f"{'full ' if j.done() else 'lacks'} {j.run_dir}  (from the full profile: not run by this one)")
+    if lacking := borrowed_missing(lent):
+        print(lacking)
+    jobs = [j for j in jobs if not j.borrowed]
     done = [j.done() for j in jobs]
     for j, d in zip(jobs, done, strict=True):
         print(f"{'reuse' if d else 'run  '} {j.run_dir}  cerebx run {' '.join(j.overrides())}")
@@ -346,8 +362,9 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--profile", choices=("quick", "full"),
                     help="run the missing studies of this profile into runs/report/PROFILE first")
     ap.add_argument("--figures", help="comma-separated figure names (default: all; --list shows them)")
-    ap.add_argument("--jobs", type=int, default=2, help="studies run at once (default 2); each is one "
-                    "`cerebx run -m`, whose launcher runs its jobs")
+    ap.add_argument("--jobs", type=int, default=2, help="multiruns at once (default 2); each is one "
+                    "`cerebx run -m`, whose launcher runs its jobs; a sweep is split into this many multiruns "
+                    "side by side (by its swept key with the most values), so one long sweep keeps every core busy")
     ap.add_argument("-o", "--override", action="append", default=[], metavar="OVERRIDE",
                     help="Hydra override for every study's multirun, e.g. -o hydra/launcher=slurm "
                     "(repeatable; see docs/guide/sweeps.md)")
@@ -374,12 +391,15 @@ def main(argv: list[str]) -> int:
                 dry_run(jobs, root / a.profile, a.jobs)
                 return 0
             try:
-                failed = execute(group(jobs), runner=study_runner(a.override), parallel=a.jobs)
+                failed = execute(group([j for j in jobs if not j.borrowed], a.jobs), runner=study_runner(a.override),
+                                 parallel=a.jobs)
             except KeyboardInterrupt:
                 print("report: interrupted; finished runs are kept (run the same command again to resume)",
                       file=sys.stderr)
                 return 130
-            dirs = [j.run_dir for j in jobs]
+            if lacking := borrowed_missing(jobs):
+                print(lacking, file=sys.stderr)
+            dirs = [j.run_dir for j in jobs if not j.borrowed or j.done()]
         else:
             dirs = []
             for p in a.runs or [Path("runs")]:

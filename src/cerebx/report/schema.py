@@ -27,6 +27,10 @@ class ProfileSpec(Strict):
     init_from: str | None = Field("inherit", description="start from this study's run instead (null: scratch)")
     seeds: int = Field(1, ge=1, le=20, description="independently learned seeds (seed 0 .. seeds-1; each more "
                        "seed k runs as the study <name>~seed<k>)")
+    from_full: bool = Field(False, description="quick only: the learning behind this study cannot reach its plateau "
+                            "in the quick profile's budget, so the quick profile does not run it (nor the studies "
+                            "that start from it); their figures are drawn from the full profile's runs when they "
+                            "exist (cerebx report --profile quick --dry-run lists them)")
 
 
 class PlateauSpec(Strict):

@@ -18,6 +18,7 @@ fewer). The figures draw their curves from the first seed and take their headlin
 from __future__ import annotations
 
 import functools
+import re
 import shutil
 import signal
 import subprocess
@@ -81,6 +82,9 @@ def load_studies(*paths: Path) -> dict[str, StudySpec]:
                 raise ConfigError(f"{path}: studies.{name}: already defined in {where[name]}")
             studies[name], where[name] = spec, path
     for name, s in studies.items():
+        if s.full.from_full:
+            raise ConfigError(f"{where[name]}: studies.{name}.full.from_full: only the quick profile can draw on "
+                              "the full profile's runs")
         for prof in PROFILES:
             if getattr(s, prof).seeds > 1 and any(_key(a) == "seed" for a in [*s.args, *getattr(s, prof).args]):
                 raise ConfigError(f"{where[name]}: studies.{name}.{prof}.seeds: the study sets its seed itself "
@@ -219,6 +223,7 @@ class Job:
 
     sweep_args: list[str] = field(default_factory=list)  # this job's point of its preset's sweep
     sweeps: list[str] = field(default_factory=list)  # the study's args that sweep several values (seed=0,1,2)
+    borrowed: bool = False  # a full-profile run a quick report draws on (from_full): used if done, never run
 
     def overrides(self) -> list[str]:
         return [*self.common(), *self.sweep_args]
@@ -266,7 +271,8 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
     ``max_seeds``: only the first seeds of studies learned from more (e.g. 1: every study's first seed)."""
     if profile not in PROFILES:
         raise ConfigError(f"--profile: {profile!r} is not one of {', '.join(PROFILES)}")
-    studies = with_replicas(load_studies() if studies is None else studies, profile, max_seeds)
+    given = load_studies() if studies is None else studies
+    studies = with_replicas(given, profile, max_seeds)
     wanted: list[str] = []
 
     def want(n: str) -> None:
@@ -283,7 +289,17 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
 
     for n in names if names is not None else list(studies):
         want(n)
+    borrowed: list[str] = []  # from_full, or starting from a study that is: the full profile's runs
+    for n in wanted:
+        if getattr(studies[n], profile).from_full or _init_from(studies[n], profile) in borrowed:
+            borrowed.append(n)
     jobs: list[Job] = []
+    if borrowed:
+        bases = list(dict.fromkeys(n.split(REPLICA)[0] for n in borrowed))
+        jobs = plan("full", root, bases, given, max_seeds)
+        for j in jobs:
+            j.borrowed = True
+        wanted = [n for n in wanted if n not in borrowed]
     single: dict[str, Job] = {}
     by_label: dict[tuple[str, str], Job] = {}
     for n in wanted:
@@ -307,11 +323,12 @@ def plan(profile: str, root: Path, names: list[str] | None = None,
 
 @dataclass
 class Study:
-    """The jobs of one study, run together as one ``cerebx run -m``."""
+    """The jobs of one study, run together as one ``cerebx run -m`` (or a part of them: see :func:`group`)."""
 
     name: str
     jobs: list[Job]
     deps: list[Study] = field(default_factory=list, repr=False)
+    part: tuple[str, tuple[str, ...], int] | None = None  # (swept key, its values in this part, part number)
 
     @property
     def sweep_dir(self) -> Path:
@@ -324,6 +341,11 @@ class Study:
     @property
     def run_dir(self) -> Path:  # where its log goes
         return self.sweep_dir
+
+    @property
+    def log_name(self) -> str:
+        """Its ``cerebx run -m``'s log in :attr:`sweep_dir` (a part has its own: parts run side by side)."""
+        return "study.log" if self.part is None else f"study.{self.part[2]}.log"
 
     def done(self) -> bool:
         return all(j.done() for j in self.jobs)
@@ -340,8 +362,11 @@ class Study:
         """``cerebx run -m`` overrides: the shared ones, then where the jobs go, then ``extra`` (a launcher)."""
         common = self.jobs[0].common()
         swept = bool(self.jobs[0].sweep_args)
-        out = ["-m", *self.jobs[0].common(sweeps=True), "resume=auto", "recording.progress=off",
-               f"hydra.sweep.dir='{self.sweep_dir}'"]
+        shared = self.jobs[0].common(sweeps=True)
+        if self.part is not None:  # this part's values of one swept key replace the study's (the preset's too:
+            key, values, _ = self.part  # Hydra's basic sweeper lets the command line win)
+            shared = [*(a for a in shared if _key(a) != key), f"{key}={','.join(values)}"]
+        out = ["-m", *shared, "resume=auto", "recording.progress=off", f"hydra.sweep.dir='{self.sweep_dir}'"]
         if swept and self.name == self.jobs[0].name:  # one job of a paired study: its sweep point fixed
             out += [*self.jobs[0].sweep_args, f"hydra.sweep.subdir='{self.jobs[0].label}'"]
         elif swept:
@@ -353,17 +378,48 @@ class Study:
         return [*out, *extra]
 
 
-def group(jobs: list[Job]) -> list[Study]:
+_PLAIN_VALUE = re.compile(r"[\w.+-]+")  # a sweep value that can be listed again with commas as it is
+
+
+def split_sweep(jobs: list[Job], parts: int) -> list[tuple[str, tuple[str, ...]]]:
+    """How a sweep's ``jobs`` share out over ``parts`` multiruns side by side: the swept key with the most
+    values, its values dealt in turn (``seed=0,2,4…`` and ``seed=1,3,5…``), so that each part holds every
+    value of the other keys and the parts take about as long. ``[]`` when it does not split (one part, fewer
+    than two values, or values that cannot be written back as a comma list)."""
+    values: dict[str, dict[str, None]] = {}
+    for j in jobs:
+        for arg in j.sweep_args:
+            key, _, value = arg.partition("=")
+            values.setdefault(key, {})[value] = None
+    plain = {k: list(v) for k, v in values.items() if all(_PLAIN_VALUE.fullmatch(x) for x in v)}
+    if parts < 2 or not plain:
+        return []
+    key = max(plain, key=lambda k: len(plain[k]))
+    n = min(parts, len(plain[key]))
+    return [(key, tuple(plain[key][i::n])) for i in range(n)] if n > 1 else []
+
+
+def group(jobs: list[Job], parts: int = 1) -> list[Study]:
     """The jobs as studies (in plan order), each depending on the studies its jobs start from. A study whose
     jobs start from the jobs of the same sweep values of another (paired) runs each job as its own multirun
-    of one job, as each has its own ``init_from``."""
+    of one job, as each has its own ``init_from``. ``parts``: a sweep is run as that many multiruns side by
+    side into its folder (:func:`split_sweep`), so that one long sweep keeps every core busy."""
     studies: dict[str, Study] = {}
     of_job: dict[str, Study] = {}
     for j in jobs:
         paired = bool(j.sweep_args) and any(d.sweep_args for d in j.deps)
         st = studies.setdefault(j.name if paired else j.study, Study(j.name if paired else j.study, []))
         st.jobs.append(j)
-        of_job[j.name] = st
+    for name, st in list(studies.items()):
+        split = split_sweep(st.jobs, parts) if st.jobs[0].sweep_args and st.name == st.jobs[0].study else []
+        if split:
+            del studies[name]
+            for k, (key, values) in enumerate(split, 1):
+                mine = [j for j in st.jobs if any(f"{key}={v}" in j.sweep_args for v in values)]
+                studies[f"{name}:{k}/{len(split)}"] = Study(f"{name}:{k}/{len(split)}", mine, part=(key, values, k))
+    for st in studies.values():
+        for j in st.jobs:
+            of_job[j.name] = st
     for st in studies.values():
         st.deps = list({id(of_job[d.name]): of_job[d.name] for j in st.jobs for d in j.deps
                         if d.name in of_job}.values())
@@ -404,7 +460,7 @@ def study_runner(extra: list[str] = ()) -> Runner:
     def run(study: Study) -> int:
         study.sweep_dir.mkdir(parents=True, exist_ok=True)
         cmd = [sys.executable, "-m", "cerebx", "run", *study.overrides(list(extra))]
-        return _run_logged(cmd, study.sweep_dir / "study.log", "a")
+        return _run_logged(cmd, study.sweep_dir / study.log_name, "a")
 
     return run
 
@@ -473,7 +529,7 @@ class _Scheduler:
                 self.running[pool.submit(self.runner, j)] = j
 
     def _record(self, j: Any, fut: Future) -> None:
-        logname = "study.log" if isinstance(j, Study) else "job.log"
+        logname = j.log_name if isinstance(j, Study) else "job.log"
         try:
             rc, why = fut.result(), f"see {j.run_dir / logname}"
         except Exception as err:  # a runner that raises is a failed job, not a failed report

@@ -171,14 +171,19 @@ def _off(prof) -> bool:
     return isinstance(prof, (types.NoneType, types.Omitted))
 
 
-@overload(prof_now, inline="always")
+# Not inline="always": after inlining an overload, numba (0.68) runs a typed dead-code elimination whose alias
+# analysis does not follow arrays taken out of a tuple (the KernelState's NamedTuples): a store into such an array
+# that is not read again in the function is dropped as dead. run_step lost the LTP's row mark
+# (plast.dirty[pl, j] = 1), so checkpoints missed rows that only LTP had changed and resumed runs diverged.
+# Called, these compile to a few instructions that LLVM inlines.
+@overload(prof_now)
 def _now_impl(prof):
     if _off(prof):
         return lambda prof: 0
     return lambda prof: _clock_ns()
 
 
-@overload(prof_lap, inline="always")
+@overload(prof_lap)
 def _lap_impl(prof, k, t0):
     if _off(prof):
         return lambda prof, k, t0: t0

@@ -530,6 +530,12 @@ class NetworkConfig(Strict):
         }
         return hashlib.sha256(json.dumps(shape, sort_keys=True).encode()).hexdigest()[:16]
 
+    def layout(self) -> dict[str, list[str]]:
+        """The order of the populations and projections, which the state arrays follow (neurons by population,
+        weights by projection) and :meth:`fingerprint` leaves out; a learned state records it beside the
+        fingerprint (:func:`layout_problem`)."""
+        return {"populations": list(self.populations), "projections": list(self.projections)}
+
     @property
     def n_neurons(self) -> int:
         return sum(p.size for p in self.populations.values())
@@ -541,6 +547,20 @@ class NetworkConfig(Strict):
     @property
     def n_plastic(self) -> int:
         return sum(p.synapses for p in self.projections.values() if p.plasticity is not None)
+
+
+def layout_problem(saved: Any, cfg: NetworkConfig) -> str | None:
+    """Why a state whose metadata recorded the layout ``saved`` (:meth:`NetworkConfig.layout`) cannot be loaded
+    into ``cfg`` of the same fingerprint: its arrays follow another order of populations or projections. A state
+    saved before the layout was recorded (``saved`` None) is taken as before, in ``cfg``'s order."""
+    if saved is None:
+        return None
+    want = cfg.layout()
+    for key in ("populations", "projections"):
+        if list(saved.get(key, want[key])) != want[key]:
+            return (f"was saved with its {key} in the order {', '.join(saved[key])}, which its arrays follow, but "
+                    f"network {cfg.name!r} lists them as {', '.join(want[key])}: list them in the saved order")
+    return None
 
 
 def _plasticity_problems(where: str, p: Projection, projections: dict[str, Projection]) -> list[str]:

@@ -236,22 +236,32 @@ def test_a_plugin_registers_its_kinds_export_through_the_api():
         mapping.CONNECTORS.pop("my_rule", None)
 
 
-def test_learned_weights_of_a_run_are_exported(tmp_path, capsys):
-    """``--weights RUN``: the npz holds the saved state's weights (count and sum per projection), not the initial
-    ones; a state of another network is refused in one line."""
+def _learned_state(tmp_path, seed: int, layout: bool, pc_dcn_weight=None):
+    """A small network with pair STDP on MF-DCN, its weights drawn at random (as if learned), saved as a run's
+    ``controller_state.npz`` in ``tmp_path`` (``layout``: with the populations' and projections' order, as
+    states are saved now; without: as before it was recorded)."""
     from cerebx.persistence.state import save_state_npz
     from cerebx.snn.network import Network
 
     d = network_dict(joints=1, fibers=2, per_joint=4)
     d["projections"]["mf_dcn"].update(rule={"kind": "fixed_indegree", "indegree": 2}, synapses=8)
+    if pc_dcn_weight is not None:
+        d["projections"]["pc_dcn"].update(weight_nS=pc_dcn_weight)
     _with_plasticity(d, "mf_dcn", dict(PAIR, delay="dendritic"))
     cfg = NetworkConfig.model_validate(d)
     net = Network(cfg, parallel=False)
-    rng = np.random.default_rng(4)
+    rng = np.random.default_rng(seed)
     net.dense_w[:] = rng.uniform(0, 5, net.dense_w.size)
     net.sp_w[:] = rng.uniform(0, 1, net.sp_w.size)
-    state = {f"net_{k}": v for k, v in net.state_arrays().items()}
-    save_state_npz(tmp_path / "controller_state.npz", {"fingerprint": cfg.fingerprint(), "network": cfg.name}, **state)
+    meta = {"fingerprint": cfg.fingerprint(), "network": cfg.name, **({"layout": cfg.layout()} if layout else {})}
+    save_state_npz(tmp_path / "controller_state.npz", meta, **{f"net_{k}": v for k, v in net.state_arrays().items()})
+    return cfg, net
+
+
+def test_learned_weights_of_a_run_are_exported(tmp_path, capsys):
+    """``--weights RUN``: the npz holds the saved state's weights (count and sum per projection), not the initial
+    ones; a state of another network is refused in one line."""
+    cfg, net = _learned_state(tmp_path, seed=4, layout=False)
     src = tmp_path / "net.yaml"
     src.write_text(yaml.safe_dump(cfg.model_dump(), sort_keys=False))  # the synapses' order is the projections'
     assert main(["export", str(src), "--weights", str(tmp_path / "controller_state.npz"), "--static", "--approximate",
@@ -302,3 +312,47 @@ def test_a_network_written_per_joint_is_sized_for_the_composed_plant(tmp_path):
     bare.write_text("populations: {}\nprojections: {}\nper_joint: {pc: 10}\n")
     with pytest.raises(CerebxError, match="per_joint: the network is sized from a plant"):
         load_network(str(bare))
+
+
+def test_a_preset_population_s_integration_is_set_through_its_neuron():
+    """A preset's population names its neuron by reference (``neuron: ${...neurons.gc}``). Setting a key inside the
+    reference failed with Hydra's contradictory "already set; drop the leading '+'" (or, with '++', replaced the
+    neuron by the one key); the line now names the key that works, and that key sets the population's step."""
+    from cerebx.errors import CerebxError
+    from cerebx.export.source import load_network
+
+    cfg = load_network("small_golgi", ["controller.network.dt_ms=0.1",
+                                       "controller.network.neurons.gc.integration={method: rk4, dt_ms: null}"])
+    gc = cfg.populations["gc"].neuron
+    assert cfg.dt_ms == 0.1 and gc.integration.method == "rk4" and gc.integration.dt_ms is None
+    assert gc.clamp_at_rest and load_network("small_golgi").populations["gc"].neuron.integration.dt_ms == 1.0
+    for plus in ("", "+", "++"):
+        with pytest.raises(CerebxError) as err:
+            load_network("small_golgi", [f"{plus}controller.network.populations.gc.neuron.integration.dt_ms=0.1"])
+        assert str(err.value) == (
+            "controller.network.populations.gc.neuron.integration.dt_ms: controller.network.populations.gc.neuron "
+            "is a reference (${...neurons.gc}), and a key inside one cannot be overridden; use "
+            "controller.network.neurons.gc.integration.dt_ms=0.1 (it applies to everything that refers to "
+            "controller.network.neurons.gc), or replace controller.network.populations.gc.neuron whole")
+
+
+def test_learned_weights_are_found_by_projection_name(tmp_path, capsys):
+    """The saved weights follow the saving network's projection order, which the fingerprint leaves out: with the
+    order recorded in the state (``layout``), a network file listing the projections in another order (here
+    sorted, as ``yaml.safe_dump`` writes a dict) exports each projection's own weights."""
+    cfg, net = _learned_state(tmp_path, seed=5, layout=True,
+                              pc_dcn_weight={"dist": "uniform", "low": 0.5, "high": 1.5})
+    src = tmp_path / "net.yaml"
+    src.write_text(yaml.safe_dump(cfg.model_dump()))  # sorted keys: another projection order, same fingerprint
+    assert list(yaml.safe_load(src.read_text())["projections"]) != list(cfg.projections)
+    assert main(["export", str(src), "--weights", str(tmp_path / "controller_state.npz"), "--static", "--approximate",
+                 "--out", str(tmp_path / "out")]) == 0
+    capsys.readouterr()
+    _, tables = read_npz(tmp_path / "out" / "network.npz")
+    for name in ("mf_gc", "mf_dcn", "pc_dcn", "cf_pc", "cf_dcn_ampa"):
+        pre, post, w = net.sparse_weights(name)
+        order = np.lexsort((post, pre))
+        mine = np.lexsort((tables[name]["post"], tables[name]["pre"]))
+        np.testing.assert_array_equal(tables[name]["w"][mine], w[order], err_msg=name)
+    block = net.topo.dense_block(next(x for x in net.topo.dense if x.name == "pf_pc"))
+    np.testing.assert_array_equal(tables["pf_pc"]["w"], block)

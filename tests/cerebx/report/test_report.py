@@ -237,20 +237,20 @@ def test_studies_are_multiruns_of_their_presets(tmp_path):
 def test_init_from_a_study_with_the_same_sweep_pairs_jobs_by_sweep_value(tmp_path):
     from cerebx.report.studies import group
 
-    jobs = plan("quick", tmp_path, ["fig4_6a"])
+    jobs = plan("full", tmp_path, ["fig4_6a"], max_seeds=1)  # quick draws Fig. 4.6 A from full
     by_name = {j.name: j for j in jobs}
     for k in (0, 1, 5, 9, 10, 12):
         job = by_name[f"fig4_6a/muscle.cocontraction={k}"]
         assert [d.name for d in job.deps] == [f"fig4_6a_learn/muscle.cocontraction={k}"]
-        assert f"init_from='{tmp_path}/quick/fig4_6a_learn/muscle.cocontraction={k}'" in job.overrides()
+        assert f"init_from='{tmp_path}/full/fig4_6a_learn/muscle.cocontraction={k}'" in job.overrides()
     studies = group(jobs)
     assert [s.name for s in studies][0] == "fig4_6a_learn" and len(studies) == 7  # one multirun per paired job
     one = studies[3]
     assert one.name == "fig4_6a/muscle.cocontraction=5" and one.deps == [studies[0]]
     ov = one.overrides()
     assert "muscle.cocontraction=5" in ov and "hydra.sweep.subdir='muscle.cocontraction=5'" in ov
-    assert f"init_from='{tmp_path}/quick/fig4_6a_learn/muscle.cocontraction=5'" in ov
-    assert f"hydra.sweep.dir='{tmp_path}/quick/fig4_6a'" in ov
+    assert f"init_from='{tmp_path}/full/fig4_6a_learn/muscle.cocontraction=5'" in ov
+    assert f"hydra.sweep.dir='{tmp_path}/full/fig4_6a'" in ov
     bad = tmp_path / "studies.yaml"
     bad.write_text("studies:\n  a:\n    args: [+experiment=fig3_4_pd]\n"
                    "    quick: {trials: 1}\n    full: {trials: 2}\n"
@@ -274,3 +274,88 @@ def test_plant_realism_takes_the_study_runs_not_chapter_3_runs_on_the_same_plant
     runs = RunSet([study, run("fig3_4", "snn_delays", [150.0], 102, 0.019),
                    run("multikernel", "snn", [100.0, 150.0, 200.0], 102, 0.033)])
     assert realism_cells(runs) == {("baxter", "snn", 0.0): study}
+
+
+def test_a_sweep_is_split_so_that_every_core_runs_part_of_it(tmp_path):
+    """One long sweep would leave a core idle: with two parts, each multirun sweeps every other value of the
+    key with the most values, into the same folder, with its own log, and the parts hold every job once."""
+    from cerebx.report.studies import group, split_sweep
+
+    f = tmp_path / "studies.yaml"
+    f.write_text("studies:\n  a:\n    args: [+experiment=fig3_4_pd, 'seed=0,1,2']\n"
+                 "    quick: {trials: 1}\n    full: {trials: 2}\n")
+    jobs = plan("quick", tmp_path, studies=load_studies(f))
+    assert len(jobs) == 15  # 5 delays x 3 seeds
+    assert split_sweep(jobs, 2) == [("delay.total_ms", ("0", "40", "80")), ("delay.total_ms", ("20", "60"))]
+    assert split_sweep(jobs, 1) == [] and split_sweep(jobs[:1], 2) == []
+    parts = group(jobs, 2)
+    assert [p.name for p in parts] == ["a:1/2", "a:2/2"]
+    assert sorted(j.name for p in parts for j in p.jobs) == sorted(j.name for j in jobs)
+    ov = parts[1].overrides()
+    assert "delay.total_ms=20,60" in ov and "seed=0,1,2" in ov
+    assert {p.sweep_dir for p in parts} == {tmp_path / "quick" / "a"}
+    assert [p.log_name for p in parts] == ["study.1.log", "study.2.log"]
+    assert group(jobs)[0].log_name == "study.log" and len(group(jobs)) == 1
+    # the command-line values win over the preset's sweep: Hydra runs exactly this part's jobs
+    from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+
+    parsed = OverridesParser.create().parse_overrides(["delay.total_ms=0,20,40,60,80", "delay.total_ms=20,60"])
+    (batch,) = BasicSweeper.split_arguments(parsed, None)
+    assert sorted(o[0] for o in batch) == ["delay.total_ms=20", "delay.total_ms=60"]
+
+
+def test_the_parts_of_a_split_sweep_run_side_by_side_and_its_dependents_wait(tmp_path):
+    from cerebx.report.studies import group
+
+    ran: list[str] = []
+
+    def fake(study) -> int:
+        ran.append(study.name)
+        for job in study.jobs:
+            _complete(job)
+        return 0
+
+    jobs = plan("full", tmp_path, ["fig4_6a"], max_seeds=1)
+    studies = group(jobs, 2)
+    learn = [s for s in studies if s.name.startswith("fig4_6a_learn:")]
+    assert len(learn) == 2 and all(len(s.jobs) == 3 for s in learn)
+    paired = next(s for s in studies if s.name == "fig4_6a/muscle.cocontraction=5")
+    assert paired.deps == [next(s for s in learn if any(j.label == "muscle.cocontraction=5" for j in s.jobs))]
+    execute(studies, runner=fake, parallel=2, log=lambda line: None)  # (the fake saves no state to start from)
+    assert set(ran[:2]) == {s.name for s in learn} and len(ran) == 8  # both parts first, then the 6 that wait
+
+
+def test_a_study_that_cannot_converge_in_quick_is_drawn_from_the_full_profile(tmp_path, capsys):
+    """from_full: the quick profile runs neither the study nor those starting from it; it draws on their
+    full-profile runs when they exist, and the dry run says which are there and which lack."""
+    from cerebx.report.build import dry_run
+    from cerebx.report.studies import group
+
+    f = tmp_path / "studies.yaml"
+    f.write_text("studies:\n"
+                 "  learn:\n    args: [+experiment=learn_circle_ch3]\n"
+                 "    quick: {trials: 3, from_full: true}\n    full: {trials: 5}\n"
+                 "  evaluate:\n    args: [+experiment=fig3_4_snn, delay.total_ms=0]\n    init_from: learn\n"
+                 "    quick: {trials: 2}\n    full: {trials: 4}\n"
+                 "  pd:\n    args: [+experiment=fig3_4_pd, delay.total_ms=0]\n"
+                 "    quick: {trials: 2}\n    full: {trials: 4}\n")
+    studies = load_studies(f)
+    jobs = plan("quick", tmp_path, studies=studies)
+    by = {j.study: j for j in jobs}
+    assert by["learn"].borrowed and by["evaluate"].borrowed and not by["pd"].borrowed
+    assert by["learn"].run_dir == tmp_path / "full" / "learn" / "run" and by["learn"].trials == 5
+    assert by["evaluate"].trials == 4 and by["pd"].run_dir == tmp_path / "quick" / "pd" / "run"
+    assert [s.name for s in group([j for j in jobs if not j.borrowed])] == ["pd"]
+    dry_run(jobs, tmp_path / "quick", 2)
+    out = capsys.readouterr().out
+    assert f"lacks {tmp_path / 'full' / 'learn' / 'run'}" in out
+    assert "cannot converge" in out and "learn, evaluate" in out
+    _complete(by["learn"])
+    dry_run(plan("quick", tmp_path, studies=studies), tmp_path / "quick", 2)
+    assert f"full  {tmp_path / 'full' / 'learn' / 'run'}" in capsys.readouterr().out
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("studies:\n  a:\n    args: [+experiment=fig3_4_pd]\n"
+                   "    quick: {trials: 1}\n    full: {trials: 2, from_full: true}\n")
+    with pytest.raises(ConfigError, match="full.from_full: only the quick profile"):
+        load_studies(bad)

@@ -218,6 +218,39 @@ def test_save_load_roundtrip_and_mismatch(tmp_path):
         b.load_state(bad)
 
 
+def test_a_state_follows_the_order_of_its_network_s_projections(tmp_path):
+    """The fingerprint leaves the order of populations and projections out (a state is about sizes and
+    connections), but the saved arrays follow it: a state records its layout, and a network that lists the same
+    projections in another order refuses it, at validation (init_from) and on load, in one line. A state saved
+    before the layout was recorded is read in the network's order, as before."""
+    from cerebx.persistence.state import load_state_npz, save_state_npz
+    from cerebx.snn.schema import NetworkConfig
+
+    a = make_ctrl()
+    drive(a, 20)
+    a.save_state(tmp_path / "s.npz")
+    d = a.net_cfg.model_dump()
+    d["projections"] = dict(reversed(d["projections"].items()))
+    turned = NetworkConfig.model_validate(d)
+    assert turned.fingerprint() == a.net_cfg.fingerprint() and turned.layout() != a.net_cfg.layout()
+    _, meta = load_state_npz(tmp_path / "s.npz", "SNN")
+    assert meta["layout"] == a.net_cfg.layout()
+    ccfg = SNNController(network=turned, mf=BoxEncoder(fibers_per_signal=5))
+    why = ccfg.state_problems(meta, None)
+    assert why == (f"was saved with its projections in the order {', '.join(a.net_cfg.projections)}, which its "
+                   f"arrays follow, but network 'full' lists them as {', '.join(turned.projections)}: list them in "
+                   "the saved order")
+    b = SNNControllerImpl(ccfg, BuildContext(cfg=SimpleNamespace(controller=ccfg, seed=3), task=_Task()))
+    with pytest.raises(StateMismatchError, match="list them in the saved order"):
+        b.load_state(tmp_path / "s.npz")
+    data, meta = load_state_npz(tmp_path / "s.npz", "SNN")
+    del meta["layout"]
+    save_state_npz(tmp_path / "old.npz", meta, **{k: data[k] for k in data.files if k != "meta"})
+    c = make_ctrl()
+    c.load_state(tmp_path / "old.npz")
+    np.testing.assert_array_equal(a.net.weights("pf_pc"), c.net.weights("pf_pc"))
+
+
 def test_same_seed_same_torques():
     a, b = make_ctrl(), make_ctrl()
     a.reset(np.random.default_rng(7))

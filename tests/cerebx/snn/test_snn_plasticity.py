@@ -124,6 +124,40 @@ def test_checkpoints_rewrite_the_rows_learning_changed(tmp_path):
     np.testing.assert_array_equal(state["net"]._state.arrays.delivery.dense_w, net.dense_w)
 
 
+@pytest.mark.parametrize("how", ["step", "chunk", "profiled"])
+def test_every_row_learning_writes_is_reported_changed(how):
+    """A checkpoint rewrites only the rows the kernels marked (``changed_ranges``): LTP alone (PF spikes, no CF
+    in their window) and LTD must both mark every row they write, in each compiled variant of the step (one
+    step, a chunk, a profiled step). An LTP-only row left unmarked came back from a checkpoint with its old
+    weights, and a resumed run diverged from the uninterrupted one (issue #47)."""
+    net = plastic_net(n_pf=30, n_pc=4)
+    if how == "profiled":
+        net.start_profile()
+    rng = np.random.default_rng(3)
+    rows = net.weights("pf_pc")
+    w_off, n_post = (int(x) for x in net.de_i[net.pl_i[0, 0], [4, 3]])
+    net.changed_ranges()  # the first call reports every weight; the interval starts here
+    ltp_only = ltd = 0  # rows written in the first 200 steps; rows LTD lowered after
+    for k in range(400):
+        pf = rng.choice(30, 2, replace=False) if k % 5 == 0 else []
+        cf = [int(rng.integers(4))] if k >= 200 and k % 35 == 0 else []  # the first 200 steps: LTP only
+        x = np.array([net.index("pf").start + i for i in pf] + [net.index("cf").start + i for i in cf], np.int32)
+        before = rows.copy()
+        if how == "chunk":
+            net.step_many([x])
+        else:
+            net.step(x)
+        changed = set(np.flatnonzero((rows != before).any(axis=1)).tolist())
+        marked = {int(s - w_off) // n_post for a, starts, length in net.changed_ranges() if a is net.dense_w
+                  for s in starts}
+        assert changed <= marked, f"step {k}: rows {sorted(changed - marked)} written but not reported"
+        if k < 200:
+            ltp_only += len(changed)
+        else:
+            ltd += int((rows < before).any(axis=1).sum())
+    assert ltp_only > 20 and ltd > 20
+
+
 def test_weights_written_ahead_then_their_changed_rows_give_the_checkpoint(tmp_path):
     net = plastic_net(n_pf=30, n_pc=4)
     rng = np.random.default_rng(1)

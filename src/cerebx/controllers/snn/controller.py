@@ -51,6 +51,7 @@ from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
 from cerebx.snn.encoders import EncoderPair
 from cerebx.snn.kernels import OUTPUTS, prof_lap, prof_now, run_chunk
 from cerebx.snn.network import Network, pack
+from cerebx.snn.schema import layout_problem
 
 STEP_S = 0.002
 STATE_VERSION = 1
@@ -555,7 +556,7 @@ class SNNControllerImpl(Controller):
         arrays["cf_burst_left"] = self.cf.burst_left
         arrays["out_fifo"] = np.array(list(self._ready)).reshape(len(self._ready), self.width)
         meta = {"version": STATE_VERSION, "fingerprint": self.fingerprint, "config": self.config_hash,
-                "network": self.net_cfg.name, "rng": self.cf.rng.bit_generator.state}
+                "network": self.net_cfg.name, "layout": self.net_cfg.layout(), "rng": self.cf.rng.bit_generator.state}
         if isinstance(getattr(self.mf, "rng", None), np.random.Generator):
             meta["mf_rng"] = self.mf.rng.bit_generator.state
         arrays["in_fifo"] = np.array(json.dumps([a.tolist() for a in self._pending]))
@@ -572,6 +573,9 @@ class SNNControllerImpl(Controller):
                 f"{path}: saved from network {meta.get('network')!r} with a different structure "
                 f"(fingerprint {meta.get('fingerprint')}), this controller runs {self.net_cfg.name!r} "
                 f"({self.fingerprint})")
+        problem = layout_problem(meta.get("layout"), self.net_cfg)
+        if problem:
+            raise StateMismatchError(f"{path}: {problem}")
         try:
             self.net.load_arrays({k[4:]: data[k] for k in data.files if k.startswith("net_")})
         except (KeyError, ValueError) as exc:

@@ -14,7 +14,7 @@ from cerebx.schema.base import NonNegFloat, PositiveFloat, Strict
 from cerebx.schema.controller import ControllerConfig, muscle_command_signals
 from cerebx.signals import StageIO, torque_controller_io
 from cerebx.snn import sizing
-from cerebx.snn.schema import BoxEncoder, CFEncoder, NetworkConfig
+from cerebx.snn.schema import BoxEncoder, CFEncoder, NetworkConfig, layout_problem
 
 DELAYED_RECEIVER = {"kind": "future_past", "min_future_samples": 2, "past_samples": 10, "decay_per_step": 0.998}
 """What ``efferent: auto`` puts in place of a ``mean`` receiver when the link delays."""
@@ -139,7 +139,7 @@ class SNNController(ControllerConfig):
         if saved != want:
             return (f"was saved from network {meta.get('network')!r} (fingerprint {saved}), but this run's network "
                     f"{self.network.name!r} has fingerprint {want}: sizes or connections differ")
-        return None
+        return layout_problem(meta.get("layout"), self.network)
 
     def io(self, n_joints: int) -> StageIO:
         if self.output == "torque":
