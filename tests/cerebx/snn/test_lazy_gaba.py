@@ -142,8 +142,8 @@ def _drive(nets, steps, n_mf, n_goc, lo_mf, lo_goc, seed=1):
 
 def test_a_golgi_granular_layer_steps_exactly_like_the_integrated_one_and_resumes_from_its_state():
     """Random MF (AMPA) and Golgi (GABA) drive onto 2,000 GCs with fixed in-degrees; the listed network against
-    the one integrating every GC, spike for spike and state for state, also after a save and load mid-run and
-    after a pickle (a checkpoint)."""
+    the one integrating every GC, spike for spike and state for state, also profiled, after a save and load
+    mid-run and after a pickle (a checkpoint)."""
     indeg = lambda k: {"kind": "fixed_indegree", "indegree": k}  # noqa: E731
     cfg = NetworkConfig.model_validate({
         "name": "layer", "dt_ms": 0.5,
@@ -157,10 +157,13 @@ def test_a_golgi_granular_layer_steps_exactly_like_the_integrated_one_and_resume
         "io": {"mossy": "mf", "climbing": "goc", "output": "gc", "purkinje": ["gc"], "granule": "gc"},
     })
     lazy, dense = _pair(cfg)
+    profiled = Network(cfg, parallel=False, compact_min=1)
+    profiled.start_profile()  # other compiled code (issue #47: a store the compiler dropped there once)
     mf, goc = lazy.index("mf"), lazy.index("goc")
     args = (100, 40, mf.start, goc.start)
-    _drive([lazy, dense], 300, *args)
+    _drive([lazy, dense, profiled], 300, *args)
     _same(lazy, dense)
+    _same(profiled, dense)
     gc = lazy.topo.index["gc"]
     assert 0 < lazy.n_act[gc] < 2000 and (lazy.g_rest != 0).sum() > 100  # some listed, many held unlisted
     resumed = Network(cfg, parallel=False, compact_min=1)
