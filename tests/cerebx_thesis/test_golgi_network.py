@@ -62,3 +62,25 @@ def test_the_reduced_golgi_network_learns_the_circle(load, tmp_path):
     s = run_experiment(load(["+experiment=learn_circle", "network=small_golgi", *SMALL, "trials=20"]), tmp_path)
     mae = np.asarray(s["mae_per_trial"])
     assert s["status"] == "completed" and mae[-3:].mean() < 0.8 * mae[0], mae  # measured: 0.224 -> ~0.14
+
+
+def test_small_golgi_skipping_resting_gcs_spikes_exactly_as_integrating_every_gc(load):
+    """The granule layer listed, with GCs at rest under Golgi inhibition left unlisted (what the full-size network
+    does: its 60,000 GCs are above ``compact_min``), against every GC integrated every step: the same spikes at
+    the same substeps and the same state (docs/networks/golgi.md#speed)."""
+    cfg = load(["+experiment=learn_circle", "network=small_golgi", *SMALL]).controller.network
+    listed, every = Network(cfg, parallel=False, compact_min=1), Network(cfg, parallel=False, compact_min=10**9)
+    gc = listed.topo.index["gc"]
+    assert listed.pop_lazy[gc] > 1.0 and every.pop_lazy[gc] == 0
+    n_spikes, held = 0, 0
+    for t in range(400):  # the box code of a slow sweep, as _spikes
+        ph = 2 * np.pi * t / 500
+        idx = np.array([j * 20 + s * 5 + int(round(2 + 2 * np.sin(ph + 0.7 * s + j))) for j in range(6)
+                        for s in range(4)], np.int32)
+        a, b = listed.step(idx), every.step(idx)
+        assert np.array_equal(a.idx, b.idx) and np.array_equal(a.sub, b.sub), t
+        n_spikes += len(a.idx)
+        held = max(held, int((listed.g_rest != 0).sum()))
+    for key in ("V", "g", "ref"):
+        assert np.array_equal(listed.state_arrays()[key], every.state_arrays()[key]), key
+    assert n_spikes > 1000 and held > 100 and listed.n_act[gc] < cfg.populations["gc"].size

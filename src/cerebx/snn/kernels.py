@@ -28,7 +28,7 @@ Populations with NMDA/GABA input (DCN) run the RK stages in float32 with a branc
 (max abs error 1e-6 against the exact expression), so that loop vectorises too.
 
 Resting neurons are skipped exactly: a neuron with u == 0, g == 0 and not refractory stays so
-until input arrives (every RK stage is exactly 0). Large AMPA-only populations ("compact") keep
+until input arrives (every RK stage is exactly 0). Large lif_cond populations ("compact") keep
 their non-resting neurons packed in the front of the population's slice of u/g/ref, with
 ``cid`` (compact position -> global index) and ``slot`` (global index -> compact position, -1 at
 rest); delivered input activates a resting neuron by appending it, and neurons that came back
@@ -41,6 +41,16 @@ run), rebuilt after each compaction; each target receives exactly the same float
 the same order as without the cache. Conductances below 1e-12 nS and
 |u| below 1e-6 mV become exactly 0 (V itself is only resolved to 7.6e-6 mV in float32 near -65
 mV), so a neuron returns to rest a few tens of ms after its last input.
+
+Rest under GABA (the granule layer under Golgi inhibition): in a compact population with
+``clamp_at_rest`` and E_GABA <= E_L, a neuron at rest whose only input is a GABA conductance up to
+``Populations.lazy`` (``topology.lazy_gaba_nS``: the step from rest is then negative and clamped to
+exactly 0) stays unlisted. Its conductance lives in ``g_rest`` (global index order), takes the
+deliveries there in the same order and float32 operations as a listed neuron's, and decays with each
+step of the population in one vectorised pass (the integration loop's product, flushed below
+G_FLOOR). Activation moves it into the list; a compaction moves a listed neuron back. The listed
+neurons of a population without NMDA input compute their one-step estimates in a vectorised pass
+(``_lif_full_listed``, bit for bit ``_lif_full_fine``).
 """
 
 from __future__ import annotations
@@ -58,6 +68,7 @@ from cerebx.kernel_struct import KernelStruct
 from cerebx.snn.learning import NoLearning, SparseLearning, run_rules
 from cerebx.snn.topology import (
     I_COMPACT,
+    I_HI,
     I_KIND,
     I_LO,
     I_NFINE,
@@ -199,6 +210,8 @@ class Neurons(NamedTuple):
     n_rest: np.ndarray  # int64 [pop]: listed neurons found at rest by the last step
     pop_ep: np.ndarray  # int64 [pop]: version of the compact list (every compaction increments it)
     w: np.ndarray  # float32 [n]: adaptation current of adex_cond neurons (pA; 0 elsewhere), global index order
+    g_rest: np.ndarray  # float32 [n]: GABA conductance of the unlisted neurons of rest-GABA populations (nS),
+    # global index order, decayed with every step of the population
 
 
 class Populations(NamedTuple):
@@ -207,6 +220,8 @@ class Populations(NamedTuple):
     pop_i: np.ndarray  # int64 [pop, I_*]: kind, bounds, step ratio, compact, bifixed sub-steps
     pop_par: np.ndarray  # float64 [pop, P_*]: membrane, synapse and step constants
     poly: np.ndarray  # float32 [pop, 2, 2, N_COEF]: step polynomials of AMPA-only populations
+    lazy: np.ndarray  # float64 [pop]: largest GABA conductance an unlisted neuron at rest holds (nS; 0: none)
+    nmda: np.ndarray  # uint8 [pop]: 1 where the population has NMDA input
 
 
 class Delivery(NamedTuple):
@@ -247,7 +262,7 @@ class Buffers(NamedTuple):
     acc_j: np.ndarray  # int64 [n]: PFs with a nonzero acc
     out_idx: np.ndarray  # int32 [n * n_sub]: spiking neurons of the step
     out_t: np.ndarray  # int32 [n * n_sub]: their substep (1..n_sub)
-    scr_f: np.ndarray  # float32 [3, n]: compaction scratch (u, g_AMPA, ref)
+    scr_f: np.ndarray  # float32 [5, n]: compaction scratch (u, g_AMPA, ref, g_NMDA, g_GABA)
     scr_i: np.ndarray  # int64 [n]: compaction scratch (sort keys)
 
 
@@ -295,6 +310,19 @@ def _decay(g, d):
     for i in range(g.shape[0]):
         x = g[i] * d
         g[i] = x if x > G_FLOOR else zero
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _rest_full(u, gA, gN, gG, ref, gmax):
+    """Listed neurons of a compact lif_cond population with NMDA/GABA that a compaction may drop: at rest (u, the
+    AMPA and NMDA conductances and the refractory count 0) with a GABA conductance in [0, gmax] (gmax 0: none)."""
+    zero, one = np.float32(0.0), np.float32(1.0)
+    cnt = zero
+    for i in range(u.shape[0]):
+        b = gG[i]
+        ok = (u[i] == zero) & (gA[i] == zero) & (gN[i] == zero) & (ref[i] == zero) & (b >= zero) & (b <= gmax)
+        cnt += one if ok else zero
+    return int(cnt)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
@@ -560,6 +588,114 @@ def _lif_full_fine(u, gA, gN, gG, ref, flag, p, nf):
     return _end_full(u, ref, flag, (gA, gN, gG), p)
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _du_no_nmda(x, a, n, b, gL, EL, EAL, EGL, invC):
+    """:func:`_du` for n = 0 (no NMDA input), bit for bit: the Mg block, which then multiplies 0, is replaced by
+    a cheap stand-in of the same form 1 / (1 + e(V)), so the compiler builds the same arithmetic around it (it
+    folds n / (1 + e) into one division and contracts the rest alike: a formula without the term is contracted
+    differently and moves the last bits). Tests compare it with :func:`_du` on random states."""
+    f32 = np.float32
+    v = min(max(EL + x, f32(-150.0)), f32(50.0))
+    y = (f32(-0.062) * v + f32(MG_LN)) * f32(1.0 / 64.0)
+    mg = f32(1.0) / (f32(1.0) + y * y)
+    return (-gL * x + (a + n * mg) * (EAL - x) + b * (EGL - x)) * invC
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _no_nmda_rk(x, g0, h, dec, method, m):
+    """:func:`_full_rk` with :func:`_du_no_nmda`."""
+    a0, n0, b0 = g0
+    dA, dAh, dN, dNh, dG, dGh = dec
+    gL, EL, EAL, EGL, invC = m
+    if method == 2:
+        k1 = _du_no_nmda(x, a0, n0, b0, gL, EL, EAL, EGL, invC)
+        k2 = _du_no_nmda(x + np.float32(0.5) * h * k1, a0 * dAh, n0 * dNh, b0 * dGh, gL, EL, EAL, EGL, invC)
+        k3 = _du_no_nmda(x + np.float32(0.5) * h * k2, a0 * dAh, n0 * dNh, b0 * dGh, gL, EL, EAL, EGL, invC)
+        k4 = _du_no_nmda(x + h * k3, a0 * dA, n0 * dN, b0 * dG, gL, EL, EAL, EGL, invC)
+        return x + h * np.float32(1.0 / 6.0) * (k1 + np.float32(2.0) * k2 + np.float32(2.0) * k3 + k4)
+    if method == 1:
+        k1 = _du_no_nmda(x, a0, n0, b0, gL, EL, EAL, EGL, invC)
+        k2 = _du_no_nmda(x + h * k1, a0 * dA, n0 * dN, b0 * dG, gL, EL, EAL, EGL, invC)
+        return x + np.float32(0.5) * h * (k1 + k2)
+    return x + h * _du_no_nmda(x, a0, n0, b0, gL, EL, EAL, EGL, invC)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _full_estimates(u, gA, gN, gG, out, h, dec, method, m):
+    """The one-step estimate of every neuron of a population without NMDA input into ``out``
+    (:func:`_no_nmda_rk`, equal to :func:`_full_rk`); inlined with a constant ``method`` the loop has no branch and
+    vectorises."""
+    for i in range(u.shape[0]):
+        out[i] = _no_nmda_rk(u[i], (gA[i], gN[i], gG[i]), h, dec, method, m)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _lif_full_listed(u, gA, gN, gG, ref, flag, out, p, nf):
+    """:func:`_lif_full_fine` in two passes for a population without NMDA input, with the same result bit for
+    bit (tests): the one-step estimates of all neurons first, in a loop that vectorises without the Mg block
+    (about five times faster), then the bifixed sub-steps for the neurons that need them. ``out``: scratch at
+    least as long as u. For the listed neurons of a compact population (whose list may be long: the granule layer
+    under Golgi inhibition). Populations with NMDA input keep :func:`_lif_full_fine` (the vectorised Mg block
+    may differ from the per-neuron one in the last bit)."""
+    f32 = np.float32
+    h = f32(p[P_H])
+    hf = h / f32(nf)
+    gL, EL, invC = f32(p[P_GL]), f32(p[P_EL]), f32(1.0 / p[P_CM])
+    EAL, EGL = f32(p[P_EA] - p[P_EL]), f32(p[P_EG] - p[P_EL])
+    dec = (f32(p[P_DA]), f32(p[P_DAH]), f32(p[P_DN]), f32(p[P_DNH]), f32(p[P_DG]), f32(p[P_DGH]))
+    fA, fN, fG = f32(p[P_DFA]), f32(p[P_DFN]), f32(p[P_DFG])
+    fdec = (fA, f32(p[P_DFAH]), fN, f32(p[P_DFNH]), fG, f32(p[P_DFGH]))
+    ufine = f32(p[P_UFINE])
+    method = int(p[P_METHOD])
+    lo_u = f32(0.0) if p[P_CLAMP] > 0.5 else f32(-3.0e38)
+    zero = f32(0.0)
+    m = (gL, EL, EAL, EGL, invC)
+    n = u.shape[0]
+    est = out[:n]
+    if method == 2:
+        _full_estimates(u, gA, gN, gG, est, h, dec, 2, m)
+    elif method == 1:
+        _full_estimates(u, gA, gN, gG, est, h, dec, 1, m)
+    else:
+        _full_estimates(u, gA, gN, gG, est, h, dec, 0, m)
+    for i in range(n):
+        x = u[i]
+        un = est[i]
+        if nf > 1 and ((x > ufine) | (un > ufine)):
+            a0, n0, b0 = gA[i], gN[i], gG[i]
+            un = x
+            for _ in range(nf):
+                un = _full_rk(un, (a0, n0, b0), hf, fdec, method, m)
+                a0, n0, b0 = a0 * fA, n0 * fN, b0 * fG
+        un = max(un, lo_u)
+        u[i] = un if abs(un) >= U_FLOOR else zero
+    return _end_full(u, ref, flag, (gA, gN, gG), p)
+
+
+@njit(cache=True, parallel=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _lif_full_listed_par(u, gA, gN, gG, ref, flag, out, p, nf, nch):
+    """:func:`_lif_full_listed` on numba threads: ``nch`` contiguous chunks."""
+    n = u.shape[0]
+    cnt = 0
+    for ch in prange(nch):
+        a = ch * n // nch
+        b = (ch + 1) * n // nch
+        cnt += _lif_full_listed(u[a:b], gA[a:b], gN[a:b], gG[a:b], ref[a:b], flag[a:b], out[a:b], p, nf)
+    return cnt
+
+
+def lif_step(u, gA, gN, gG, ref, p, nf, listed=False):
+    """One step of a lif_cond population with NMDA/GABA input by :func:`_lif_full_fine` (``listed``:
+    :func:`_lif_full_listed`) on copies, for tests: (u, gA, gN, gG, ref, flag)."""
+    u, gA, gN, gG, ref = (np.array(a, dtype=np.float32) for a in (u, gA, gN, gG, ref))
+    flag = np.zeros(len(u), np.uint8)
+    if listed:
+        _lif_full_listed(u, gA, gN, gG, ref, flag, np.zeros(len(u), np.float32), p, nf)
+    else:
+        _lif_full_fine(u, gA, gN, gG, ref, flag, p, nf)
+    return u, gA, gN, gG, ref, flag
+
+
 # --------------------------------------------------------------------------- AdEx (aeif_cond_exp)
 W_FLOOR = np.float32(1e-12)  # |w| below this (pA) becomes exactly 0 (avoids denormals when a = 0)
 
@@ -736,22 +872,33 @@ def _collect(flag, ids, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp, so
 
 
 @njit(cache=True, boundscheck=False)
-def _compact(lo, na, nrn, buf):
-    """Drop the neurons at rest from the ``na`` listed neurons of the compact AMPA-only population
+def _compact(lo, na, nrn, buf, full, gmax):
+    """Drop the neurons at rest from the ``na`` listed neurons of the compact population
     starting at ``lo`` and put the others in global index order (the order of the list does not
     affect any result: every per-neuron operation is independent and collected spikes are sorted;
     index order makes the targets of one presynaptic neuron long runs, see :func:`_build_runs`).
     Only the list is read, never the whole population: the neurons listed at the last compaction
     are still in index order, those activated since follow in the order they came and are sorted
     (keys global index << 32 | position, so a key's order is its index's), then merged in.
+    ``full``: the population has NMDA/GABA conductances (moved too); a neuron at rest whose GABA conductance is
+    in (0, gmax] leaves the list with it, kept in ``g_rest``.
     Returns the new count."""
     u, g, ref, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot
+    g_rest = nrn.g_rest
     sf, key, merged = buf.scr_f, buf.scr_i, buf.col_buf
     j = 0
     for k in range(lo, lo + na):
         i = cid[k]
         x, gk, r = u[k], g[0, k], ref[k]
-        if x == 0.0 and gk == 0.0 and r == 0.0:
+        if full:
+            gn, gb = g[1, k], g[2, k]
+            if x == 0.0 and gk == 0.0 and r == 0.0 and gn == 0.0 and gb >= 0.0 and gb <= gmax:
+                slot[i] = -1
+                g_rest[i] = gb
+                continue
+            sf[3, j] = gn
+            sf[4, j] = gb
+        elif x == 0.0 and gk == 0.0 and r == 0.0:
             slot[i] = -1
             continue
         sf[0, j] = x
@@ -786,6 +933,9 @@ def _compact(lo, na, nrn, buf):
         u[k] = sf[0, q]
         g[0, k] = sf[1, q]
         ref[k] = sf[2, q]
+        if full:
+            g[1, k] = sf[3, q]
+            g[2, k] = sf[4, q]
         cid[k] = i
         slot[i] = k
     return j
@@ -796,7 +946,8 @@ def _build_runs(qa, qb, plo, pp, nrn, dl):
     """Positions in the compact list of population pp (starting at plo) of the targets
     sp_post[qa:qb] of one presynaptic neuron (activating the ones at rest), as runs of consecutive
     positions: c_k start position, c_q first synapse, c_l length, stored from qa on. Returns the
-    number of runs. Valid until the population is compacted again (activation only appends)."""
+    number of runs. Valid until the population is compacted again (activation only appends; an activated
+    neuron takes its GABA conductance from ``g_rest``)."""
     u, g, ref, cid, slot, n_act = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot, nrn.n_act
     sp_post, c_k, c_q, c_l = dl.sp_post, dl.c_k, dl.c_q, dl.c_l
     nr = 0
@@ -816,7 +967,8 @@ def _build_runs(qa, qb, plo, pp, nrn, dl):
             u[kq] = 0.0
             g[0, kq] = 0.0
             g[1, kq] = 0.0
-            g[2, kq] = 0.0
+            g[2, kq] = nrn.g_rest[i]
+            nrn.g_rest[i] = 0.0
             ref[kq] = 0.0
         if kq == prev + 1:
             ln += 1
@@ -896,11 +1048,14 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
     Sparse projections onto a compact population deliver through a per-presynaptic-neuron cache of
     the targets' compact positions (``_build_runs``; sp_c[off + j] = (epoch, runs), valid while
     the epoch equals pop_ep of the target population, which every compaction increments).
+    GABA onto a lazy-GABA population (``Populations.lazy``) goes to a neuron's listed state if it is listed,
+    else to the lazy store without listing it, as long as the neuron stays exactly at rest under it.
     """
     nrn, pops, dl, plast, buf = net.neurons, net.populations, net.delivery, net.plasticity, net.buffers
     u, g, ref, flag, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.flag, nrn.cid, nrn.slot
     n_act, n_rest, pop_ep = nrn.n_act, nrn.n_rest, nrn.pop_ep
-    pop_i, pop_par = pops.pop_i, pops.pop_par
+    g_rest = nrn.g_rest
+    pop_i, pop_par, pop_lazy = pops.pop_i, pops.pop_par, pops.lazy
     ring_idx, ring_n = dl.ring_idx, dl.ring_n
     sp_i, sp_ptr, sp_post, sp_w, sp_c = dl.sp_i, dl.sp_ptr, dl.sp_post, dl.sp_w, dl.sp_c
     c_k, c_q, c_l, de_i, dense_w = dl.c_k, dl.c_q, dl.c_l, dl.de_i, dl.dense_w
@@ -933,6 +1088,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                 continue
             plo = pop_i[pp, I_LO]
             compact = pop_i[pp, I_COMPACT] != 0
+            lazy = compact and rec == 2 and pop_lazy[pp] > 0.0
+            gmax = np.float32(pop_lazy[pp])
             dec = pop_par[pp, P_D1A + rec]
             scale = 1.0
             for a in range(ratio):  # arrivals since the population's previous step boundary
@@ -945,6 +1102,28 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                 for k in range(ring_n[sl]):
                     j = ring_idx[sl, k] - pre_lo
                     if j < 0 or j >= n_pre:
+                        continue
+                    if lazy:
+                        for q in range(sp_ptr[off + j], sp_ptr[off + j + 1]):
+                            i = sp_post[q]
+                            kq = slot[i]
+                            if kq >= 0:
+                                g[2, kq] += sp_w[q] * sc
+                                continue
+                            x = g_rest[i] + sp_w[q] * sc
+                            if x >= 0.0 and x <= gmax:  # stays exactly at rest: unlisted
+                                g_rest[i] = x
+                                continue
+                            g_rest[i] = 0.0
+                            kq = plo + n_act[pp]
+                            n_act[pp] += 1
+                            slot[i] = kq
+                            cid[kq] = i
+                            u[kq] = 0.0
+                            g[0, kq] = 0.0
+                            g[1, kq] = 0.0
+                            g[2, kq] = x
+                            ref[kq] = 0.0
                         continue
                     if compact:
                         cj = off + j
@@ -974,7 +1153,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                             u[kq] = 0.0
                             g[0, kq] = 0.0
                             g[1, kq] = 0.0
-                            g[2, kq] = 0.0
+                            g[2, kq] = g_rest[i]
+                            g_rest[i] = 0.0
                             ref[kq] = 0.0
                         g[rec, kq] += sp_w[q] * sc
         # dense (all-to-all) projections: a spike adds its weight row; plastic rows get LTP
@@ -1011,7 +1191,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                                 u[kq] = 0.0
                                 g[0, kq] = 0.0
                                 g[1, kq] = 0.0
-                                g[2, kq] = 0.0
+                                g[2, kq] = g_rest[i]
+                                g_rest[i] = 0.0
                                 ref[kq] = 0.0
                             g[rec, kq] += dense_w[row + q] * sc
                     elif a == 0:  # (1D slices: these loops vectorise)
@@ -1071,6 +1252,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
             if kind == KIND_INPUT or (t + 1) % pop_i[pi, I_RATIO] != 0:
                 continue
             lo = pop_i[pi, I_LO]
+            if pop_lazy[pi] > 0.0:  # the unlisted neurons' GABA decays as the loop would decay it
+                _decay(g_rest[lo : pop_i[pi, I_HI]], np.float32(pop_par[pi, P_DG]))
             na = n_act[pi]
             if na == 0:
                 continue
@@ -1086,11 +1269,21 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
             elif kind == KIND_ADEX:
                 cnt = _adex(u[lo:hi], nrn.w[lo:hi], g[0, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp,
                             pop_i[pi, I_NFINE])
+            elif pop_i[pi, I_NFINE] > 1 and pop_i[pi, I_COMPACT] != 0 and pops.nmda[pi] == 0:
+                if par > 1 and na >= PAR_MIN:
+                    cnt = _lif_full_listed_par(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi],
+                                               flag[lo:hi], buf.scr_f[0, :na], pp, pop_i[pi, I_NFINE], par)
+                else:
+                    cnt = _lif_full_listed(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi],
+                                           buf.scr_f[0], pp, pop_i[pi, I_NFINE])
             elif pop_i[pi, I_NFINE] > 1:
                 cnt = _lif_full_fine(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp,
                                      pop_i[pi, I_NFINE])
             else:
                 cnt = _lif_full(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp)
+            if kind != KIND_LIF_AMPA and pop_i[pi, I_COMPACT] != 0:
+                n_rest[pi] = _rest_full(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi],
+                                        np.float32(pop_lazy[pi]))
             tk = prof_lap(prof, pi, tk)
             if cnt > 0:
                 n_out = _collect(flag[lo:hi], cid[lo:hi], ring_idx, nxt, ring_n, out_idx, out_t, n_out,
@@ -1099,7 +1292,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
     # they are integrated as exact no-ops)
     for pi in range(pop_i.shape[0]):
         if pop_i[pi, I_COMPACT] != 0 and n_rest[pi] > 0 and COMPACT_FRACTION * n_rest[pi] >= n_act[pi]:
-            n_act[pi] = _compact(pop_i[pi, I_LO], n_act[pi], nrn, buf)
+            n_act[pi] = _compact(pop_i[pi, I_LO], n_act[pi], nrn, buf, pop_i[pi, I_KIND] != KIND_LIF_AMPA,
+                                 np.float32(pop_lazy[pi]))
             pop_ep[pi] += 1
             n_rest[pi] = 0
     prof_lap(prof, pb + BOOKKEEPING, tk)

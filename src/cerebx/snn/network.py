@@ -17,6 +17,7 @@ from cerebx.snn.topology import (
     I_RATIO,
     KIND_INPUT,
     KIND_LIF_AMPA,
+    KIND_LIF_FULL,
     N_SPAR,
     P_EL,
     S_DELAY,
@@ -33,7 +34,7 @@ from cerebx.snn.topology import (
 )
 from cerebx.snn.weight_stats import Beside, RunCache, weight_stats
 
-COMPACT_MIN = 4096  # AMPA-only populations this large integrate only their non-resting neurons
+COMPACT_MIN = 4096  # lif_cond populations this large integrate only their non-resting neurons
 PF_RING = 1 << 16  # buffered PF arrivals per plastic projection (must cover the kernel window)
 
 
@@ -172,6 +173,7 @@ class Network:
         self._g = np.zeros((3, n), dtype=np.float32)
         self._ref = np.zeros(n, dtype=np.float32)
         self.w = np.zeros(n, dtype=np.float32)  # adex_cond adaptation currents (pA), global index order
+        self.g_rest = np.zeros(n, dtype=np.float32)  # GABA of unlisted neurons at rest (kernels), global index order
         self.flag = np.zeros(n, dtype=np.uint8)
         self.cid = np.arange(n, dtype=np.int32)
         self.slot = np.arange(n, dtype=np.int32)
@@ -185,7 +187,10 @@ class Network:
         self.pop_par = topo.par
         self.pop_i = topo.ipar.copy()
         sizes = self.pop_hi - self.pop_lo
-        self.pop_i[:, I_COMPACT] = (topo.kind == KIND_LIF_AMPA) & (sizes >= compact_min)
+        listed = (topo.kind == KIND_LIF_AMPA) | (topo.kind == KIND_LIF_FULL)
+        self.pop_i[:, I_COMPACT] = listed & (sizes >= compact_min)
+        self.pop_lazy = np.where(self.pop_i[:, I_COMPACT] != 0, topo.lazy_gaba, 0.0)
+        self.pop_nmda = topo.nmda_in.copy()
         self.poly = topo.poly
         self.el = np.repeat(topo.par[:, P_EL], sizes).astype(np.float32)
         sp = topo.sparse
@@ -238,7 +243,7 @@ class Network:
         self.c_q = np.zeros(nsyn, dtype=np.int64)
         self.c_l = np.zeros(nsyn, dtype=np.int64)
         self.pop_ep = np.ones(len(topo.names), dtype=np.int64)
-        self.scr_f = np.zeros((3, n), dtype=np.float32)
+        self.scr_f = np.zeros((5, n), dtype=np.float32)
         self.scr_i = np.zeros(n, dtype=np.int64)
         self.sl = _sparse_learning(topo)
         self.learn = True
@@ -253,8 +258,8 @@ class Network:
         written in place, so it stays valid for the network's life)."""
         return kernels.NetworkArrays(
             neurons=kernels.Neurons(self.u, self._g, self._ref, self.flag, self.cid, self.slot, self.n_act,
-                                    self.n_rest, self.pop_ep, self.w),
-            populations=kernels.Populations(self.pop_i, self.pop_par, self.poly),
+                                    self.n_rest, self.pop_ep, self.w, self.g_rest),
+            populations=kernels.Populations(self.pop_i, self.pop_par, self.poly, self.pop_lazy, self.pop_nmda),
             delivery=kernels.Delivery(self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
                                       self.sp_c, self.c_k, self.c_q, self.c_l, self.de_i, self.dense_w),
             plasticity=kernels.Plasticity(self.pl_i, self.pl_f, self.kern, self.pf_t, self.pf_j, self.pf_head,
@@ -267,8 +272,10 @@ class Network:
     # ------------------------------------------------------------------ state
     def _set_neurons(self, V: np.ndarray, g: np.ndarray, ref: np.ndarray) -> None:
         """Kernel state from full per-neuron arrays: compact populations keep their non-resting
-        neurons, in index order."""
+        neurons, in index order; a neuron at rest but for a GABA conductance it may hold unlisted
+        (``pop_lazy``) has it in ``g_rest``."""
         n = len(self.u)
+        self.g_rest[:] = 0
         self.u[:] = (V - self.el).astype(np.float32)
         self._g[:] = g
         self._ref[:] = ref
@@ -282,7 +289,10 @@ class Network:
             if not self.pop_i[pi, I_COMPACT]:
                 continue
             u, gg, r = self.u[lo:hi].copy(), self._g[:, lo:hi].copy(), self._ref[lo:hi].copy()
-            live = np.flatnonzero((u != 0) | (gg != 0).any(axis=0) | (r != 0))
+            gmax = np.float32(self.pop_lazy[pi])
+            kept = (gg[2] > 0) & (gg[2] <= gmax) & (u == 0) & (gg[:2] == 0).all(axis=0) & (r == 0)
+            live = np.flatnonzero(((u != 0) | (gg != 0).any(axis=0) | (r != 0)) & ~kept)
+            self.g_rest[lo:hi][kept] = gg[2, kept]
             na = len(live)
             self.n_act[pi] = na
             self.slot[lo:hi] = -1
@@ -302,6 +312,8 @@ class Network:
             V[idx] = self.el[idx] + self.u[lo : lo + na]
             g[:, idx] = self._g[:, lo : lo + na]
             ref[idx] = self._ref[lo : lo + na]
+            rest = self.g_rest[lo : int(self.pop_hi[pi])]
+            g[2, lo : int(self.pop_hi[pi])] = np.where(rest != 0, rest, g[2, lo : int(self.pop_hi[pi])])
         return V, g, ref
 
     @property
@@ -318,6 +330,7 @@ class Network:
 
     def reset_state(self) -> None:
         """Neurons at rest, no conductances, nothing in flight; weights are kept."""
+        self.t_sub = 0
         self._set_neurons(self.el, np.zeros_like(self._g), np.zeros_like(self._ref))
         self.w[:] = 0
         self.ring_n[:] = 0
@@ -354,8 +367,8 @@ class Network:
         for k in self.state_keys:
             if k not in ("V", "g", "ref"):
                 self._state_array(k)[...] = arrays[k]
-        self._set_neurons(arrays["V"], arrays["g"], arrays["ref"])
         self.t_sub = int(arrays["t_sub"])
+        self._set_neurons(arrays["V"], arrays["g"], arrays["ref"])
         self._all_changed = True
         self._stats_cache = {}
 
@@ -425,6 +438,12 @@ class Network:
             self.sl = learning.empty()
         if "_stats_dirty" not in state:  # pickled by earlier code
             self._stats_dirty, self._stats_cache = np.zeros_like(self.pl_dirty), {}
+        if "pop_lazy" not in state:  # pickled before lazy GABA: its populations keep the lists they had
+            self.pop_lazy = np.zeros(len(self.pop_lo))
+            self.pop_nmda = np.ones(len(self.pop_lo), np.uint8)
+            self.g_rest = np.zeros_like(self._ref)
+        if self.scr_f.shape[0] < 5:  # its compaction scratch had 3 rows
+            self.scr_f = np.zeros((5, self.scr_f.shape[1]), np.float32)
         self.prof = None
         if stale:
             self.sp_c[:, 0] = 0  # no cache is valid (epochs start at 1): each is rebuilt when first used

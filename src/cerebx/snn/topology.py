@@ -105,6 +105,36 @@ def step_polynomials(method: str, h: float, C: float, gL: float, E: float, d: fl
     return res
 
 
+LAZY_MARGIN = 0.25  # a lazily kept GABA conductance leaves the step's rest result at least this share of its lead term
+
+
+def lazy_gaba_nS(nrn: LIFNeuron, h: float) -> float:
+    """The largest GABA conductance (nS) under which a ``lif_cond`` neuron at rest with no other input (V = E_L,
+    no AMPA or NMDA conductance, not refractory) stays exactly at rest, step after step, while the conductance
+    decays: 0 when there is none (the neuron then leaves rest under any GABA).
+
+    With ``clamp_at_rest`` and E_GABA < E_L, the step from rest is u' = Q(g) (``step_polynomials`` with GABA's
+    reversal and decay), which is negative, and so clamped to exactly 0, while Q(g) keeps at least
+    :data:`LAZY_MARGIN` of its lead term g (E_GABA - E_L) h / C (float32 rounding, ~1e-6 of it, cannot change
+    the sign). Beyond that bound the explicit step overshoots (it goes unstable near (g_L + g) h / C = 2). The
+    kernels keep such a neuron out of their integration loop and decay its conductance only when it is next
+    touched, by the same float32 products the loop would have applied (kernels, lazy GABA)."""
+    if not nrn.clamp_at_rest or nrn.V_thr_mV <= nrn.E_L_mV:
+        return 0.0
+    E = nrn.E_GABA_mV - nrn.E_L_mV
+    if E > 0:
+        return 0.0
+    C, gL, tau = nrn.C_m_pF, nrn.g_L_nS, nrn.tau_GABA_ms
+    top = 4.0 * C / h + gL  # past the stability limit of every method
+    if E == 0:
+        return top  # GABA then never moves V at rest
+    Q = Pn(step_polynomials(nrn.integration.method, h, C, gL, E, np.exp(-h / tau), np.exp(-0.5 * h / tau))[1])
+    g = np.linspace(0.0, top, 200_001)[1:]
+    ratio = Q(g) / (g * E * h / C)
+    bad = np.flatnonzero(ratio < LAZY_MARGIN)
+    return float(top if not len(bad) else (g[bad[0] - 1] if bad[0] > 0 else 0.0))
+
+
 def _step_ratio(integ: Integration, name: str, dt: float, n_sub: int) -> tuple[int, float]:
     """(network steps per integration step, the step h in ms) of a population, checked."""
     h = integ.dt_ms if integ.dt_ms is not None else dt
@@ -229,6 +259,8 @@ class Topology:
     sparse_rules: list[SparseRule] = field(default_factory=list)
     built: dict[str, int] = field(default_factory=dict)  # synapses built per projection
     dense_init: dict[str, np.ndarray] = field(default_factory=dict)  # drawn initial weights of dense blocks
+    lazy_gaba: np.ndarray | None = None  # float64 [n_pop]: lazy_gaba_nS of lif_cond populations with GABA input
+    nmda_in: np.ndarray | None = None  # uint8 [n_pop]: 1 where a projection carries NMDA to the population
 
     @property
     def n_neurons(self) -> int:
@@ -369,6 +401,8 @@ def build_topology(cfg: NetworkConfig, fill: bool = True, seed: int = 0) -> Topo
     par = np.zeros((len(names), N_PAR))
     ipar = np.zeros((len(names), N_IPAR), dtype=np.int64)
     poly = np.zeros((len(names), 2, 2, N_COEF), dtype=np.float32)
+    lazy = np.zeros(len(names))
+    nmda_in = np.array([RECEPTORS["nmda"] in targeted[n] for n in names], dtype=np.uint8)
     ipar[:, I_LO], ipar[:, I_HI], ipar[:, I_RATIO], ipar[:, I_NFINE] = lo, hi, 1, 1
     for i, n in enumerate(names):
         nrn = cfg.populations[n].neuron
@@ -416,6 +450,8 @@ def build_topology(cfg: NetworkConfig, fill: bool = True, seed: int = 0) -> Topo
                                       np.exp(-0.5 * h / tau))
         poly[i, 1] = step_polynomials(integ.method, hf, nrn.C_m_pF, nrn.g_L_nS, E, np.exp(-hf / tau),
                                       np.exp(-0.5 * hf / tau), integ.bifixed_substeps)
+        if RECEPTORS["gaba"] in targeted[n]:
+            lazy[i] = lazy_gaba_nS(nrn, h)
 
     sparse: list[SparseProj] = []
     dense: list[DenseProj] = []
@@ -496,7 +532,7 @@ def build_topology(cfg: NetworkConfig, fill: bool = True, seed: int = 0) -> Topo
     dendritic = [2 * sparse[r.piece].delay for r in sparse_rules if getattr(r.spec, "dendritic", False)]
     max_delay = max([s.delay for s in sparse] + [d.delay for d in dense] + dendritic + [1])  # the ring's reach
     topo = Topology(cfg, n_sub, dt, names, lo, hi, kind, par, ipar, poly, sparse, dense, dense_w, plastic,
-                    max_delay, index, sparse_rules, built, dense_init)
+                    max_delay, index, sparse_rules, built, dense_init, lazy, nmda_in)
     if fill:
         fill_dense(topo)
     return topo
