@@ -424,6 +424,8 @@ class Network:
 
     def __setstate__(self, state: dict) -> None:
         """A state of :meth:`__getstate__`, or of earlier code (every array in it, and the kernels' handles)."""
+        numba.get_num_threads()  # numba's parallel runtime started, as __init__ does (a process that only loads a
+        # pickled network crashed on the network thread's first chunk otherwise: numba issue 8578)
         state = dict(state)
         stale = False
         for name in _SCRATCH + _CACHES:
