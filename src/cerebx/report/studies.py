@@ -486,7 +486,7 @@ def execute(jobs: list[Any], runner: Runner = subprocess_runner, parallel: int =
 class _Scheduler:
     def __init__(self, jobs: list[Job], runner: Runner, parallel: int, log: Callable[[str], None]):
         self.runner, self.parallel, self.log = runner, parallel, log
-        self.kind = jobs[0] if jobs else None  # Jobs, or Studies (multiruns: a sweep may be split in parts)
+        self.multiruns = bool(jobs) and isinstance(jobs[0], Study)  # else Jobs (a sweep's multirun may be in parts)
         self.todo = [j for j in jobs if not j.done()]
         self.reused = len(jobs) - len(self.todo)
         self.finished = {j.name for j in jobs if j not in self.todo}
@@ -498,7 +498,7 @@ class _Scheduler:
         self.t0 = time.monotonic()
 
     def run(self) -> list[str]:
-        what = "multiruns" if isinstance(self.kind, Study) else "jobs"
+        what = "multiruns" if self.multiruns else "jobs"
         self.log(f"studies: {self.reused + len(self.todo)} {what}, {self.reused} reused, {len(self.todo)} to run")
         with ThreadPoolExecutor(max_workers=self.parallel) as pool:
             try:
