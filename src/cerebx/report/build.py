@@ -41,7 +41,7 @@ from cerebx.report import figures
 from cerebx.report.badge import stamp
 from cerebx.report.delays import delay_rows
 from cerebx.report.explain import explain, load_explanations
-from cerebx.report.pace import profile_pace, remaining_wall_s
+from cerebx.report.pace import left_fraction, profile_pace, remaining_wall_s
 from cerebx.report.plot import fmt
 from cerebx.report.registry import Figure, FigureSpec, MissingRuns, all_figures
 from cerebx.report.runs import RunSet, find_run_dirs, load_runs
@@ -322,6 +322,10 @@ def borrowed_missing(jobs: list) -> str | None:
             f"runs, which are missing ({', '.join(lacking)}): run cerebx report --profile full to draw their figures")
 
 
+def _hours(seconds: float) -> str:
+    return f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds / 60:.0f} min"
+
+
 def dry_run(jobs: list, folder: Path, parallel: int) -> None:
     """Print each job (reused or to run; ``full``: a full-profile run a quick report draws on, ``lacks``: one that
     does not exist yet) and the estimate of those to run: on a quiet machine (``cerebx.estimate``) and at the pace
@@ -336,14 +340,21 @@ def dry_run(jobs: list, folder: Path, parallel: int) -> None:
     for j, d in zip(jobs, done, strict=True):
         print(f"{'reuse' if d else 'run  '} {j.run_dir}  cerebx run {' '.join(j.overrides())}")
     exps, problems = load_jobs([j.overrides() for j in jobs])
-    left = [e for e, d in zip(exps, done, strict=True) if not d and e is not None]
+    todo = [(j, e) for j, e, d in zip(jobs, exps, done, strict=True) if not d and e is not None]
+    left = [e for _, e in todo]
     bad = [p for p, d in zip(problems, done, strict=True) if p is not None and not d]
     print(f"{done.count(False)} runs to do: {total([estimate(e) for e in left]).line()}", *bad, sep="\n")
     pace = profile_pace(folder, {j.run_dir: estimate(e).wall_s
                                  for j, e, d in zip(jobs, exps, done, strict=True) if d and e is not None})
-    if pace.runs:
-        print(f"at the pace of this profile's {pace.runs} finished runs (by kind of run, --jobs {parallel}): "
-              f"~{remaining_wall_s(pace, left, parallel) / 3600:.1f} h")
+    fractions = [left_fraction(j.run_dir, e.trials) for j, e in todo]
+    resumed = sum(f < 1.0 for f in fractions)
+    if pace.runs or pace.beside_runs:
+        whose = (f"this profile's {pace.runs} finished runs" if pace.runs else "") + (
+            " and " if pace.runs and pace.beside_runs else "") + (
+            f"{pace.beside_runs} finished runs of the other profiles (for the kinds it has not run)" if pace.beside_runs else "")
+        print(f"at the pace of {whose} (by kind of run, --jobs {parallel}"
+              f"{f'; {resumed} resume from their checkpoints' if resumed else ''}): "
+              f"~{_hours(remaining_wall_s(pace, left, parallel, fractions))}")
 
 
 def needed_studies(names: list[str] | None) -> list[str]:
