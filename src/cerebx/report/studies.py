@@ -365,7 +365,7 @@ class Study:
         shared = self.jobs[0].common(sweeps=True)
         if self.part is not None:  # this part's values of one swept key replace the study's (the preset's too:
             key, values, _ = self.part  # Hydra's basic sweeper lets the command line win)
-            shared = [*(a for a in shared if _key(a) != key), f"{key}={','.join(values)}"]
+            shared = [*(a for a in shared if _key(a) != _key(key)), f"{key}={','.join(values)}"]
         out = ["-m", *shared, "resume=auto", "recording.progress=off", f"hydra.sweep.dir='{self.sweep_dir}'"]
         if swept and self.name == self.jobs[0].name:  # one job of a paired study: its sweep point fixed
             out += [*self.jobs[0].sweep_args, f"hydra.sweep.subdir='{self.jobs[0].label}'"]

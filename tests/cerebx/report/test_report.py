@@ -305,6 +305,32 @@ def test_a_sweep_is_split_so_that_every_core_runs_part_of_it(tmp_path):
     assert sorted(o[0] for o in batch) == ["delay.total_ms=20", "delay.total_ms=60"]
 
 
+def test_a_split_sweep_over_an_appended_key_keeps_one_value_list_of_it(tmp_path):
+    """A study sweeping a key it appends (``+task=a,b``, as fig4_5_learn) split in two: each part gives that key
+    once, as its part's values (measured from an empty folder, both parts of fig4_5_learn failed with
+    Hydra's "Multiple values for task" when the split appended ``+task=a`` beside the study's ``+task=a,b``)."""
+    from cerebx.report.studies import group
+
+    f = tmp_path / "studies.yaml"
+    f.write_text("studies:\n  a:\n    args: [+experiment=upper_limb, '+task=flexion_extension,vertical_circle_slow',"
+                 " 'spinal=cord,direct']\n    quick: {trials: 1}\n    full: {trials: 2}\n")
+    jobs = plan("quick", tmp_path, studies=load_studies(f))
+    parts = group(jobs, 2)
+    assert len(parts) == 2
+    for p, task in zip(parts, ("flexion_extension", "vertical_circle_slow"), strict=True):
+        ov = p.overrides()
+        assert [a for a in ov if a.lstrip("+").startswith("task=")] == [f"+task={task}"]
+        assert "spinal=cord,direct" in ov
+        # what Hydra's basic sweeper makes of the part's command line: its two jobs, each with one task
+        from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
+        from hydra.core.override_parser.overrides_parser import OverridesParser
+
+        parsed = OverridesParser.create().parse_overrides([a for a in ov[1:] if not a.startswith("hydra.")])
+        (batch,) = BasicSweeper.split_arguments(parsed, None)
+        assert sorted(sorted(x for x in job if "task=" in x or "spinal=" in x) for job in batch) == [
+            [f"+task={task}", "spinal=cord"], [f"+task={task}", "spinal=direct"]]
+
+
 def test_the_parts_of_a_split_sweep_run_side_by_side_and_its_dependents_wait(tmp_path):
     from cerebx.report.studies import group
 
