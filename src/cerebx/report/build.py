@@ -348,11 +348,8 @@ def dry_run(jobs: list, folder: Path, parallel: int) -> None:
                                  for j, e, d in zip(jobs, exps, done, strict=True) if d and e is not None})
     fractions = [left_fraction(j.run_dir, e.trials) for j, e in todo]
     resumed = sum(f < 1.0 for f in fractions)
-    if pace.runs or pace.beside_runs:
-        whose = (f"this profile's {pace.runs} finished runs" if pace.runs else "") + (
-            " and " if pace.runs and pace.beside_runs else "") + (
-            f"{pace.beside_runs} finished runs of the other profiles (for the kinds it has not run)" if pace.beside_runs else "")
-        print(f"at the pace of {whose} (by kind of run, --jobs {parallel}"
+    if pace.runs:
+        print(f"at the pace of this profile's {pace.runs} finished runs (by kind of run, --jobs {parallel}"
               f"{f'; {resumed} resume from their checkpoints' if resumed else ''}): "
               f"~{_hours(remaining_wall_s(pace, left, parallel, fractions))}")
 

@@ -8,7 +8,7 @@ import pytest
 
 from cerebx.config import load
 from cerebx.estimate import estimate
-from cerebx.report.pace import kind_of, left_fraction, measured_pace, profile_pace, remaining_wall_s
+from cerebx.report.pace import kind_of, left_fraction, measured_pace, remaining_wall_s
 
 pytestmark = pytest.mark.unit
 
@@ -37,23 +37,6 @@ def test_a_kind_without_finished_runs_is_the_quiet_estimate_slowed_as_the_others
     pace = measured_pace([(_summary("snn", "baxter", "none", 100.0, 3 * quiet), quiet)])
     assert pace.slowdown == pytest.approx(3.0)
     assert pace.wall_s(exp) == pytest.approx(3 * quiet)
-
-
-def _write_run(folder, study: str, job: str, summary: dict) -> None:
-    run = folder / study / job
-    run.mkdir(parents=True)
-    (run / "summary.json").write_text(json.dumps(summary))
-
-
-def test_a_profile_without_runs_of_a_kind_takes_that_kinds_pace_from_the_profiles_beside_it(tmp_path):
-    exp, _ = load(["+experiment=demo", "trials=10"])  # 20 s simulated
-    _write_run(tmp_path / "full", "s", "a", _summary("pd", "planar2", "none", 20.0, 5.0))   # 4x
-    _write_run(tmp_path / "quick", "s", "b", _summary("pd", "planar2", "constant", 20.0, 1.0))  # another kind
-    pace = profile_pace(tmp_path / "quick", {})
-    assert pace.runs == 1 and pace.beside_runs == 1
-    assert pace.wall_s(exp) == pytest.approx(5.0)  # the full profile's pace for PD without delay
-    own = profile_pace(tmp_path / "full", {})
-    assert own.wall_s(exp) == pytest.approx(5.0) and own.beside_runs == 1
 
 
 def test_a_run_resumed_from_a_checkpoint_counts_only_its_trials_left(tmp_path):
