@@ -45,7 +45,7 @@ from cerebx.report.pace import left_fraction, profile_pace, remaining_wall_s
 from cerebx.report.plot import fmt
 from cerebx.report.registry import Figure, FigureSpec, MissingRuns, all_figures
 from cerebx.report.runs import RunSet, find_run_dirs, load_runs
-from cerebx.report.studies import execute, group, plan, profile_of, study_runner
+from cerebx.report.studies import REPLICA, execute, group, plan, profile_of, study_runner
 from cerebx.report.summary import checks_list, shape_rows, summary_table
 
 MAX_TRACKING_RUNS = 12  # per-run joint-tracking figures only for small run sets
@@ -208,17 +208,20 @@ def _img(png: Path, caption: str) -> str:
 
 def build(run_dirs: list[Path], out: Path, names: list[str] | None = None, log=lambda line: None,
           command: str | None = None, profile: str | None = None,
-          started: float | None = None) -> tuple[Path, list[str], int]:
+          started: float | None = None, lacking: frozenset[str] = frozenset()) -> tuple[Path, list[str], int]:
     """Draw every figure (or the named ones) from ``run_dirs`` into ``out``; returns (index, problems, runs).
     ``command`` and ``profile`` are recorded in figures.json (the profile is read from the runs' folders
-    when not given), and the wall time since ``started`` (a ``time.monotonic()``) when given."""
+    when not given), and the wall time since ``started`` (a ``time.monotonic()``) when given. ``lacking``: the
+    studies a quick report draws from the full profile whose runs are missing there; a figure that needs one
+    (:meth:`FigureSpec.needs`) is not drawn (from other runs it would stand for a figure it is not)."""
     runs, problems = load_runs(run_dirs)
-    return build_from(runs, out, names, log, problems, command, profile, started)
+    return build_from(runs, out, names, log, problems, command, profile, started, lacking)
 
 
 def build_from(runs: RunSet, out: Path, names: list[str] | None = None, log=lambda line: None,
                problems: list[str] | None = None, command: str | None = None,
-               profile: str | None = None, started: float | None = None) -> tuple[Path, list[str], int]:
+               profile: str | None = None, started: float | None = None,
+               lacking: frozenset[str] = frozenset()) -> tuple[Path, list[str], int]:
     """Draw every figure (or the named ones) from ``runs`` into ``out``; ``problems``: lines already found
     (unreadable runs); the rest as :func:`build`."""
     problems = list(problems or [])
@@ -236,6 +239,10 @@ def build_from(runs: RunSet, out: Path, names: list[str] | None = None, log=lamb
     paper_rows = [PAPER_HEADER]
     for spec in chosen:
         t0 = time.monotonic()
+        if without := [s for s in spec.studies if s in lacking and spec.needs(s)]:
+            missing.append(f"{spec.name}: drawn from the full profile's runs of {', '.join(without)}, which are "
+                           "missing (cerebx report --profile full)")
+            continue
         try:
             fig: Figure = spec.draw(runs, fig_dir / spec.name)
         except MissingRuns as err:
@@ -408,12 +415,15 @@ def main(argv: list[str]) -> int:
             if lacking := borrowed_missing(jobs):
                 print(lacking, file=sys.stderr)
             dirs = [j.run_dir for j in jobs if not j.borrowed or j.done()]
+            # (a figure is drawn from the first seed; the other seeds only give its intervals)
+            absent = frozenset(j.study for j in jobs if j.borrowed and not j.done() and REPLICA not in j.study)
         else:
+            absent = frozenset()
             dirs = []
             for p in a.runs or [Path("runs")]:
                 dirs.extend(find_run_dirs(p) if p.is_dir() and not (p / runfiles.SUMMARY).exists() else [p])
         index, problems, n = build(dirs, a.out, names, log=print, command=shlex.join(["cerebx", "report", *argv]),
-                                   profile=a.profile, started=t0)
+                                   profile=a.profile, started=t0, lacking=absent)
     except CerebxError as err:
         for line in str(err).splitlines():
             print(line, file=sys.stderr)

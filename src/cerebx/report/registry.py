@@ -101,6 +101,12 @@ class FigureSpec:
     title: str
     studies: tuple[str, ...]
     draw: Callable[[RunSet, Path], Figure]
+    optional: tuple[str, ...] = ()
+    """Of ``studies``: those the figure reads when their runs exist and is drawn without (sensitivity rows)."""
+
+    def needs(self, study: str) -> bool:
+        """Whether the figure cannot stand for the paper's without ``study``'s runs."""
+        return study in self.studies and study not in self.optional
 
 
 FIGURES: dict[str, FigureSpec] = {}
@@ -108,7 +114,7 @@ STUDY_FILES: list[Path] = []
 EXPLANATION_FILES: list[Path] = []
 
 
-def figure(name: str, title: str, studies: tuple[str, ...]) -> Callable:
+def figure(name: str, title: str, studies: tuple[str, ...], optional: tuple[str, ...] = ()) -> Callable:
     """Register a figure function under ``name`` (unique across plugins); a decorator.
 
     The decorated function takes the runs and a file stem and returns a :class:`Figure`
@@ -122,11 +128,17 @@ def figure(name: str, title: str, studies: tuple[str, ...]) -> Callable:
         The title on the figure's page.
     studies : tuple of str
         The studies (from the plugin's studies file) whose runs the figure draws.
+    optional : tuple of str
+        Of ``studies``, those it is drawn without when their runs are missing (e.g. a sensitivity study a quick
+        report borrows from the full profile); a report leaves out a figure missing any other of its studies.
     """
     def deco(fn: Callable[[RunSet, Path], Figure]) -> Callable[[RunSet, Path], Figure]:
         if name in FIGURES:
             raise ValueError(f"figure {name!r} registered twice")
-        FIGURES[name] = FigureSpec(name, title, tuple(studies), fn)
+        unknown = [o for o in optional if o not in studies]
+        if unknown:
+            raise ValueError(f"figure {name!r}: optional studies {unknown} are not among its studies")
+        FIGURES[name] = FigureSpec(name, title, tuple(studies), fn, tuple(optional))
         return fn
     return deco
 

@@ -137,7 +137,7 @@ def deviation(run: Run, reference: Run | None) -> float:
 
 @figure("fig4_5", "Fig. 4.5 — upper limb with and without the spinal cord",
         ("fig4_5_learn", "fig4_5_learn_fast_cord", "fig4_5_learn_fast_direct", "fig4_5_perturb_cord",
-         "fig4_5_perturb_direct", "fig4_5_learn_d50"))
+         "fig4_5_perturb_direct", "fig4_5_learn_d50"), optional=("fig4_5_learn_d50",))
 def fig4_5(runs: RunSet, stem: Path) -> Figure:
     """A: position and velocity MAE after learning; B: trials to 0.1 rad; D: deviation under pulses."""
     learn, pert = learning_runs(runs), perturbation_runs(runs)

@@ -352,6 +352,22 @@ def test_the_parts_of_a_split_sweep_run_side_by_side_and_its_dependents_wait(tmp
     assert set(ran[:2]) == {s.name for s in learn} and len(ran) == 8  # both parts first, then the 6 that wait
 
 
+def test_a_figure_is_not_drawn_without_a_study_it_borrows_from_the_full_profile(tmp_path):
+    """Measured from an empty folder, the quick report drew Fig. 3.6 from the one 150 ms-kernel run it had (the
+    chapter 3 learning, 654 trials) under a red badge. A figure needing a borrowed study that lacks is left out
+    with a line; one whose missing study is optional (Fig. 4.5's sensitivity runs) is drawn from the rest."""
+    from cerebx.report.build import build_from
+
+    lines: list[str] = []
+    _, missing, _ = build_from(RunSet([]), tmp_path, ["fig3_6", "fig4_5"], log=lines.append, profile="quick",
+                               lacking=frozenset({"fig3_6_kernels", "fig4_5_learn_d50"}))
+    assert missing[0] == ("fig3_6: drawn from the full profile's runs of fig3_6_kernels, which are missing "
+                          "(cerebx report --profile full)")
+    assert missing[1].startswith("fig4_5: no upper-limb SNN learning runs")  # drawn, from no runs at all here
+    spec = all_figures()["fig4_5"]
+    assert not spec.needs("fig4_5_learn_d50") and spec.needs("fig4_5_learn") and not spec.needs("fig3_6")
+
+
 def test_a_study_that_cannot_converge_in_quick_is_drawn_from_the_full_profile(tmp_path, capsys):
     """from_full: the quick profile runs neither the study nor those starting from it; it draws on their
     full-profile runs when they exist, and the dry run says which are there and which lack."""
