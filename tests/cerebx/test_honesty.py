@@ -66,6 +66,18 @@ def test_sweep_exit_code_is_the_number_of_failed_jobs(in_tmp, monkeypatch, capsy
     assert "0 of 3 jobs completed, 3 failed" in capsys.readouterr().err
 
 
+def test_a_job_that_runs_clears_the_refusal_an_earlier_attempt_left(in_tmp, capsys):
+    """error.txt says a sweep job was refused before it ran; once a later attempt of the job runs, the sweep's
+    summary must not go on counting it as failed (the report's Fig. 4.6 seeds: three jobs completed in folders
+    with an older refusal were listed as failed and the study exited with 5)."""
+    for job in ("0", "1"):  # as a job refused by other code (the sweep is checked before any job starts now)
+        (in_tmp / "sw" / job).mkdir(parents=True)
+        (in_tmp / "sw" / job / "error.txt").write_text("recording.trials: unknown key\n")
+    assert main(["run", "-m", *DEMO, "trials=1", "seed=1,2", "hydra.sweep.dir=sw"]) == 0
+    assert not (in_tmp / "sw" / "0" / "error.txt").exists() and not (in_tmp / "sw" / "1" / "error.txt").exists()
+    assert "2 of 2 jobs completed" in capsys.readouterr().out
+
+
 # ---- a hard-killed run stays first-class ------------------------------------------------------------
 
 def _start(tmp_path: Path, *args: str) -> subprocess.Popen:
