@@ -47,7 +47,8 @@ def _one_network(name: str, seconds: float, warmup: float, parallel: bool, start
         out["closed_loop"] = {"error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}
         return out
     loop = json.loads(proc.stdout)
-    out["closed_loop"] = {k: loop[k] for k in ("build_s", "rt_factor", "cpu_rt_factor", "us_per_step", "per_step_us")}
+    out["closed_loop"] = {k: loop[k] for k in ("build_s", "rt_factor", "cpu_rt_factor", "us_per_step", "cpu_us_per_step",
+                                               "per_step_us")}
     return out
 
 
@@ -56,7 +57,7 @@ def _plant_pd(seconds: float) -> dict[str, Any]:
     for label, extra in (("baxter_pd", []), ("baxter_pd_physics_1ms", ["plant.physics_dt_ms=1.0"]),
                          ("baxter_sea_pd", ["plant=baxter_sea"])):
         r = closed_loop_rt(["+task=circle", "controller=pd", *extra], seconds=seconds, warmup_s=1.0, parts=not extra)
-        rows[label] = {k: r[k] for k in ("rt_factor", "us_per_step", "per_step_us") if k in r}
+        rows[label] = {k: r[k] for k in ("rt_factor", "us_per_step", "cpu_us_per_step", "per_step_us") if k in r}
     return rows
 
 

@@ -18,7 +18,9 @@ from cerebx.recording.recorder import Recorder
 def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float = 1.0,
                    record_to: Path | None = None, parts: bool = False) -> dict[str, Any]:
     """Run ``overrides`` for ``warmup_s`` (compilation, first-touch), then time ``seconds`` more: simulated
-    seconds per wall second (``rt_factor``) and per CPU second of the process, all threads (``cpu_rt_factor``).
+    seconds per wall second (``rt_factor``) and per CPU second of the process, all threads (``cpu_rt_factor``);
+    ``cpu_us_per_step``: the CPU time per control step of the loop's own thread and of every other thread (a
+    spiking network's thread and numba's workers), from the same untimed trials (no per-phase timers).
 
     With ``record_to`` the MCAP recording is on (as in a real run); otherwise it is off, which
     measures plant + controller + loop alone. With ``parts`` as many trials again follow, timed part by part
@@ -39,10 +41,10 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
     try:
         for i in range(warm_trials):
             loop.run_trial(i)
-        t1, c1 = time.perf_counter(), time.process_time()
+        t1, c1, m1 = time.perf_counter(), time.process_time(), time.thread_time()
         for i in range(warm_trials, warm_trials + timed_trials):
             loop.run_trial(i)
-        wall, cpu = time.perf_counter() - t1, time.process_time() - c1
+        wall, cpu, main_cpu = time.perf_counter() - t1, time.process_time() - c1, time.thread_time() - m1
         if parts:
             first = warm_trials + timed_trials
             table = per_step_parts(loop, range(first, first + timed_trials), steps_per_trial)
@@ -51,10 +53,13 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
             loop.settle()
             rec.close()
     sim = timed_trials * steps_per_trial * dt
+    steps = timed_trials * steps_per_trial
     return {"overrides": overrides, "build_s": round(build_s, 3), "sim_seconds": sim,
             "wall_seconds": round(wall, 3), "rt_factor": round(sim / wall, 2),
             "cpu_seconds": round(cpu, 3), "cpu_rt_factor": round(sim / cpu, 2),
             "us_per_step": round(wall / (timed_trials * steps_per_trial) * 1e6, 1),
+            "cpu_us_per_step": {"main_thread": round(main_cpu / steps * 1e6, 1),
+                                "other_threads": round((cpu - main_cpu) / steps * 1e6, 1)},
             "recording": record_to is not None, **({"per_step_us": table} if parts else {})}
 
 

@@ -59,6 +59,18 @@ def test_the_closed_loop_reports_each_part_per_step():
     assert all(v > 0 for k, v in net.items() if k != "thread_other")
     assert parts["network_busy"] == pytest.approx(sum(net.values()), abs=0.1)
     assert 0 < parts["network_cpu"] < parts["process_cpu"]
+    # untimed CPU per step by thread: the network runs on its own thread beside the loop's
+    cpu = out["cpu_us_per_step"]
+    assert cpu["main_thread"] > 0 and cpu["other_threads"] > 0
+    total = 1e6 / out["cpu_rt_factor"] * 0.002  # the process's CPU per 2 ms step
+    assert cpu["main_thread"] + cpu["other_threads"] == pytest.approx(total, rel=0.02)
+
+
+@pytest.mark.integration
+def test_a_loop_without_a_network_thread_spends_its_cpu_on_the_main_thread():
+    out = closed_loop_rt(["+task=circle", "controller=pd"], seconds=0.5, warmup_s=0.5)
+    cpu = out["cpu_us_per_step"]
+    assert cpu["main_thread"] > 0 and cpu["other_threads"] < 0.2 * cpu["main_thread"]
 
 
 def test_the_network_bench_splits_a_step_into_parts():
