@@ -47,8 +47,8 @@ def _one_network(name: str, seconds: float, warmup: float, parallel: bool, start
         out["closed_loop"] = {"error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}
         return out
     loop = json.loads(proc.stdout)
-    out["closed_loop"] = {k: loop[k] for k in ("build_s", "rt_factor", "cpu_rt_factor", "us_per_step", "cpu_us_per_step",
-                                               "per_step_us")}
+    keys = ("build_s", "rt_factor", "cpu_rt_factor", "us_per_step", "cpu_us_per_step", "per_step_us")
+    out["closed_loop"] = {k: loop[k] for k in keys}
     return out
 
 
