@@ -47,7 +47,7 @@ def run_app(cfg: DictConfig) -> float | None:
             (run_dir / runfiles.ERROR).write_text("; ".join(err.problems) + "\n")
             return None
         raise SystemExit(2) from None
-    # a refusal an earlier attempt of this job left (error.txt) no longer stands: this attempt's summary says how it went
+    # a refusal an earlier attempt of this job left (error.txt) no longer stands: this attempt's summary tells
     (Path(hc.runtime.output_dir) / runfiles.ERROR).unlink(missing_ok=True)
     if reused is not None:
         print(f"reused: {run_dir} already completed {reused.get('trials_completed')} trials")
