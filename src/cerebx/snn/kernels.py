@@ -1179,7 +1179,6 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
     pf_head, pf_lost = plast.pf_head, plast.pf_lost
     col_buf, out_idx, out_t = buf.col_buf, buf.out_idx, buf.out_t
     R = ring_idx.shape[0]
-    zero32 = np.float32(0.0)
     pb = pop_i.shape[0]  # the profile's first part (after the populations)
     tk = prof_now(prof)
     slot0 = t0 % R
@@ -1221,22 +1220,15 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                     if j < 0 or j >= n_pre:
                         continue
                     if lazy:
-                        # without a branch on whether the target is listed (about half of the granule layer's
-                        # targets are, at random: a branch there mispredicts every other synapse); the store
-                        # not meant for the target writes back the value it read (w 0 + g at the list's first
-                        # slot). Both sums keep the form g + w sc, which the compiler contracts into one fma as
-                        # everywhere else a synapse delivers
-                        g2 = g[2]
                         for q in range(sp_ptr[off + j], sp_ptr[off + j + 1]):
                             i = sp_post[q]
                             kq = slot[i]
-                            on = kq >= 0
-                            k = kq if on else plo
-                            g2[k] += sp_w[q] * (sc if on else zero32)
-                            r = g_rest[i]
-                            x = r + sp_w[q] * sc
-                            g_rest[i] = r if on else x
-                            if not ((kq < 0) & ((x < 0.0) | (x > gmax))):  # listed, or stays exactly at rest
+                            if kq >= 0:
+                                g[2, kq] += sp_w[q] * sc
+                                continue
+                            x = g_rest[i] + sp_w[q] * sc
+                            if x >= 0.0 and x <= gmax:  # stays exactly at rest: unlisted
+                                g_rest[i] = x
                                 continue
                             g_rest[i] = 0.0
                             kq = plo + n_act[pp]
