@@ -49,8 +49,10 @@ exactly 0) stays unlisted. Its conductance lives in ``g_rest`` (global index ord
 deliveries there in the same order and float32 operations as a listed neuron's, and decays with each
 step of the population in one vectorised pass (the integration loop's product, flushed below
 G_FLOOR). Activation moves it into the list; a compaction moves a listed neuron back. The listed
-neurons of a population without NMDA input compute their one-step estimates in a vectorised pass
-(``_lif_full_listed``, bit for bit ``_lif_full_fine``).
+neurons of a population without NMDA input are stepped in one vectorised pass that computes the step and its
+bifixed sub-steps for every neuron and selects one (``_lif_gaba``; bit for bit ``_lif_full_fine``, for the
+methods and sub-step counts in ``FUSED``; the others compute their one-step estimates in a vectorised pass and
+the sub-steps neuron by neuron, ``_lif_full_listed``).
 """
 
 from __future__ import annotations
@@ -591,13 +593,11 @@ def _lif_full_fine(u, gA, gN, gG, ref, flag, p, nf):
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
 def _du_no_nmda(x, a, n, b, gL, EL, EAL, EGL, invC):
     """:func:`_du` for n = 0 (no NMDA input), bit for bit: the Mg block, which then multiplies 0, is replaced by
-    a cheap stand-in of the same form 1 / (1 + e(V)), so the compiler builds the same arithmetic around it (it
-    folds n / (1 + e) into one division and contracts the rest alike: a formula without the term is contracted
-    differently and moves the last bits). Tests compare it with :func:`_du` on random states."""
-    f32 = np.float32
-    v = min(max(EL + x, f32(-150.0)), f32(50.0))
-    y = (f32(-0.062) * v + f32(MG_LN)) * f32(1.0 / 64.0)
-    mg = f32(1.0) / (f32(1.0) + y * y)
+    a cheap stand-in of the same form 1 / (1 + e), e = x^2 (finite and positive, so n times it is exactly 0), and
+    the compiler builds the same arithmetic around it (it folds n / (1 + e) into one division and contracts the
+    rest alike: a formula without the term, or with a stand-in that is no division, is contracted differently and
+    moves the last bits). Tests compare it with :func:`_du` on random states."""
+    mg = np.float32(1.0) / (np.float32(1.0) + x * x)
     return (-gL * x + (a + n * mg) * (EAL - x) + b * (EGL - x)) * invC
 
 
@@ -682,6 +682,122 @@ def _lif_full_listed_par(u, gA, gN, gG, ref, flag, out, p, nf, nch):
         b = (ch + 1) * n // nch
         cnt += _lif_full_listed(u[a:b], gA[a:b], gN[a:b], gG[a:b], ref[a:b], flag[a:b], out[a:b], p, nf)
     return cnt
+
+
+FUSED = ((1, 3), (0, 2), (0, 3))
+"""(method, bifixed sub-steps) for which :func:`_lif_gaba` has a fused loop: those whose result the tests prove
+bit for bit equal to :func:`_lif_full_listed`'s (RK2 with 3 sub-steps is the granule cell's; with 2 sub-steps, and
+Euler with 4 or more, the compiler rearranges the unrolled sub-steps' products and the last bit of V moves).
+The others keep :func:`_lif_full_listed`."""
+
+
+@njit(cache=True, inline="always")
+def _fusable(method, nf):
+    return (method == 1 and nf == 3) or (method == 0 and (nf == 2 or nf == 3))
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _gaba_loop(u, gA, gG, ref, flag, p, gmax, method, nf):
+    """The loop of :func:`_lif_gaba` for a constant ``method`` and ``nf`` (inlined: the sub-steps unroll and the
+    loop, free of branches, vectorises)."""
+    f32 = np.float32
+    h = f32(p[P_H])
+    hf = h / f32(nf)
+    gL, EL, invC = f32(p[P_GL]), f32(p[P_EL]), f32(1.0 / p[P_CM])
+    EAL, EGL = f32(p[P_EA] - p[P_EL]), f32(p[P_EG] - p[P_EL])
+    dA, dG = f32(p[P_DA]), f32(p[P_DG])
+    dec = (dA, f32(p[P_DAH]), f32(p[P_DN]), f32(p[P_DNH]), dG, f32(p[P_DGH]))
+    fA, fG = f32(p[P_DFA]), f32(p[P_DFG])
+    fdec = (fA, f32(p[P_DFAH]), f32(p[P_DFN]), f32(p[P_DFNH]), fG, f32(p[P_DFGH]))
+    ufine = f32(p[P_UFINE])
+    uth, nref = f32(p[P_VTH] - p[P_EL]), f32(p[P_NREF])
+    lo_u = f32(0.0) if p[P_CLAMP] > 0.5 else f32(-3.0e38)
+    zero, one = f32(0.0), f32(1.0)
+    # the NMDA conductance, 0 as a value the compiler cannot see through (h > 0): the NMDA term then stays in the
+    # stages' arithmetic, which the compiler contracts exactly as in _lif_full_fine (a literal 0 folds it away)
+    nz = f32(min(p[P_H], 0.0))
+    m = (gL, EL, EAL, EGL, invC)
+    cnt = zero
+    nrest = zero
+    for i in range(u.shape[0]):
+        x = u[i]
+        a0, b0 = gA[i], gG[i]
+        r = ref[i]
+        un = _no_nmda_rk(x, (a0, nz, b0), h, dec, method, m)
+        uf = x
+        a, n, b = a0, nz, b0
+        for _ in range(nf):
+            uf = _no_nmda_rk(uf, (a, n, b), hf, fdec, method, m)
+            a, n, b = a * fA, n * fdec[2], b * fG
+        un = uf if (x > ufine) | (un > ufine) else un
+        un = max(un, lo_u)
+        un = un if abs(un) >= U_FLOOR else zero
+        spk = (un >= uth) & (r <= zero)
+        un = zero if (r > zero) | spk else un
+        rn = nref if spk else max(r - one, zero)
+        ga = a0 * dA
+        ga = ga if ga > G_FLOOR else zero
+        gb = b0 * dG
+        gb = gb if gb > G_FLOOR else zero
+        u[i] = un
+        ref[i] = rn
+        flag[i] = np.uint8(spk)
+        gA[i] = ga
+        gG[i] = gb
+        cnt += one if spk else zero
+        nrest += one if (un == zero) & (ga == zero) & (rn == zero) & (gb >= zero) & (gb <= gmax) else zero
+    return int(cnt), int(nrest)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _lif_gaba(u, gA, gG, ref, flag, p, nf, gmax):
+    """One step of a compact lif_cond population with AMPA and GABA input and no NMDA input (the granule layer
+    under Golgi inhibition) in one pass per neuron: the step, its ``nf`` bifixed sub-steps (both computed for
+    every neuron and one selected by the rule of :func:`_lif_full_fine`, as :func:`_lif_poly` does, so the loop
+    vectorises), threshold, reset and refractory count, the AMPA and GABA decays and the count of neurons a
+    compaction may drop (:func:`_rest_full` with ``gmax``), touching no NMDA array (its conductances stay 0).
+    Bit for bit :func:`_lif_full_listed` followed by :func:`_rest_full` (tests), in about a quarter of their time
+    on the granule layer of thesis_golgi (its ~7 % of steps that need the sub-steps are branches there).
+    (method, ``nf``): one of :data:`FUSED`. Returns (spikes, neurons at rest after the step)."""
+    if int(p[P_METHOD]) == 1:
+        return _gaba_loop(u, gA, gG, ref, flag, p, gmax, 1, 3)
+    if nf == 2:
+        return _gaba_loop(u, gA, gG, ref, flag, p, gmax, 0, 2)
+    return _gaba_loop(u, gA, gG, ref, flag, p, gmax, 0, 3)
+
+
+@njit(cache=True, parallel=True, fastmath=True, error_model="numpy", boundscheck=False)
+def _lif_gaba_par(u, gA, gG, ref, flag, p, nf, gmax, nch):
+    """:func:`_lif_gaba` on numba threads: ``nch`` contiguous chunks."""
+    n = u.shape[0]
+    cnt = 0
+    nrest = 0
+    for ch in prange(nch):
+        a = ch * n // nch
+        b = (ch + 1) * n // nch
+        c1, r1 = _lif_gaba(u[a:b], gA[a:b], gG[a:b], ref[a:b], flag[a:b], p, nf, gmax)
+        cnt += c1
+        nrest += r1
+    return cnt, nrest
+
+
+def lif_gaba_step(u, gA, gG, ref, p, nf, gmax, chunks=1):
+    """One step of :func:`_lif_gaba` (``chunks`` > 1: :func:`_lif_gaba_par`) on copies, for tests: (u, gA, gG,
+    ref, flag, neurons at rest)."""
+    if (int(p[P_METHOD]), nf) not in FUSED:
+        raise ValueError(f"no fused loop for method {int(p[P_METHOD])} with {nf} sub-steps")
+    u, gA, gG, ref = (np.array(a, dtype=np.float32) for a in (u, gA, gG, ref))
+    flag = np.zeros(len(u), np.uint8)
+    if chunks > 1:
+        _, nrest = _lif_gaba_par(u, gA, gG, ref, flag, p, nf, np.float32(gmax), chunks)
+    else:
+        _, nrest = _lif_gaba(u, gA, gG, ref, flag, p, nf, np.float32(gmax))
+    return u, gA, gG, ref, flag, nrest
+
+
+def rest_count(u, gA, gN, gG, ref, gmax):
+    """:func:`_rest_full` on float32 copies, for tests."""
+    return _rest_full(*(np.asarray(a, dtype=np.float32) for a in (u, gA, gN, gG, ref)), np.float32(gmax))
 
 
 def lif_step(u, gA, gN, gG, ref, p, nf, listed=False):
@@ -1260,6 +1376,9 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
             hi = lo + na
             pp = pop_par[pi]
             tk = prof_lap(prof, pb + BOOKKEEPING, tk)  # the spikes collected so far
+            nf = pop_i[pi, I_NFINE]
+            fused = (kind != KIND_LIF_AMPA and kind != KIND_ADEX and pop_i[pi, I_COMPACT] != 0 and pops.nmda[pi] == 0
+                     and _fusable(int(pp[P_METHOD]), nf))
             if kind == KIND_LIF_AMPA:
                 if par > 1 and na >= PAR_MIN:
                     cnt, nr = _lif_poly_par(u[lo:hi], g[0, lo:hi], ref[lo:hi], flag[lo:hi], pops, pi, par)
@@ -1269,6 +1388,14 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
             elif kind == KIND_ADEX:
                 cnt = _adex(u[lo:hi], nrn.w[lo:hi], g[0, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp,
                             pop_i[pi, I_NFINE])
+            elif fused:
+                gmax = np.float32(pop_lazy[pi])
+                if par > 1 and na >= PAR_MIN:
+                    cnt, nr = _lif_gaba_par(u[lo:hi], g[0, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp, nf,
+                                            gmax, par)
+                else:
+                    cnt, nr = _lif_gaba(u[lo:hi], g[0, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp, nf, gmax)
+                n_rest[pi] = nr
             elif pop_i[pi, I_NFINE] > 1 and pop_i[pi, I_COMPACT] != 0 and pops.nmda[pi] == 0:
                 if par > 1 and na >= PAR_MIN:
                     cnt = _lif_full_listed_par(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi],
@@ -1281,7 +1408,7 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                                      pop_i[pi, I_NFINE])
             else:
                 cnt = _lif_full(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi], flag[lo:hi], pp)
-            if kind != KIND_LIF_AMPA and pop_i[pi, I_COMPACT] != 0:
+            if kind != KIND_LIF_AMPA and pop_i[pi, I_COMPACT] != 0 and not fused:
                 n_rest[pi] = _rest_full(u[lo:hi], g[0, lo:hi], g[1, lo:hi], g[2, lo:hi], ref[lo:hi],
                                         np.float32(pop_lazy[pi]))
             tk = prof_lap(prof, pi, tk)

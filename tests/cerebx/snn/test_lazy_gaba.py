@@ -7,15 +7,16 @@ bit."""
 from __future__ import annotations
 
 import pickle
+from itertools import product
 
 import numpy as np
 import pytest
 
-from cerebx.snn.kernels import lif_step
+from cerebx.snn.kernels import FUSED, _fusable, lif_gaba_step, lif_step, rest_count
 from cerebx.snn.network import Network
 from cerebx.snn.presets import GC
 from cerebx.snn.schema import LIFNeuron, NetworkConfig
-from cerebx.snn.topology import P_DG, build_topology, lazy_gaba_nS
+from cerebx.snn.topology import METHODS, N_COEF, N_PAR, ORDER, P_DG, P_EL, P_UFINE, P_VTH, build_topology, lazy_gaba_nS
 
 GC_GABA = dict(GC, E_GABA_mV=-80.0, tau_GABA_ms=10.0)
 N_GC = 8
@@ -128,6 +129,52 @@ def test_the_listed_step_equals_the_per_neuron_step_bit_for_bit(method, nf):
     assert a[5].sum() > 1000
     for x, y in zip(a, b, strict=True):
         assert np.array_equal(x.view(np.uint8), y.view(np.uint8))
+
+
+def _states(n: int, p: np.ndarray, seed: int = 0) -> tuple[np.ndarray, ...]:
+    """Random GC states (u, gA, gG, ref): a third at or near rest, a third within 0.01 mV of u_fine (the bifixed
+    rule's edge) or of the threshold, the rest anywhere in [-1, 20] mV; conductances often 0, else up to a few nS
+    (the lazy bound) with an exponential tail."""
+    rng = np.random.default_rng(seed)
+    edge = np.where(rng.random(n) < 0.5, p[P_UFINE], p[P_VTH] - p[P_EL]) + rng.uniform(-0.01, 0.01, n)
+    k = rng.integers(0, 3, n)
+    u = np.select([k == 0, k == 1], [np.where(rng.random(n) < 0.7, 0, rng.uniform(-1e-5, 1e-5, n)), edge],
+                  rng.uniform(-1, 20, n))
+    gA = np.where(rng.random(n) < 0.3, 0, rng.exponential(0.5, n))
+    gG = np.where(rng.random(n) < 0.3, 0, np.where(rng.random(n) < 0.5, rng.uniform(0, 4, n), rng.exponential(0.2, n)))
+    ref = np.where(rng.random(n) < 0.9, 0, rng.integers(0, 3, n))
+    return u, gA, gG, ref
+
+
+@pytest.mark.parametrize("method,nf", [("rk2", 3), ("euler", 2), ("euler", 3)])
+def test_the_fused_step_equals_the_listed_step_and_rest_count_bit_for_bit(method, nf):
+    """_lif_gaba (one vectorised pass: step and sub-steps for every neuron, one selected) against
+    _lif_full_listed then _rest_full, on 1.2 M states incl. states at u_fine and at threshold; and on threads."""
+    neuron = dict(GC_GABA, integration={"method": method, "dt_ms": 1.0, "bifixed_substeps": nf})
+    p = build_topology(_cfg(neuron)).par[2]
+    gmax = lazy_gaba_nS(LIFNeuron.model_validate(neuron), 1.0)
+    u, gA, gG, ref = _states(1_200_000, p, seed=nf)
+    z = np.zeros_like(u)
+    a = lif_step(u, gA, z, gG, ref, p, nf, listed=True)
+    b = lif_gaba_step(u, gA, gG, ref, p, nf, gmax)
+    assert a[5].sum() > 10_000 and (u.astype(np.float32) > np.float32(p[P_UFINE])).sum() > 300_000
+    assert not a[2].any()
+    for x, y in zip((a[0], a[1], a[3], a[4], a[5]), b[:5], strict=True):
+        assert np.array_equal(x.view(np.uint8), y.view(np.uint8))
+    assert b[5] == rest_count(*a[:5], gmax) > 100_000
+    c = lif_gaba_step(u, gA, gG, ref, p, nf, gmax, chunks=3)  # on numba threads, in 3 chunks
+    assert b[5] == c[5]
+    for x, y in zip(b[:5], c[:5], strict=True):
+        assert np.array_equal(x.view(np.uint8), y.view(np.uint8))
+
+
+def test_the_fused_loop_is_taken_exactly_for_its_table():
+    """Every (method, sub-steps) a lif_cond population may have: the step kernel fuses those of FUSED (proven
+    above), the others keep the two-pass step."""
+    allowed = [(METHODS[m], nf) for m, nf in product(METHODS, range(1, 7)) if ORDER[m] * nf <= N_COEF - 1]
+    assert {c for c in allowed if _fusable(*c)} == set(FUSED)
+    with pytest.raises(ValueError, match="no fused loop"):
+        lif_gaba_step(np.zeros(1), np.zeros(1), np.zeros(1), np.zeros(1), np.zeros(N_PAR), 4, 0.0)
 
 
 def _drive(nets, steps, n_mf, n_goc, lo_mf, lo_goc, seed=1):
