@@ -730,13 +730,7 @@ def _gaba_loop(u, gA, gG, ref, flag, p, gmax, method, nf):
             uf = _no_nmda_rk(uf, (a, n, b), hf, fdec, method, m)
             a, n, b = a * fA, n * fdec[2], b * fG
         un = uf if (x > ufine) | (un > ufine) else un
-        un = max(un, lo_u)
-        un = un if abs(un) >= U_FLOOR else zero
-        spk = (un >= uth) & (r <= zero)
-        un = zero if (r > zero) | spk else un
-        rn = nref if spk else max(r - one, zero)
-        ga = a0 * dA
-        ga = ga if ga > G_FLOOR else zero
+        un, rn, spk, ga = _finish(un, r, a0, lo_u, uth, nref, dA)
         gb = b0 * dG
         gb = gb if gb > G_FLOOR else zero
         u[i] = un
