@@ -52,9 +52,9 @@ class Estimate:
 
     def line(self) -> str:
         state = f", learned state <= {_size(self.state_bytes)} before compression" if self.state_bytes else ""
-        compiling = f" (~{_duration(self.compile_s)} of it compiling numba kernels, once)" if self.compile_s else ""
+        compiling = f" (~{duration(self.compile_s)} of it compiling numba kernels, once)" if self.compile_s else ""
         return (f"estimate: {self.sim_s:,.0f} s simulated, run.mcap ~{_size(self.mcap_bytes)}{state}, "
-                f"~{_duration(self.wall_s)} on a quiet 2-core machine{compiling}")
+                f"~{duration(self.wall_s)} on a quiet 2-core machine{compiling}")
 
     def with_compiling(self, seconds: float) -> Estimate:
         """This estimate with ``seconds`` of compiling added to its wall time."""
@@ -68,7 +68,8 @@ def _size(b: float) -> str:
     return f"{b:.0f} B"
 
 
-def _duration(s: float) -> str:
+def duration(s: float) -> str:
+    """A duration in seconds as people read it (days, h, min or s)."""
     if s >= 86400:
         return f"{s / 86400:,.1f} days"
     if s >= 3600:

@@ -36,7 +36,7 @@ from typing import Any
 from cerebx import __version__, runfiles
 from cerebx.config import load_jobs
 from cerebx.errors import CerebxError
-from cerebx.estimate import estimate, total
+from cerebx.estimate import duration, estimate, total
 from cerebx.report import figures
 from cerebx.report.badge import stamp
 from cerebx.report.delays import delay_rows
@@ -329,10 +329,6 @@ def borrowed_missing(jobs: list) -> str | None:
             f"runs, which are missing ({', '.join(lacking)}): run cerebx report --profile full to draw their figures")
 
 
-def _hours(seconds: float) -> str:
-    return f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds / 60:.0f} min"
-
-
 def dry_run(jobs: list, folder: Path, parallel: int) -> None:
     """Print each job (reused or to run; ``full``: a full-profile run a quick report draws on, ``lacks``: one that
     does not exist yet) and the estimate of those to run: on a quiet machine (``cerebx.estimate``) and at the pace
@@ -358,7 +354,7 @@ def dry_run(jobs: list, folder: Path, parallel: int) -> None:
     if pace.runs:
         print(f"at the pace of this profile's {pace.runs} finished runs (by kind of run, --jobs {parallel}"
               f"{f'; {resumed} resume from their checkpoints' if resumed else ''}): "
-              f"~{_hours(remaining_wall_s(pace, left, parallel, fractions))}")
+              f"~{duration(remaining_wall_s(pace, left, parallel, fractions))}")
 
 
 def needed_studies(names: list[str] | None) -> list[str]:

@@ -314,16 +314,23 @@ def _decay(g, d):
         g[i] = x if x > G_FLOOR else zero
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+def _at_rest(u, a, n, r, b, gmax):
+    """Whether a neuron of a compact lif_cond population with NMDA/GABA may leave the list: at rest (u, the AMPA
+    and NMDA conductances a, n and the refractory count r 0) with a GABA conductance b in [0, gmax] (gmax 0:
+    none), which a compaction keeps in ``g_rest``. Branch-free, so the loops that count it vectorise."""
+    zero = np.float32(0.0)
+    return (u == zero) & (a == zero) & (n == zero) & (r == zero) & (b >= zero) & (b <= gmax)
+
+
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
 def _rest_full(u, gA, gN, gG, ref, gmax):
-    """Listed neurons of a compact lif_cond population with NMDA/GABA that a compaction may drop: at rest (u, the
-    AMPA and NMDA conductances and the refractory count 0) with a GABA conductance in [0, gmax] (gmax 0: none)."""
+    """Listed neurons of a compact lif_cond population with NMDA/GABA that a compaction may drop
+    (:func:`_at_rest`)."""
     zero, one = np.float32(0.0), np.float32(1.0)
     cnt = zero
     for i in range(u.shape[0]):
-        b = gG[i]
-        ok = (u[i] == zero) & (gA[i] == zero) & (gN[i] == zero) & (ref[i] == zero) & (b >= zero) & (b <= gmax)
-        cnt += one if ok else zero
+        cnt += one if _at_rest(u[i], gA[i], gN[i], ref[i], gG[i], gmax) else zero
     return int(cnt)
 
 
@@ -739,7 +746,7 @@ def _gaba_loop(u, gA, gG, ref, flag, p, gmax, method, nf):
         gA[i] = ga
         gG[i] = gb
         cnt += one if spk else zero
-        nrest += one if (un == zero) & (ga == zero) & (rn == zero) & (gb >= zero) & (gb <= gmax) else zero
+        nrest += one if _at_rest(un, ga, nz, rn, gb, gmax) else zero
     return int(cnt), int(nrest)
 
 
@@ -1002,7 +1009,7 @@ def _compact(lo, na, nrn, buf, full, gmax):
         x, gk, r = u[k], g[0, k], ref[k]
         if full:
             gn, gb = g[1, k], g[2, k]
-            if x == 0.0 and gk == 0.0 and r == 0.0 and gn == 0.0 and gb >= 0.0 and gb <= gmax:
+            if _at_rest(x, gk, gn, r, gb, gmax):
                 slot[i] = -1
                 g_rest[i] = gb
                 continue
