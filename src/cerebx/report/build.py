@@ -2,6 +2,7 @@
 
     cerebx report                         every run under runs/
     cerebx report RUN_DIR...              only those runs (a folder of runs is searched)
+    cerebx report runs/report/quick       a quick profile's runs, with those it draws from the full profile
     cerebx report --profile quick|full    first run the studies whose runs are missing, then draw them
 
 Every registered figure (report/registry.py) is drawn from the runs it finds; one whose runs are
@@ -329,6 +330,17 @@ def borrowed_missing(jobs: list) -> str | None:
             f"runs, which are missing ({', '.join(lacking)}): run cerebx report --profile full to draw their figures")
 
 
+def with_borrowed(quick: Path, names: list[str] | None = None) -> tuple[list[Path], frozenset[str]]:
+    """A quick profile's folder given to the report (``<root>/quick``) is drawn as ``--profile quick`` draws it:
+    with the runs of the studies it borrows from the full profile (``from_full``) in ``<root>/full``, those
+    of the ``names`` figures. Returns those runs and the borrowed studies without runs there (their figures
+    are left out with a line)."""
+    lent = list(dict.fromkeys(j.study for j in plan("quick", quick.parent, needed_studies(names)) if j.borrowed))
+    found = {s: find_run_dirs(quick.parent / "full" / s) if (quick.parent / "full" / s).is_dir() else [] for s in lent}
+    absent = frozenset(s for s, d in found.items() if not d and REPLICA not in s)
+    return [d for s in lent for d in found[s]], absent
+
+
 def dry_run(jobs: list, folder: Path, parallel: int) -> None:
     """Print each job (reused or to run; ``full``: a full-profile run a quick report draws on, ``lacks``: one that
     does not exist yet) and the estimate of those to run: on a quiet machine (``cerebx.estimate``) and at the pace
@@ -414,10 +426,13 @@ def main(argv: list[str]) -> int:
             # (a figure is drawn from the first seed; the other seeds only give its intervals)
             absent = frozenset(j.study for j in jobs if j.borrowed and not j.done() and REPLICA not in j.study)
         else:
-            absent = frozenset()
             dirs = []
             for p in a.runs or [Path("runs")]:
                 dirs.extend(find_run_dirs(p) if p.is_dir() and not (p / runfiles.SUMMARY).exists() else [p])
+            absent = frozenset()
+            if quick := [p for p in a.runs or [] if p.name == "quick" and p.is_dir()]:
+                lent, absent = with_borrowed(quick[0], names)
+                dirs, a.profile = [*dirs, *lent], "quick"
         index, problems, n = build(dirs, a.out, names, log=print, command=shlex.join(["cerebx", "report", *argv]),
                                    profile=a.profile, started=t0, lacking=absent)
     except CerebxError as err:

@@ -368,6 +368,25 @@ def test_a_figure_is_not_drawn_without_a_study_it_borrows_from_the_full_profile(
     assert not spec.needs("fig4_5_learn_d50") and spec.needs("fig4_5_learn") and not spec.needs("fig3_6")
 
 
+def test_a_quick_folder_given_to_the_report_draws_on_the_full_profile_beside_it(tmp_path):
+    """CI's slow test gave the report a quick profile's folder: Fig. 3.10 was "Not drawn", its learning
+    (from_full) lying in the full profile's folder beside it, where ``--profile quick`` finds it."""
+    from cerebx.report.build import with_borrowed
+
+    def run(*parts):
+        d = tmp_path.joinpath(*parts)
+        d.mkdir(parents=True)
+        (d / "summary.json").write_text("{}")
+        return d
+
+    run("quick", "fig3_4_pd", "delay.total_ms=0")
+    learned = run("full", "learn_multikernel", "run")
+    lent, absent = with_borrowed(tmp_path / "quick")
+    assert learned in lent and "learn_multikernel" not in absent
+    assert "fig3_6_kernels" in absent  # its figure is left out with a line
+    assert with_borrowed(tmp_path / "quick", ["fig3_4"]) == ([], frozenset())  # only the figures asked for
+
+
 def test_a_study_that_cannot_converge_in_quick_is_drawn_from_the_full_profile(tmp_path, capsys):
     """from_full: the quick profile runs neither the study nor those starting from it; it draws on their
     full-profile runs when they exist, and the dry run says which are there and which lack."""
