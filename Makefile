@@ -45,7 +45,10 @@ install: $(STAMP) ## create .venv and install cerebx with its test tools
 run: $(STAMP) ## run the default experiment (RUN_ARGS=... to choose another)
 	$(BIN)/cerebx run $(RUN_ARGS)
 
+# tests/warm.py first compiles the kernels and solves the task paths the tests share, each once, on every core
+# (on a fresh clone the workers would otherwise compile the same kernels side by side)
 test: $(STAMP) ## unit and integration tests, not the slow ones (under 5 minutes on 2 cores)
+	$(BIN)/python tests/warm.py
 	$(BIN)/pytest -m "not slow" -n $(TEST_WORKERS)
 
 test-unit: $(STAMP) ## only the unit tests (seconds)

@@ -77,18 +77,18 @@ def test_sigkilled_run_resumes_to_the_same_trials(tmp_path):
 def test_sigkilled_learning_run_resumes_to_the_same_weights(tmp_path):
     """The spiking network's weights: written ahead of the first checkpoint from the live array, then only
     their changed rows; a resumed process writes its own file ahead (after settling the committed journal)."""
-    args = ["+task=circle", "+experiment=small_snn", "recording.progress=off", "trials=60",
-            "recording.checkpoint_every=10"]
+    args = ["+task=circle", "+experiment=small_snn", "recording.progress=off", "trials=30",
+            "recording.checkpoint_every=5"]
     whole, killed = tmp_path / "whole", tmp_path / "killed"
     ref = _cerebx(*args, f"hydra.run.dir={whole}", cwd=tmp_path)
     assert ref.wait() == 0, ref.stdout.read()
     run = _cerebx(*args, f"hydra.run.dir={killed}", cwd=tmp_path)
-    _wait_for_checkpoint(killed, 20, run)
+    _wait_for_checkpoint(killed, 10, run)
     run.send_signal(signal.SIGKILL)
     run.wait()
     head = checkpoint.read_head(killed)
-    assert head["arrays"]["file"] == "checkpoint.10.arrays"  # written ahead, then journals on top
-    assert head["trials_done"] < 60
+    assert head["arrays"]["file"] == "checkpoint.5.arrays"  # written ahead, then journals on top
+    assert head["trials_done"] < 30
     cont = _cerebx(f"resume={killed}", cwd=tmp_path)
     out, _ = cont.communicate(timeout=300)
     assert cont.returncode == 0, out

@@ -69,14 +69,15 @@ def test_distance_metric_adapts_only_when_enabled():
 
 
 def test_storage_grows_and_outputs_are_independent():
-    model = LWPR(1, 2, init_D=400.0, initial_capacity=2)
+    # (2 inputs, the second constant: the 2-in/2-out shape test_update_many compiles; numba compiles ~20 s a shape)
+    model = LWPR(2, 2, init_D=400.0, initial_capacity=2)
     for _ in range(5):
         for x in np.linspace(-1, 1, 41):
-            model.update([x], [x, -2 * x])
+            model.update([x, 0.5], [x, -2 * x])
     assert model.n_receptive_fields[0] > 2 and model.n_receptive_fields[0] == model.n_receptive_fields[1]
-    y = model.predict([0.3])
+    y = model.predict([0.3, 0.5])
     assert y[0] == pytest.approx(0.3, abs=0.05) and y[1] == pytest.approx(-0.6, abs=0.1)
-    _, acts = model.predict_with_activations([0.3])
+    _, acts = model.predict_with_activations([0.3, 0.5])
     assert len(acts) == 2 and acts[0].shape == (model.n_receptive_fields[0],) and acts[0].max() > 0.5
 
 

@@ -1,0 +1,83 @@
+"""Compile the kernels and solve the task paths `make test` needs, once, on every core, before pytest starts.
+
+On a fresh clone numba's cache and the IK cache are empty. Left to the tests, pytest's workers and the runs they
+start as subprocesses compile the same kernels side by side (the spiking network's chunk kernel, ~50 s, was
+compiled by a worker and by a killed-and-resumed run at the same time); here each family is compiled once, the
+families spread over the cores. With warm caches this takes a few seconds (loads only).
+
+Usage: ``python tests/warm.py [JOBS]`` (default: every core); NUMBA_CACHE_DIR and CEREBX_CACHE as the tests use.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+
+def _snn(parts: bool, network: str = "small") -> None:
+    """A small network's closed loop: the chunk kernels with and without the cost profile (``parts``), for a
+    network without sparse plasticity and for one with it (the Golgi layer's)."""
+    from cerebx.loop.timing import closed_loop_rt
+
+    closed_loop_rt(["+task=circle", "+experiment=small_snn", f"network={network}"], seconds=0.05, warmup_s=0.05,
+                   parts=parts)
+
+
+def _lwpr(n_in: int, n_out: int) -> None:
+    """LWPR's entry points for one model shape (numba compiles one version per shape)."""
+    import numpy as np
+
+    from cerebx.lwpr import LWPR
+
+    m = LWPR(n_in, n_out)
+    m.update_many(np.zeros((2, n_in)), np.zeros((2, n_out)))
+    m.predict_many(np.zeros((2, n_in)))
+
+
+def _capolei() -> None:
+    """The Capolei circuit's LWPR shape, as its stage contract test builds it."""
+    from cerebx.build import build_components
+    from cerebx.config import load
+
+    build_components(load(["+experiment=capolei2020_arch3", "trials=1"])[0])
+
+
+def _task(kind: str) -> None:
+    """A Cartesian task's joint paths (IK, cached under CEREBX_CACHE)."""
+    from types import SimpleNamespace
+
+    from cerebx import registry
+    from cerebx.registry import load_plugins
+    from cerebx.schema import task as T
+
+    load_plugins()
+    cfg = {"circle_eight": T.CircleEightTask(), "inclined_circle": T.InclinedCircleTask()}[kind]
+    registry.tasks.build(cfg, SimpleNamespace(cache_dir=Path(os.environ["CEREBX_CACHE"]), plant=None))
+
+
+# longest first, so the pool ends about together
+JOBS = [(_snn, (False,)), (_task, ("circle_eight",)), (_capolei, ()), (_lwpr, (1, 1)), (_lwpr, (2, 1)),
+        (_lwpr, (2, 2)), (_task, ("inclined_circle",)), (_snn, (False, "small_golgi")), (_snn, (True,))]
+
+
+def main(jobs: int) -> int:
+    root = Path(__file__).resolve().parents[1]
+    os.environ.setdefault("NUMBA_CACHE_DIR", str(root / ".cache" / "numba"))
+    os.environ.setdefault("CEREBX_CACHE", str(root / ".cache" / "cerebx"))
+    from cerebx.numba_cache import retire_stale
+
+    retire_stale(Path(os.environ["NUMBA_CACHE_DIR"]))  # as the tests' conftest does, before any worker loads
+    t0 = time.monotonic()
+    with ProcessPoolExecutor(jobs, mp_context=mp.get_context("spawn")) as pool:
+        for f in [pool.submit(fn, *args) for fn, args in JOBS]:
+            f.result()  # a failure here is the tests' failure too: say it now
+    print(f"warm: kernels and task paths ready in {time.monotonic() - t0:.0f} s ({jobs} processes)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(int(sys.argv[1]) if len(sys.argv) > 1 else os.cpu_count() or 1))
