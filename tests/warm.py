@@ -64,12 +64,8 @@ JOBS = [(_snn, (False,)), (_task, ("circle_eight",)), (_capolei, ()), (_lwpr, (1
 
 
 def main(jobs: int) -> int:
-    root = Path(__file__).resolve().parents[1]
-    os.environ.setdefault("NUMBA_CACHE_DIR", str(root / ".cache" / "numba"))
-    os.environ.setdefault("CEREBX_CACHE", str(root / ".cache" / "cerebx"))
-    from cerebx.numba_cache import retire_stale
+    import conftest  # noqa: F401  (the tests' cache folders, stale kernels dropped: before any process loads one)
 
-    retire_stale(Path(os.environ["NUMBA_CACHE_DIR"]))  # as the tests' conftest does, before any worker loads
     t0 = time.monotonic()
     with ProcessPoolExecutor(jobs, mp_context=mp.get_context("spawn")) as pool:
         for f in [pool.submit(fn, *args) for fn, args in JOBS]:

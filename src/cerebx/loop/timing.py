@@ -52,12 +52,12 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
         if rec is not None:
             loop.settle()
             rec.close()
-    sim = timed_trials * steps_per_trial * dt
     steps = timed_trials * steps_per_trial
+    sim = steps * dt
     return {"overrides": overrides, "build_s": round(build_s, 3), "sim_seconds": sim,
             "wall_seconds": round(wall, 3), "rt_factor": round(sim / wall, 2),
             "cpu_seconds": round(cpu, 3), "cpu_rt_factor": round(sim / cpu, 2),
-            "us_per_step": round(wall / (timed_trials * steps_per_trial) * 1e6, 1),
+            "us_per_step": round(wall / steps * 1e6, 1),
             "cpu_us_per_step": {"main_thread": round(main_cpu / steps * 1e6, 1),
                                 "other_threads": round((cpu - main_cpu) / steps * 1e6, 1)},
             "recording": record_to is not None, **({"per_step_us": table} if parts else {})}

@@ -336,7 +336,7 @@ def with_borrowed(quick: Path, names: list[str] | None = None) -> tuple[list[Pat
     of the ``names`` figures. Returns those runs and the borrowed studies without runs there (their figures
     are left out with a line)."""
     lent = list(dict.fromkeys(j.study for j in plan("quick", quick.parent, needed_studies(names)) if j.borrowed))
-    found = {s: find_run_dirs(quick.parent / "full" / s) if (quick.parent / "full" / s).is_dir() else [] for s in lent}
+    found = {s: find_run_dirs(quick.parent / "full" / s) for s in lent}  # (none for a missing folder)
     absent = frozenset(s for s, d in found.items() if not d and REPLICA not in s)
     return [d for s in lent for d in found[s]], absent
 
