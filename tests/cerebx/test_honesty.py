@@ -394,6 +394,23 @@ def test_the_full_network_estimate_and_its_compressed_state(load, small_state):
     assert (small_state / "controller_state.npz").stat().st_size < raw / 2  # written compressed
 
 
+def test_runs_sharing_the_cores_take_the_cpu_they_need(load):
+    """A spiking run keeps two threads busy: alone it has both cores, beside another run one. The thesis
+    network's learning runs of the full profile from an empty folder (--jobs 2, 2026-11-28) took 588-651 s for
+    5,000 s simulated, with 579-614 s of CPU; two such runs at a time take about one run's CPU each."""
+    from cerebx.estimate import estimate, total
+
+    e = estimate(load(["+task=circle", "trials=2500"]))  # 5,000 s simulated
+    assert 540 < e.cpu_s < 660
+    assert e.wall_s < 0.6 * e.cpu_s  # alone: both cores
+    assert total([e, e], jobs=1).wall_s == pytest.approx(2 * e.wall_s)  # one after the other
+    assert total([e, e], jobs=2).wall_s == pytest.approx(e.cpu_s)  # side by side on 2 cores
+    pd = estimate(load(["+task=circle", "controller=pd", "trials=2500"]))  # one thread
+    assert pd.wall_s == pytest.approx(pd.cpu_s, rel=0.1)
+    assert total([pd, pd], jobs=2).wall_s == pytest.approx(pd.wall_s, rel=0.1)
+    assert "2 runs at a time" in total([e, pd], jobs=2).line()
+
+
 def test_report_dry_run_prints_an_estimate(in_tmp, capsys):
     assert main(["report", "--profile", "quick", "--dry-run", "--figures", "fig3_4"]) == 0
     last = capsys.readouterr().out.strip().splitlines()[-1]

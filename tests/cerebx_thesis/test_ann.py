@@ -183,3 +183,15 @@ def test_ann_preset_runs_without_supervisor_or_filter(load):
     cfg = load(["+task=circle", "controller=ann"])
     assert [s.kind for s in cfg.robot] == ["hold"]
     assert cfg.controller.desired == "newest" and cfg.controller.plasticity_error == "granule_joint"
+
+
+def test_the_estimate_counts_the_ann_controllers_own_cost():
+    """The ANN declares its CPU per simulated second (``cpu_per_sim_s``): its quick-profile runs took 82.6 ms per
+    simulated s against PD's 31 (2026-11-28), and the estimate of a run says so without naming the plugin."""
+    from cerebx.config import load
+    from cerebx.estimate import estimate
+
+    ann, _ = load(["+task=circle", "controller=ann", "trials=100"])
+    pd, _ = load(["+task=circle", "controller=pd", "trials=100"])
+    assert estimate(ann).cpu_s - estimate(pd).cpu_s == pytest.approx(0.050 * 200.0)
+    assert "cpu_per_sim_s" not in ann.controller.model_dump()  # not a config value: recorded runs keep their config

@@ -358,7 +358,7 @@ def dry_run(jobs: list, folder: Path, parallel: int) -> None:
     todo = [(j, e) for j, e, d in zip(jobs, exps, done, strict=True) if not d and e is not None]
     left = [e for _, e in todo]
     bad = [p for p, d in zip(problems, done, strict=True) if p is not None and not d]
-    print(f"{done.count(False)} runs to do: {total([estimate(e) for e in left]).line()}", *bad, sep="\n")
+    print(f"{done.count(False)} runs to do: {total([estimate(e) for e in left], parallel).line()}", *bad, sep="\n")
     pace = profile_pace(folder, {j.run_dir: estimate(e).wall_s
                                  for j, e, d in zip(jobs, exps, done, strict=True) if d and e is not None})
     fractions = [left_fraction(j.run_dir, e.trials) for j, e in todo]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import Field, model_validator
 
@@ -25,6 +25,9 @@ class ANNController(ControllerConfig):
     """
 
     kind: Literal["ann"] = "ann"
+    cpu_per_sim_s: ClassVar[float] = 0.050
+    """CPU seconds per simulated second on top of the loop's, for the run's estimate (``cerebx.estimate``):
+    measured 82.6 ms per simulated s for the ANN runs of the quick profile against 31 ms for PD (2026-11-28)."""
     bins: int = Field(4, ge=2, le=8, description="bins per MF signal (n); granule cells per joint = n**4")
     ranges: Annotated[GivenRanges | TaskRanges, Field(discriminator="kind")] = Field(
         TaskRanges(), description="MF ranges for the state coding; q_d shares the q range"
