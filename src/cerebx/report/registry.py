@@ -55,6 +55,11 @@ class Check:
     # where a failing check's cause is shown (a docs page and anchor, from the plugin's explanations file)
     explained_at: str | None = None
 
+    def __post_init__(self) -> None:
+        # a comparison of numpy values gives numpy.bool_, which figures.json would write as the string "True"
+        if self.holds is not None:
+            object.__setattr__(self, "holds", bool(self.holds))
+
 
 @dataclass
 class Figure:

@@ -156,3 +156,13 @@ def test_a_plan_can_run_only_the_first_seeds(tmp_path):
     assert [j.study for j in plan("full", tmp_path, studies=studies, max_seeds=1)] == ["learn"]
     assert [j.study for j in plan("full", tmp_path, studies=studies, max_seeds=2)] == ["learn", f"learn{REPLICA}1"]
     assert len(plan("full", tmp_path, studies=studies)) == 3
+
+
+def test_a_check_decided_on_numpy_values_is_written_as_a_boolean():
+    """Capolei's Fig. 5 compared two numpy floats: figures.json said "True" (a string), and the table of checks
+    counted it as undecided."""
+    from dataclasses import asdict
+
+    c = Check("IV's drop larger on joint 2", np.float64(49.0) > np.float64(47.0), "49 vs 47 %")
+    assert c.holds is True and json.loads(json.dumps(asdict(c), default=str))["holds"] is True
+    assert Check("cannot tell", None).holds is None
