@@ -39,6 +39,29 @@ class DCNDecoder:
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
+def chunk_sides(idx, off, lo, hi, per_joint, full_scale, saturate):
+    """A chunk's muscle commands without the interpreter lock: per step [M_ag of each joint, M_at of each joint]
+    from ``idx[off[s]:off[s + 1]]`` (the DCN are ``lo:hi``), the same doubles as :meth:`DCNDecoder.sides` (a
+    side's spike count divided by its joint's ``full_scale``, capped at 1 with ``saturate``), and the DCN spikes
+    per step."""
+    n, nj, half = off.size - 1, full_scale.size, per_joint // 2
+    m = np.zeros((n, 2 * nj))
+    counts = np.zeros(n, np.int64)
+    for s in range(n):
+        for k in range(off[s], off[s + 1]):
+            i = idx[k]
+            if lo <= i < hi:
+                c = (i - lo) // half  # 2 joint + side
+                m[s, (c % 2) * nj + c // 2] += 1.0
+                counts[s] += 1
+    for s in range(n):
+        for c in range(2 * nj):
+            x = m[s, c] / full_scale[c % nj]
+            m[s, c] = min(x, 1.0) if saturate else x
+    return m, counts
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
 def chunk_torques(idx, off, lo, hi, per_joint, sign, alpha):
     """A chunk's torques without the interpreter lock: ``idx[off[s]:off[s + 1]]`` are the global indices that
     spiked in step s; the DCN are ``lo:hi``. Returns (torque per step and joint, DCN spikes per step), the sums

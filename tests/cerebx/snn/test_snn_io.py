@@ -15,7 +15,7 @@ from cerebx.errors import StateMismatchError
 from cerebx.recording.cdr import decode_spikes
 from cerebx.schema.controller import GivenRanges
 from cerebx.signals import Deferred
-from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
+from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_sides, chunk_torques
 from cerebx.snn.encoders import ClimbingEncoder, EncoderPair, MossyEncoder
 from cerebx.snn.presets import network as full_network
 from cerebx.snn.topology import build_topology
@@ -340,6 +340,26 @@ def test_dcn_decoder_sides_count_each_side_over_full_scale():
     m = dec.sides(idx, step, 2, (2.0, 4.0), saturate=True)
     np.testing.assert_allclose(m, [[1.0, 0.0, 1.0, 0.75], [0.0, 0.25, 0.0, 0.0]])
     np.testing.assert_allclose(dec.sides(idx, step, 2, (2.0, 4.0))[0], [2.0, 0.0, 1.0, 0.75])
+
+
+def test_chunk_sides_are_the_decoders_sides_without_the_interpreter_lock():
+    """The network thread decodes a muscle chunk in compiled code: the same doubles as ``DCNDecoder.sides`` on
+    random chunks (global indices with other populations' spikes around the DCN), with and without the cap."""
+    rng = np.random.default_rng(4)
+    dec = DCNDecoder((0.75, 1.1, 0.5), 3, 20)
+    lo, hi = 1000, 1060
+    for saturate in (False, True):
+        for n in (1, 7, 25):
+            counts = rng.integers(0, 40, n)
+            off = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+            idx = rng.integers(lo - 50, hi + 50, off[-1]).astype(np.int32)
+            step = np.repeat(np.arange(n), counts)
+            sel = (idx >= lo) & (idx < hi)
+            scale = np.array([3.0, 7.0, 2.5])
+            want = dec.sides(idx[sel] - lo, step[sel], n, scale, saturate)
+            got, dcn = chunk_sides(idx, off, lo, hi, 20, scale, saturate)
+            np.testing.assert_array_equal(got, want)
+            np.testing.assert_array_equal(dcn, np.bincount(step[sel], minlength=n))
 
 
 def test_agonist_antagonist_output_is_the_torque_split_by_side():

@@ -47,7 +47,7 @@ from cerebx.errors import StateMismatchError
 from cerebx.persistence.state import load_state_npz, save_state_npz
 from cerebx.recording.spike_chunks import chunk_spike_messages
 from cerebx.signals import Deferred
-from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_torques
+from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_sides, chunk_torques
 from cerebx.snn.encoders import EncoderPair
 from cerebx.snn.kernels import OUTPUTS, prof_lap, prof_now, run_chunk
 from cerebx.snn.network import Network, pack
@@ -83,11 +83,15 @@ def _chunk_outputs(idx, off, decode, record, first, step_s):  # pragma: no cover
     messages (:func:`~cerebx.snn.decoder.chunk_select`,
     :func:`~cerebx.recording.spike_chunks.chunk_spike_messages`) in one call: each return from compiled code
     waits for the interpreter lock, which the loop's thread holds but for its MuJoCo steps. ``decode``: the
-    DCN's first and end index, per_joint, sign and alpha of the decoder; ``record``: the recorded neurons'
-    (lo, hi) ranges."""
-    lo, hi, per_joint, sign, alpha = decode
+    DCN's first and end index, per_joint, sign and alpha of the decoder, whether the output is the muscles'
+    sides (:func:`~cerebx.snn.decoder.chunk_sides`) with their full scale per joint and saturation;
+    ``record``: the recorded neurons' (lo, hi) ranges."""
+    lo, hi, per_joint, sign, alpha, sides, full_scale, saturate = decode
     rec_lo, rec_hi = record
-    taus, counts = chunk_torques(idx, off, lo, hi, per_joint, sign, alpha)
+    if sides:
+        taus, counts = chunk_sides(idx, off, lo, hi, per_joint, full_scale, saturate)
+    else:
+        taus, counts = chunk_torques(idx, off, lo, hi, per_joint, sign, alpha)
     local, ends = chunk_select(idx, off, rec_lo, rec_hi)
     words, starts = chunk_spike_messages(local, ends, first, step_s)
     return taus, counts, words, starts
@@ -260,22 +264,12 @@ class SNNControllerImpl(Controller):
                          int(self.net.pf_lost.sum()))
         recording = bool(self.recorder is not None and self._shed < 3 and self.record)
         record = (self._record_lo, self._record_hi) if recording else (_NONE, _NONE)
-        if not self.muscles:
-            net = self.net
-            idx_buf, off = net.chunk_buffers(n)
-            taus, counts, words, starts, lost = _run_chunk_outputs(
-                net._state, (net.t_sub, net.n_sub, net.learn, net.n_threads), (flat, in_off, idx_buf, off),
-                (self._decode, record, first_step, STEP_S), net.prof)
-            net.t_sub += net.n_sub * n
-        else:  # agonist/antagonist outputs: decoded here
-            idx, off = self.net.step_packed(flat, in_off)
-            step_of = np.repeat(np.arange(n), np.diff(off))
-            lo, hi = self.sl_dcn.start, self.sl_dcn.stop
-            sel = (idx >= lo) & (idx < hi)
-            taus = self.decoder.sides(idx[sel] - lo, step_of[sel], n, self.full_scale, self.cfg.decoder.saturate)
-            counts = np.bincount(step_of[sel], minlength=n)
-            words, starts = chunk_spike_messages(*chunk_select(idx, off, *record), first_step, STEP_S)
-            lost = int(self.net.pf_lost.sum())
+        net = self.net
+        idx_buf, off = net.chunk_buffers(n)
+        taus, counts, words, starts, lost = _run_chunk_outputs(
+            net._state, (net.t_sub, net.n_sub, net.learn, net.n_threads), (flat, in_off, idx_buf, off),
+            (self._decode, record, first_step, STEP_S), net.prof)
+        net.t_sub += net.n_sub * n
         if not recording:
             return Chunk(first_step, taus, counts, None, None, lost)
         return Chunk(first_step, taus, counts, words, starts, lost)
@@ -386,7 +380,9 @@ class SNNControllerImpl(Controller):
         self._alpha = np.ascontiguousarray(np.broadcast_to(self.decoder.alpha, (self.n_ctrl,)), dtype=np.float64)
         self._record_lo = np.array([sl.start for sl in self.record.values()], np.int64)
         self._record_hi = np.array([sl.stop for sl in self.record.values()], np.int64)
-        self._decode = (self.sl_dcn.start, self.sl_dcn.stop, self.decoder.per_joint, self.decoder.sign, self._alpha)
+        scale = np.ascontiguousarray(np.broadcast_to(self.full_scale, (self.n_ctrl,)), dtype=np.float64)
+        self._decode = (self.sl_dcn.start, self.sl_dcn.stop, self.decoder.per_joint, self.decoder.sign, self._alpha,
+                        self.muscles, scale, bool(self.cfg.decoder.saturate))
         self._spike_topics = tuple(f"/spikes/{name}" for name in self.record)
         self._pair = EncoderPair.of(self.mf, self.cf, self.sl_mf.start, self.sl_cf.start)
 
