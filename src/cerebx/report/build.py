@@ -358,7 +358,10 @@ def dry_run(jobs: list, folder: Path, parallel: int) -> None:
     todo = [(j, e) for j, e, d in zip(jobs, exps, done, strict=True) if not d and e is not None]
     left = [e for _, e in todo]
     bad = [p for p, d in zip(problems, done, strict=True) if p is not None and not d]
-    print(f"{done.count(False)} runs to do: {total([estimate(e) for e in left], parallel).line()}", *bad, sep="\n")
+    ests = [estimate(e) for e in left]
+    print(f"{done.count(False)} runs to do: {total(ests, parallel).line()}", *bad, sep="\n")
+    if ests:
+        print(where_the_time_goes([j.study for j, _ in todo], ests, parallel))
     pace = profile_pace(folder, {j.run_dir: estimate(e).wall_s
                                  for j, e, d in zip(jobs, exps, done, strict=True) if d and e is not None})
     fractions = [left_fraction(j.run_dir, e.trials) for j, e in todo]
@@ -367,6 +370,22 @@ def dry_run(jobs: list, folder: Path, parallel: int) -> None:
         print(f"at the pace of this profile's {pace.runs} finished runs (by kind of run, --jobs {parallel}"
               f"{f'; {resumed} resume from their checkpoints' if resumed else ''}): "
               f"~{duration(remaining_wall_s(pace, left, parallel, fractions))}")
+
+
+def where_the_time_goes(studies: list[str], ests: list, parallel: int, top: int = 6) -> str:
+    """One line: the studies that take most of the estimated time (their seeds counted together), each with
+    its share of it: of the CPU when runs share the cores, of the wall time one at a time."""
+    whole = total(ests, parallel).wall_s
+    part = "cpu_s" if parallel > 1 else "wall_s"
+    spent: dict[str, float] = {}
+    for study, e in zip(studies, ests, strict=True):
+        base = study.split(REPLICA)[0]
+        spent[base] = spent.get(base, 0.0) + getattr(e, part)
+    summed = sum(spent.values()) or 1.0
+    ranked = sorted(spent.items(), key=lambda kv: -kv[1])
+    shown = [f"{name} ~{duration(whole * t / summed)} ({100 * t / summed:.0f} %)" for name, t in ranked[:top]]
+    rest = len(ranked) - len(shown)
+    return "where the time goes: " + ", ".join(shown) + (f"; {rest} other studies the rest" if rest > 0 else "")
 
 
 def needed_studies(names: list[str] | None) -> list[str]:

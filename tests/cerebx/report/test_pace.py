@@ -49,3 +49,20 @@ def test_a_run_resumed_from_a_checkpoint_counts_only_its_trials_left(tmp_path):
     assert remaining_wall_s(pace, [exp, exp], jobs=1, left=[f, 1.0]) == pytest.approx(1.5 + 5.0)
     (tmp_path / "checkpoint.pkl.json").write_text("not json")
     assert left_fraction(tmp_path, 10) == 1.0
+
+
+def test_the_dry_run_says_which_studies_take_the_time():
+    """Seeds of a study count together; the shares are of the CPU when runs share the cores, of the wall time
+    one at a time; the times add up to the whole estimate."""
+    from cerebx.estimate import Estimate, total
+    from cerebx.report.build import where_the_time_goes
+
+    snn = Estimate(1000.0, 0.0, 0.0, wall_s=60.0, cpu_s=120.0)  # two threads
+    pd = Estimate(1000.0, 0.0, 0.0, wall_s=40.0, cpu_s=40.0)  # one thread
+    studies = ["learn", "learn~seed1", "learn~seed2", "baseline"]
+    ests = [snn, snn, snn, pd]
+    assert total(ests, 2).wall_s == pytest.approx(200.0)  # (3 x 120 + 40) s of CPU on 2 cores
+    line = where_the_time_goes(studies, ests, 2)
+    assert line == "where the time goes: learn ~3 min (90 %), baseline ~20 s (10 %)"
+    assert where_the_time_goes(studies, ests, 1) == "where the time goes: learn ~3 min (82 %), baseline ~40 s (18 %)"
+    assert where_the_time_goes(studies, ests, 2, top=1).endswith("; 1 other studies the rest")
