@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import ast
+import json
 import os
 
 import pytest
@@ -37,6 +39,27 @@ def test_a_cold_cache_is_found_and_a_warm_one_is_not(load, tmp_path):
     assert cold_kernels([exp], tmp_path).modules == ("cerebx.snn.kernels",)
 
 
+def test_what_the_sources_say_is_kept_until_a_source_changes(load, tmp_path, monkeypatch):
+    """The second run's start reads no syntax tree: each module's imports and kernel count are kept in the cache
+    folder by its source's size and age, and read again from a source whose size or age changed."""
+    exp = load(SNN)
+    first = cold_kernels([exp], tmp_path)
+    facts = json.loads((tmp_path / numba_cache.FACTS).read_text())
+    assert facts["cerebx.snn.kernels"][4] == numba_cache._kernel_count("cerebx.snn.kernels") > 0
+    numba_cache._tree.cache_clear()
+    numba_cache._kernel_count.cache_clear()
+    parsed = []
+    monkeypatch.setattr(numba_cache, "_tree", lambda name: parsed.append(name) or ast.parse(""))
+    assert cold_kernels([exp], tmp_path) == first and parsed == []
+    facts["cerebx.snn.kernels"][2] -= 1  # as if the file had been edited since: read again (here: an empty tree)
+    (tmp_path / numba_cache.FACTS).write_text(json.dumps(facts))
+    again = cold_kernels([exp], tmp_path)
+    assert parsed == ["cerebx.snn.kernels", "cerebx.snn.kernels"] and "cerebx.snn.kernels" not in again.modules
+    monkeypatch.undo()
+    (tmp_path / numba_cache.FACTS).write_text("not json")  # a damaged file is read as none
+    assert cold_kernels([exp], tmp_path).kernels > 0
+
+
 def test_a_pd_run_has_too_few_kernels_to_report(load, tmp_path):
     assert cold_kernels([load(["+experiment=demo"])], tmp_path).seconds < MIN_REPORTED_S
 
@@ -52,7 +75,7 @@ def test_a_run_with_a_cold_cache_says_it_compiles(in_tmp, monkeypatch, capsys):
     assert err[0] == (f"numba: {n} kernels of this run are not compiled yet (first run since an install or a change): "
                       f"compiling them first, ~{n * 0.9:.0f} s, once (cached in {in_tmp / 'cold'})")
     assert err[1].startswith("run: estimate: 2 s simulated") and err[1].endswith(
-        f"~{n * 0.9:.0f} s on a quiet 2-core machine (~{n * 0.9:.0f} s of it compiling numba kernels, once)")
+        f"on a quiet 2-core machine (~{n * 0.9:.0f} s of it compiling numba kernels, once)")
     assert started == [n, True]
 
 
@@ -77,7 +100,8 @@ def test_progress_counts_cerebx_kernels_only(capsys):
 @pytest.fixture(autouse=True)
 def _fresh_parse():
     """Each test reads the sources as they are now."""
-    numba_cache._closure.cache_clear()
+    numba_cache._tree.cache_clear()
+    numba_cache._kernel_count.cache_clear()
 
 
 def test_a_cache_compiled_from_other_sources_is_retired(tmp_path):
