@@ -1,6 +1,7 @@
 """Worked network A (docs/networks/golgi.md): the thesis network plus Golgi cells. The preset is thesis_ch2 with
 a GoC layer and the PF-PC start weight that gives the PCs back their rate; the Golgi cells inhibit the granule
-layer by about a third (open loop, the reduced size); (slow) the reduced network learns the circle."""
+layer by about an eighth (open loop, the reduced size), weak enough for the network to learn the circle at
+nearly the thesis network's pace; (slow) the reduced network learns the circle."""
 
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ def test_thesis_golgi_is_thesis_ch2_plus_a_golgi_layer(load):
     for name, p in ch2.projections.items():
         want = p.model_dump()
         if name == "pf_pc":
-            want["weight_nS"] = 2.2
+            want["weight_nS"] = 1.75
         assert golgi.projections[name].model_dump() == want, name
     assert golgi.populations["gc"].neuron == ch2.populations["gc"].neuron  # the GABA values are the defaults
 
@@ -47,12 +48,13 @@ def _spikes(cfg, steps=600):
 
 
 @pytest.mark.integration
-def test_golgi_cells_cut_the_granule_spikes_by_a_third_and_the_pcs_keep_their_rate(load):
-    """Open-loop calibration of the preset's constructed weights (measured: GC spikes -33 %, GoC ~50 Hz, PC
-    rate within 20 % of small_ch2's)."""
+def test_golgi_cells_cut_the_granule_spikes_by_a_tenth_and_the_pcs_keep_their_rate(load):
+    """Open-loop calibration of the preset's constructed weights (measured: GC spikes -11 %, GoC 50 Hz, PC rate
+    4 % below small_ch2's; the earlier 0.05 nS GoC -> GC cut the GC spikes by 34 % and the network learned at
+    about 0.4x the thesis network's pace, docs/networks/golgi.md#calibration)."""
     golgi = _spikes(load(["+experiment=learn_circle", "network=small_golgi", *SMALL]).controller.network)
     plain = _spikes(load(["+experiment=learn_circle", "network=small_ch2", *SMALL]).controller.network)
-    assert 0.5 * plain["gc"] < golgi["gc"] < 0.85 * plain["gc"], (golgi, plain)
+    assert 0.8 * plain["gc"] < golgi["gc"] < 0.95 * plain["gc"], (golgi, plain)
     assert 20 < golgi["goc"] / 36 / 1.0 < 100  # Hz over the 1 s measured
     assert abs(golgi["pc"] - plain["pc"]) < 0.25 * plain["pc"], (golgi, plain)
 

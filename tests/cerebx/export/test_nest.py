@@ -87,16 +87,17 @@ def test_the_small_network_fires_as_in_nest(tmp_path):
 
 def test_the_golgi_network_fires_as_in_nest_with_its_granule_cells_at_a_fine_step(tmp_path):
     """small_golgi: Golgi inhibition brings the GC membrane time constant to about half a millisecond. As
-    configured (GCs in 1 ms steps) the GC rate differs by a few per cent, and NEST's PC and DCN fed with cerebx's GC
-    spikes fire exactly as cerebx's (they only inherit it); at 0.25 ms with the GCs at the network step both
-    compute the same spikes (docs/guide/nest.md#the-worked-networks)."""
+    configured (GCs in 1 ms steps) the GC rate differs by one or a few per cent, and NEST's PC and DCN fed with
+    cerebx's GC spikes fire exactly as cerebx's (they only inherit it); at 0.25 ms with the GCs at the network step
+    both compute the same spikes (docs/guide/nest.md#the-worked-networks)."""
     fine = crosscheck(load_network("small_golgi", [GC_AT_DT, "controller.network.dt_ms=0.25"]), tmp_path / "a",
                       ms=300.0, python=PYTHON)
     for row in fine.rows:
         assert abs(row.rate_diff) < 0.01 and row.matched > 0.99, row
     conf = {r.population: r for r in crosscheck(load_network("small_golgi"), tmp_path / "b", ms=300.0,
                                                  python=PYTHON).rows}
-    assert conf["gc"].rate_diff > 0.02 and conf["goc"].rate_diff == 0
+    # measured: +1.7 % with GoC -> GC 0.03 nS (+4.5 % with the first preset's 0.05 nS); at the fine step above, 0
+    assert conf["gc"].rate_diff > 0.01 and conf["goc"].rate_diff == 0
     layer = crosscheck(load_network("small_golgi"), tmp_path / "c", ms=300.0, layer=["pc", "dcn"], python=PYTHON)
     for row in layer.rows:
         assert row.rate_diff == 0 and row.matched == 1.0, row
