@@ -413,8 +413,9 @@ def test_runs_sharing_the_cores_take_the_cpu_they_need(load):
 
 def test_report_dry_run_prints_an_estimate(in_tmp, capsys):
     assert main(["report", "--profile", "quick", "--dry-run", "--figures", "fig3_4"]) == 0
-    last = capsys.readouterr().out.strip().splitlines()[-1]
+    *_, last, where = capsys.readouterr().out.strip().splitlines()
     assert " runs to do: estimate: " in last and "run.mcap ~" in last and "quiet 2-core machine" in last
+    assert where.startswith("where the time goes: learn_circle_ch3 ~")  # the learning the figure starts from
 
 
 # ---- small things -----------------------------------------------------------------------------------
