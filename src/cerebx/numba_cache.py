@@ -113,10 +113,10 @@ def cold_kernels(exps: list[Any], cache_dir: Path | None = None) -> ColdKernels:
     folder = Path(cache_dir or os.environ.get("NUMBA_CACHE_DIR") or ".")
     roots = tuple(sorted(set().union(*(builder_modules(e) for e in exps)))) if exps else ()
     known = _load_facts(folder)
-    before = json.dumps(known, sort_keys=True)
+    before = dict(known)  # entries are replaced, never changed in place
     cold = [(m, n) for m in sorted(_closure(roots, known))
             if (n := _facts(m, known)[1]) and not _compiled(m, folder)]
-    if json.dumps(known, sort_keys=True) != before:
+    if known != before:
         _save_facts(folder, known)
     return ColdKernels(tuple(m for m, _ in cold), sum(n for _, n in cold), folder)
 
@@ -186,10 +186,9 @@ def _facts(name: str, known: dict[str, list]) -> tuple[list[str], int]:
     return imports, kernels
 
 
-def _closure(roots: tuple[str, ...], known: dict[str, list] | None = None) -> frozenset[str]:
+def _closure(roots: tuple[str, ...], known: dict[str, list]) -> frozenset[str]:
     """``roots`` and every module of cerebx or a plugin they import, directly or not (imports in functions too);
     ``known``: the modules' facts kept in the cache folder (:func:`_facts`)."""
-    known = {} if known is None else known
     seen: set[str] = set()
     todo = list(roots)
     while todo:
