@@ -45,10 +45,12 @@ mV), so a neuron returns to rest a few tens of ms after its last input.
 Rest under GABA (the granule layer under Golgi inhibition): in a compact population with
 ``clamp_at_rest`` and E_GABA <= E_L, a neuron at rest whose only input is a GABA conductance up to
 ``Populations.lazy`` (``topology.lazy_gaba_nS``: the step from rest is then negative and clamped to
-exactly 0) stays unlisted. Its conductance lives in ``g_rest`` (global index order), takes the
-deliveries there in the same order and float32 operations as a listed neuron's, and decays with each
-step of the population in one vectorised pass (the integration loop's product, flushed below
-G_FLOOR). Activation moves it into the list; a compaction moves a listed neuron back. The listed
+exactly 0) stays unlisted. The GABA conductance of every neuron of such a population, listed or not, lives in
+``g_gaba`` (global index order): a GABA spike adds its weight there (a plain scatter-add; the rare sum that leaves
+[0, lazy] lists an unlisted neuron), and each step of the population gathers the listed neurons' values into
+their compact slots, then decays the whole array in one vectorised pass by the integration loop's own product
+(flushed below G_FLOOR), so the copies the loop decays and the array stay the same bits. Activation and
+compaction move no GABA value. The listed
 neurons of a population without NMDA input are stepped in one vectorised pass that computes the step and its
 bifixed sub-steps for every neuron and selects one (``_lif_gaba``; bit for bit ``_lif_full_fine``, for the
 methods and sub-step counts in ``FUSED``; the others compute their one-step estimates in a vectorised pass and
@@ -212,8 +214,9 @@ class Neurons(NamedTuple):
     n_rest: np.ndarray  # int64 [pop]: listed neurons found at rest by the last step
     pop_ep: np.ndarray  # int64 [pop]: version of the compact list (every compaction increments it)
     w: np.ndarray  # float32 [n]: adaptation current of adex_cond neurons (pA; 0 elsewhere), global index order
-    g_rest: np.ndarray  # float32 [n]: GABA conductance of the unlisted neurons of rest-GABA populations (nS),
-    # global index order, decayed with every step of the population
+    g_gaba: np.ndarray  # float32 [n]: GABA conductance (nS) of every neuron of lazy-GABA populations (listed or
+    # not), global index order, decayed with every step of the population; their listed neurons' g[2] is a copy
+    # gathered before each step (0 elsewhere)
 
 
 class Populations(NamedTuple):
@@ -318,7 +321,7 @@ def _decay(g, d):
 def _at_rest(u, a, n, r, b, gmax):
     """Whether a neuron of a compact lif_cond population with NMDA/GABA may leave the list: at rest (u, the AMPA
     and NMDA conductances a, n and the refractory count r 0) with a GABA conductance b in [0, gmax] (gmax 0:
-    none), which a compaction keeps in ``g_rest``. Branch-free, so the loops that count it vectorise."""
+    none), which stays in ``g_gaba``. Branch-free, so the loops that count it vectorise."""
     zero = np.float32(0.0)
     return (u == zero) & (a == zero) & (n == zero) & (r == zero) & (b >= zero) & (b <= gmax)
 
@@ -998,10 +1001,9 @@ def _compact(lo, na, nrn, buf, full, gmax):
     are still in index order, those activated since follow in the order they came and are sorted
     (keys global index << 32 | position, so a key's order is its index's), then merged in.
     ``full``: the population has NMDA/GABA conductances (moved too); a neuron at rest whose GABA conductance is
-    in (0, gmax] leaves the list with it, kept in ``g_rest``.
+    in (0, gmax] leaves the list (a lazy-GABA population's ``g_gaba`` holds that conductance already).
     Returns the new count."""
     u, g, ref, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot
-    g_rest = nrn.g_rest
     sf, key, merged = buf.scr_f, buf.scr_i, buf.col_buf
     j = 0
     for k in range(lo, lo + na):
@@ -1011,7 +1013,6 @@ def _compact(lo, na, nrn, buf, full, gmax):
             gn, gb = g[1, k], g[2, k]
             if _at_rest(x, gk, gn, r, gb, gmax):
                 slot[i] = -1
-                g_rest[i] = gb
                 continue
             sf[3, j] = gn
             sf[4, j] = gb
@@ -1064,7 +1065,7 @@ def _build_runs(qa, qb, plo, pp, nrn, dl):
     sp_post[qa:qb] of one presynaptic neuron (activating the ones at rest), as runs of consecutive
     positions: c_k start position, c_q first synapse, c_l length, stored from qa on. Returns the
     number of runs. Valid until the population is compacted again (activation only appends; an activated
-    neuron takes its GABA conductance from ``g_rest``)."""
+    neuron takes its GABA conductance from ``g_gaba``, 0 outside lazy-GABA populations)."""
     u, g, ref, cid, slot, n_act = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot, nrn.n_act
     sp_post, c_k, c_q, c_l = dl.sp_post, dl.c_k, dl.c_q, dl.c_l
     nr = 0
@@ -1084,8 +1085,7 @@ def _build_runs(qa, qb, plo, pp, nrn, dl):
             u[kq] = 0.0
             g[0, kq] = 0.0
             g[1, kq] = 0.0
-            g[2, kq] = nrn.g_rest[i]
-            nrn.g_rest[i] = 0.0
+            g[2, kq] = nrn.g_gaba[i]
             ref[kq] = 0.0
         if kq == prev + 1:
             ln += 1
@@ -1165,13 +1165,13 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
     Sparse projections onto a compact population deliver through a per-presynaptic-neuron cache of
     the targets' compact positions (``_build_runs``; sp_c[off + j] = (epoch, runs), valid while
     the epoch equals pop_ep of the target population, which every compaction increments).
-    GABA onto a lazy-GABA population (``Populations.lazy``) goes to a neuron's listed state if it is listed,
-    else to the lazy store without listing it, as long as the neuron stays exactly at rest under it.
+    GABA onto a lazy-GABA population (``Populations.lazy``) adds into ``g_gaba``, listing a neuron at rest only
+    when the sum leaves [0, lazy] (it would then move from rest).
     """
     nrn, pops, dl, plast, buf = net.neurons, net.populations, net.delivery, net.plasticity, net.buffers
     u, g, ref, flag, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.flag, nrn.cid, nrn.slot
     n_act, n_rest, pop_ep = nrn.n_act, nrn.n_rest, nrn.pop_ep
-    g_rest = nrn.g_rest
+    g_gaba = nrn.g_gaba
     pop_i, pop_par, pop_lazy = pops.pop_i, pops.pop_par, pops.lazy
     ring_idx, ring_n = dl.ring_idx, dl.ring_n
     sp_i, sp_ptr, sp_post, sp_w, sp_c = dl.sp_i, dl.sp_ptr, dl.sp_post, dl.sp_w, dl.sp_c
@@ -1223,15 +1223,10 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                     if lazy:
                         for q in range(sp_ptr[off + j], sp_ptr[off + j + 1]):
                             i = sp_post[q]
-                            kq = slot[i]
-                            if kq >= 0:
-                                g[2, kq] += sp_w[q] * sc
+                            x = g_gaba[i] + sp_w[q] * sc
+                            g_gaba[i] = x
+                            if (x >= 0.0 and x <= gmax) or slot[i] >= 0:  # listed, or stays exactly at rest
                                 continue
-                            x = g_rest[i] + sp_w[q] * sc
-                            if x >= 0.0 and x <= gmax:  # stays exactly at rest: unlisted
-                                g_rest[i] = x
-                                continue
-                            g_rest[i] = 0.0
                             kq = plo + n_act[pp]
                             n_act[pp] += 1
                             slot[i] = kq
@@ -1270,8 +1265,7 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                             u[kq] = 0.0
                             g[0, kq] = 0.0
                             g[1, kq] = 0.0
-                            g[2, kq] = g_rest[i]
-                            g_rest[i] = 0.0
+                            g[2, kq] = g_gaba[i]
                             ref[kq] = 0.0
                         g[rec, kq] += sp_w[q] * sc
         # dense (all-to-all) projections: a spike adds its weight row; plastic rows get LTP
@@ -1282,6 +1276,7 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
             if t % ratio != 0:
                 continue
             compact = pop_i[pp, I_COMPACT] != 0
+            lazy = compact and rec == 2 and pop_lazy[pp] > 0.0  # GABA into g_gaba (global index order)
             dec = pop_par[pp, P_D1A + rec]
             scale = 1.0
             for a in range(ratio):
@@ -1308,10 +1303,12 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                                 u[kq] = 0.0
                                 g[0, kq] = 0.0
                                 g[1, kq] = 0.0
-                                g[2, kq] = g_rest[i]
-                                g_rest[i] = 0.0
+                                g[2, kq] = g_gaba[i]
                                 ref[kq] = 0.0
-                            g[rec, kq] += dense_w[row + q] * sc
+                            if lazy:
+                                g_gaba[i] += dense_w[row + q] * sc
+                            else:
+                                g[rec, kq] += dense_w[row + q] * sc
                     elif a == 0:  # (1D slices: these loops vectorise)
                         gs, ws = g[rec, post_lo : post_lo + n_post], dense_w[row : row + n_post]
                         for q in range(n_post):
@@ -1369,9 +1366,12 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
             if kind == KIND_INPUT or (t + 1) % pop_i[pi, I_RATIO] != 0:
                 continue
             lo = pop_i[pi, I_LO]
-            if pop_lazy[pi] > 0.0:  # the unlisted neurons' GABA decays as the loop would decay it
-                _decay(g_rest[lo : pop_i[pi, I_HI]], np.float32(pop_par[pi, P_DG]))
             na = n_act[pi]
+            if pop_lazy[pi] > 0.0:  # the listed neurons' GABA, then every neuron's decayed as the loop decays it
+                gg = g[2]
+                for k in range(lo, lo + na):
+                    gg[k] = g_gaba[cid[k]]
+                _decay(g_gaba[lo : pop_i[pi, I_HI]], np.float32(pop_par[pi, P_DG]))
             if na == 0:
                 continue
             hi = lo + na

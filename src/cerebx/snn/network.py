@@ -173,7 +173,7 @@ class Network:
         self._g = np.zeros((3, n), dtype=np.float32)
         self._ref = np.zeros(n, dtype=np.float32)
         self.w = np.zeros(n, dtype=np.float32)  # adex_cond adaptation currents (pA), global index order
-        self.g_rest = np.zeros(n, dtype=np.float32)  # GABA of unlisted neurons at rest (kernels), global index order
+        self.g_gaba = np.zeros(n, dtype=np.float32)  # GABA of lazy-GABA populations' neurons (kernels), by index
         self.flag = np.zeros(n, dtype=np.uint8)
         self.cid = np.arange(n, dtype=np.int32)
         self.slot = np.arange(n, dtype=np.int32)
@@ -258,7 +258,7 @@ class Network:
         written in place, so it stays valid for the network's life)."""
         return kernels.NetworkArrays(
             neurons=kernels.Neurons(self.u, self._g, self._ref, self.flag, self.cid, self.slot, self.n_act,
-                                    self.n_rest, self.pop_ep, self.w, self.g_rest),
+                                    self.n_rest, self.pop_ep, self.w, self.g_gaba),
             populations=kernels.Populations(self.pop_i, self.pop_par, self.poly, self.pop_lazy, self.pop_nmda),
             delivery=kernels.Delivery(self.ring_idx, self.ring_n, self.sp_i, self.sp_ptr, self.sp_post, self.sp_w,
                                       self.sp_c, self.c_k, self.c_q, self.c_l, self.de_i, self.dense_w),
@@ -273,9 +273,9 @@ class Network:
     def _set_neurons(self, V: np.ndarray, g: np.ndarray, ref: np.ndarray) -> None:
         """Kernel state from full per-neuron arrays: compact populations keep their non-resting
         neurons, in index order; a neuron at rest but for a GABA conductance it may hold unlisted
-        (``pop_lazy``) has it in ``g_rest``."""
+        (``pop_lazy``) is left out of the list; such a population's GABA conductances are all in ``g_gaba``."""
         n = len(self.u)
-        self.g_rest[:] = 0
+        self.g_gaba[:] = 0
         self.u[:] = (V - self.el).astype(np.float32)
         self._g[:] = g
         self._ref[:] = ref
@@ -292,7 +292,8 @@ class Network:
             gmax = np.float32(self.pop_lazy[pi])
             kept = (gg[2] > 0) & (gg[2] <= gmax) & (u == 0) & (gg[:2] == 0).all(axis=0) & (r == 0)
             live = np.flatnonzero(((u != 0) | (gg != 0).any(axis=0) | (r != 0)) & ~kept)
-            self.g_rest[lo:hi][kept] = gg[2, kept]
+            if gmax > 0:
+                self.g_gaba[lo:hi] = gg[2]
             na = len(live)
             self.n_act[pi] = na
             self.slot[lo:hi] = -1
@@ -312,8 +313,8 @@ class Network:
             V[idx] = self.el[idx] + self.u[lo : lo + na]
             g[:, idx] = self._g[:, lo : lo + na]
             ref[idx] = self._ref[lo : lo + na]
-            rest = self.g_rest[lo : int(self.pop_hi[pi])]
-            g[2, lo : int(self.pop_hi[pi])] = np.where(rest != 0, rest, g[2, lo : int(self.pop_hi[pi])])
+            if self.pop_lazy[pi] > 0:  # every neuron's GABA (the listed ones' g[2] is a copy taken each step)
+                g[2, lo : int(self.pop_hi[pi])] = self.g_gaba[lo : int(self.pop_hi[pi])]
         return V, g, ref
 
     @property
@@ -443,7 +444,12 @@ class Network:
         if "pop_lazy" not in state:  # pickled before lazy GABA: its populations keep the lists they had
             self.pop_lazy = np.zeros(len(self.pop_lo))
             self.pop_nmda = np.ones(len(self.pop_lo), np.uint8)
-            self.g_rest = np.zeros_like(self._ref)
+        if "g_gaba" not in state:  # pickled when the listed neurons' GABA lived in g[2] only, the others' in g_rest
+            self.g_gaba = self.__dict__.pop("g_rest", None)
+            self.g_gaba = np.zeros_like(self._ref) if self.g_gaba is None else self.g_gaba
+            for pi in np.flatnonzero(self.pop_lazy > 0):
+                lo, na = int(self.pop_lo[pi]), int(self.n_act[pi])
+                self.g_gaba[self.cid[lo : lo + na]] = self._g[2, lo : lo + na]
         if self.scr_f.shape[0] < 5:  # its compaction scratch had 3 rows
             self.scr_f = np.zeros((5, self.scr_f.shape[1]), np.float32)
         self.prof = None

@@ -63,7 +63,7 @@ def test_a_gc_inhibited_once_is_skipped_then_driven_exactly_like_the_integrated_
     for k in range(40):  # skipped: no GC is listed, its conductance held unlisted
         for net in (lazy, dense):
             net.step(none)
-        assert lazy.n_act[lazy.topo.index["gc"]] == 0 and (lazy.g_rest[gc] > 0).all()
+        assert lazy.n_act[lazy.topo.index["gc"]] == 0 and (lazy.g_gaba[gc] > 0).all()
         _same(lazy, dense)
         # known answer: after control step k + 1 (t_sub = 4 (k + 2)) GC steps 1 .. 2k + 3 have decayed it once each
         for _ in range(3 if k == 0 else 2):
@@ -89,6 +89,25 @@ def test_gaba_beyond_the_exact_bound_lists_the_neuron_and_results_still_match():
         _same(lazy, dense)
         listed.append(int(lazy.n_act[lazy.topo.index["gc"]]))
     assert max(listed) == N_GC, listed
+
+
+def test_an_all_to_all_gaba_projection_onto_the_listed_layer_steps_exactly_like_the_integrated_one():
+    """The dense (all-to-all) delivery path onto a lazy-GABA population: its GABA goes to ``g_gaba`` like the
+    sparse path's, under random MF and Golgi drive, and survives a pickle."""
+    cfg = _cfg()
+    projections = {**cfg.projections, "goc_gc": cfg.projections["goc_gc"].model_copy(
+        update={"rule": cfg.projections["mf_gc"].rule})}
+    cfg = cfg.model_copy(update={"projections": projections})
+    lazy, dense = _pair(cfg)
+    assert lazy.pop_lazy[lazy.topo.index["gc"]] > 0
+    args = (1, 1, lazy.index("mf").start, lazy.index("goc").start)
+    _drive([lazy, dense], 200, *args)
+    _same(lazy, dense)
+    pickled = pickle.loads(pickle.dumps(lazy))
+    _drive([lazy, dense, pickled], 200, *args, seed=4)
+    for net in (lazy, pickled):
+        _same(net, dense)
+    assert lazy.g[2, lazy.index("gc")].any()
 
 
 @pytest.mark.parametrize("method", ["rk2", "rk4", "euler"])
@@ -212,10 +231,26 @@ def test_a_golgi_granular_layer_steps_exactly_like_the_integrated_one_and_resume
     _same(lazy, dense)
     _same(profiled, dense)
     gc = lazy.topo.index["gc"]
-    assert 0 < lazy.n_act[gc] < 2000 and (lazy.g_rest != 0).sum() > 100  # some listed, many held unlisted
+    held = ((lazy.g_gaba != 0) & (lazy.slot < 0)).sum()
+    assert 0 < lazy.n_act[gc] < 2000 and held > 100  # some listed, many held unlisted
     resumed = Network(cfg, parallel=False, compact_min=1)
     resumed.load_arrays(lazy.state_arrays())
     pickled = pickle.loads(pickle.dumps(lazy))
-    _drive([lazy, dense, resumed, pickled], 300, *args, seed=2)
-    for net in (lazy, resumed, pickled):
-        _same(net, dense)
+    earlier = Network.__new__(Network)
+    earlier.__setstate__(_as_pickled_before_g_gaba(pickle.loads(pickle.dumps(lazy)).__getstate__(), gc))
+    for steps, seed in ((3, 2), (300, 3)):  # right after the load too: the layer forgets a wrong GABA in ~100 ms
+        _drive([lazy, dense, resumed, pickled, earlier], steps, *args, seed=seed)
+        for net in (lazy, resumed, pickled, earlier):
+            _same(net, dense)
+
+
+def _as_pickled_before_g_gaba(state: dict, pi: int) -> dict:
+    """A network's state as the code before ``g_gaba`` pickled it: the listed neurons' GABA in ``_g[2]`` only,
+    the unlisted ones' in ``g_rest`` (0 for the listed)."""
+    state = dict(state)
+    g_rest, g = state.pop("g_gaba").copy(), state["_g"].copy()
+    lo, na = int(state["pop_lo"][pi]), int(state["n_act"][pi])
+    listed = state["cid"][lo : lo + na]
+    g[2, lo : lo + na] = g_rest[listed]
+    g_rest[listed] = 0
+    return {**state, "g_rest": g_rest, "_g": g}
