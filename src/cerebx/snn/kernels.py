@@ -66,6 +66,7 @@ import numpy as np
 from llvmlite import ir
 from numba import njit, prange, types
 from numba.core import cgutils
+from numba.cpython.unsafe.numbers import trailing_zeros
 from numba.extending import intrinsic, overload
 
 from cerebx.kernel_struct import KernelStruct
@@ -269,6 +270,7 @@ class Buffers(NamedTuple):
     out_t: np.ndarray  # int32 [n * n_sub]: their substep (1..n_sub)
     scr_f: np.ndarray  # float32 [5, n]: compaction scratch (u, g_AMPA, ref, g_NMDA, g_GABA)
     scr_i: np.ndarray  # int64 [n]: compaction scratch (sort keys)
+    bits: np.ndarray  # uint64 [n // 64 + 2]: compaction scratch, a bitmap of neurons (zero between uses)
 
 
 class NetworkArrays(NamedTuple):
@@ -992,6 +994,36 @@ def _collect(flag, ids, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp, so
 
 
 @njit(cache=True, boundscheck=False)
+def _sort_keys(key, lo, slot, bits):
+    """Sort ``key`` (global index << 32 | position, the indices distinct and at least ``lo``) in place, in time
+    linear in its length and in the indices' span / 64: each index is set in the bitmap ``bits`` (bit i - lo; zero
+    on entry and left zero), with its position kept in ``slot[i]`` meanwhile (the caller rewrites it), and read
+    back in order. np.sort took ~0.4 ms for the ~10,000 granule cells a compaction of the thesis network sorts."""
+    one = np.uint64(1)
+    w_lo, w_hi = bits.shape[0], 0
+    for m in range(key.shape[0]):
+        i = key[m] >> 32
+        slot[i] = key[m] & 0xFFFFFFFF
+        d = i - lo
+        w = d >> 6
+        bits[w] |= one << np.uint64(d & 63)
+        w_lo = min(w_lo, w)
+        w_hi = max(w_hi, w + 1)
+    m = 0
+    for w in range(w_lo, w_hi):
+        x = bits[w]
+        if x == 0:
+            continue
+        bits[w] = 0
+        base = lo + (w << 6)
+        while x != 0:
+            i = base + np.int64(trailing_zeros(x))
+            key[m] = (i << 32) | np.int64(slot[i])
+            m += 1
+            x &= x - one
+
+
+@njit(cache=True, boundscheck=False)
 def _compact(lo, na, nrn, buf, full, gmax):
     """Drop the neurons at rest from the ``na`` listed neurons of the compact population
     starting at ``lo`` and put the others in global index order (the order of the list does not
@@ -999,7 +1031,7 @@ def _compact(lo, na, nrn, buf, full, gmax):
     index order makes the targets of one presynaptic neuron long runs, see :func:`_build_runs`).
     Only the list is read, never the whole population: the neurons listed at the last compaction
     are still in index order, those activated since follow in the order they came and are sorted
-    (keys global index << 32 | position, so a key's order is its index's), then merged in.
+    (keys global index << 32 | position, so a key's order is its index's; :func:`_sort_keys`), then merged in.
     ``full``: the population has NMDA/GABA conductances (moved too); a neuron at rest whose GABA conductance is
     in (0, gmax] leaves the list (a lazy-GABA population's ``g_gaba`` holds that conductance already).
     Returns the new count."""
@@ -1029,7 +1061,8 @@ def _compact(lo, na, nrn, buf, full, gmax):
         p += 1
     src = key
     if p < j:
-        tail = np.sort(key[p:j])
+        tail = key[p:j]
+        _sort_keys(tail, lo, slot, buf.bits)
         a = b = m = 0
         nt = j - p
         while a < p and b < nt:

@@ -272,7 +272,7 @@ def test_a_pickled_network_goes_on_as_the_original():
     sa, sb = _drive(a, 200, seed=1), _drive(b, 200, seed=1)
     _assert_same(sa, sb, a, b)
     # a checkpoint of earlier code pickled every array and the kernels' handles: it loads and goes on too
-    old = {k: v for k, v in a.__dict__.items() if k != "_chunk_idx"}
+    old = {k: v for k, v in a.__dict__.items() if k not in ("_chunk_idx", "bits")}
     c = Network.__new__(Network)
     c.__setstate__(pickle.loads(pickle.dumps(old)))
     _assert_same(_drive(a, 50, seed=2), _drive(c, 50, seed=2), a, c)
@@ -315,6 +315,21 @@ def test_delivery_caches_and_compaction_are_exact_and_consistent():
     np.testing.assert_array_equal(a.dense_w, b.dense_w)
     for key in ("V", "g", "ref"):
         np.testing.assert_array_equal(getattr(a, key), getattr(b, key))
+
+
+@pytest.mark.parametrize("lo, span, n", [(0, 64, 64), (7, 1000, 1), (130, 60_000, 10_000), (5, 200, 0)])
+def test_the_compactions_sort_orders_keys_as_np_sort_and_leaves_its_bitmap_clear(lo, span, n):
+    """_sort_keys (the bitmap sort of a compaction's newly listed neurons) against np.sort: keys index << 32 |
+    position for distinct indices in [lo, lo + span), positions shuffled."""
+    rng = np.random.default_rng(span + n)
+    idx = lo + rng.choice(span, n, replace=False).astype(np.int64)
+    keys = (idx << 32) | rng.permutation(n).astype(np.int64)
+    slot = np.full(lo + span, -1, np.int32)
+    bits = np.zeros((lo + span) // 64 + 2, np.uint64)
+    got = keys.copy()
+    kernels._sort_keys(got, lo, slot, bits)
+    np.testing.assert_array_equal(got, np.sort(keys))
+    assert not bits.any()
 
 
 def test_a_failed_first_write_of_the_weights_fails_the_build(monkeypatch):
