@@ -446,8 +446,8 @@ class Network:
             self.pop_lazy = np.zeros(len(self.pop_lo))
             self.pop_nmda = np.ones(len(self.pop_lo), np.uint8)
         if "g_gaba" not in state:  # pickled when the listed neurons' GABA lived in g[2] only, the others' in g_rest
-            self.g_gaba = self.__dict__.pop("g_rest", None)
-            self.g_gaba = np.zeros_like(self._ref) if self.g_gaba is None else self.g_gaba
+            g_rest = self.__dict__.pop("g_rest", None)
+            self.g_gaba = np.zeros_like(self._ref) if g_rest is None else g_rest
             for pi in np.flatnonzero(self.pop_lazy > 0):
                 lo, na = int(self.pop_lo[pi]), int(self.n_act[pi])
                 self.g_gaba[self.cid[lo : lo + na]] = self._g[2, lo : lo + na]
