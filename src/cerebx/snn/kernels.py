@@ -263,13 +263,12 @@ class Plasticity(NamedTuple):
 class Buffers(NamedTuple):
     """Scratch space and the step's spike output."""
 
-    col_buf: np.ndarray  # int64 [n]: PCs hit by teacher spikes; the compaction's merge
+    col_buf: np.ndarray  # int64 [n]: PCs hit by teacher spikes
     acc: np.ndarray  # float64 [n]: summed kernel values per PF (zero between uses)
     acc_j: np.ndarray  # int64 [n]: PFs with a nonzero acc
     out_idx: np.ndarray  # int32 [n * n_sub]: spiking neurons of the step
     out_t: np.ndarray  # int32 [n * n_sub]: their substep (1..n_sub)
     scr_f: np.ndarray  # float32 [5, n]: compaction scratch (u, g_AMPA, ref, g_NMDA, g_GABA)
-    scr_i: np.ndarray  # int64 [n]: compaction scratch (sort keys)
     bits: np.ndarray  # uint64 [n // 64 + 2]: compaction scratch, a bitmap of neurons (zero between uses)
 
 
@@ -696,16 +695,17 @@ def _lif_full_listed_par(u, gA, gN, gG, ref, flag, out, p, nf, nch):
     return cnt
 
 
-FUSED = ((1, 3), (0, 2), (0, 3))
+FUSED = ((1, 3), (0, 2))
 """(method, bifixed sub-steps) for which :func:`_lif_gaba` has a fused loop: those whose result the tests prove
 bit for bit equal to :func:`_lif_full_listed`'s (RK2 with 3 sub-steps is the granule cell's; with 2 sub-steps, and
-Euler with 4 or more, the compiler rearranges the unrolled sub-steps' products and the last bit of V moves).
-The others keep :func:`_lif_full_listed`."""
+Euler with 4 or more, the compiler rearranges the unrolled sub-steps' products and the last bit of V moves; Euler
+with 3 differed on an AVX-512 host, 71,403 of 1.2 million V values, though it had matched on the development
+host). The others keep :func:`_lif_full_listed`."""
 
 
 @njit(cache=True, inline="always")
 def _fusable(method, nf):
-    return (method == 1 and nf == 3) or (method == 0 and (nf == 2 or nf == 3))
+    return (method == 1 and nf == 3) or (method == 0 and nf == 2)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
@@ -994,16 +994,29 @@ def _collect(flag, ids, ring_idx, slot, ring_n, out_idx, out_t, n_out, stamp, so
 
 
 @njit(cache=True, boundscheck=False)
-def _sort_keys(key, lo, slot, bits):
-    """Sort ``key`` (global index << 32 | position, the indices distinct and at least ``lo``) in place, in time
-    linear in its length and in the indices' span / 64: each index is set in the bitmap ``bits`` (bit i - lo; zero
-    on entry and left zero), with its position kept in ``slot[i]`` meanwhile (the caller rewrites it), and read
-    back in order. np.sort took ~0.4 ms for the ~10,000 granule cells a compaction of the thesis network sorts."""
+def _compact(lo, na, nrn, buf, full, gmax):
+    """Drop the neurons at rest from the ``na`` listed neurons of the compact population
+    starting at ``lo`` and put the others in global index order (the order of the list does not
+    affect any result: every per-neuron operation is independent and collected spikes are sorted;
+    index order makes the targets of one presynaptic neuron long runs, see :func:`_build_runs`).
+    Only the list is read, never the whole population: each neuron that stays sets its bit (index - lo) in
+    the bitmap ``buf.bits`` (zero on entry and left zero), which is then read in index order; a neuron's
+    listed position is its ``slot`` until it is rewritten. ``full``: the population has NMDA/GABA conductances
+    (moved too); a neuron at rest whose GABA conductance is in (0, gmax] leaves the list (a lazy-GABA
+    population's ``g_gaba`` holds that conductance already). Returns the new count."""
+    u, g, ref, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot
+    sf, bits = buf.scr_f, buf.bits
     one = np.uint64(1)
     w_lo, w_hi = bits.shape[0], 0
-    for m in range(key.shape[0]):
-        i = key[m] >> 32
-        slot[i] = key[m] & 0xFFFFFFFF
+    for k in range(lo, lo + na):
+        i = cid[k]
+        if full:
+            if _at_rest(u[k], g[0, k], g[1, k], ref[k], g[2, k], gmax):
+                slot[i] = -1
+                continue
+        elif u[k] == 0.0 and g[0, k] == 0.0 and ref[k] == 0.0:
+            slot[i] = -1
+            continue
         d = i - lo
         w = d >> 6
         bits[w] |= one << np.uint64(d & 63)
@@ -1018,78 +1031,24 @@ def _sort_keys(key, lo, slot, bits):
         base = lo + (w << 6)
         while x != 0:
             i = base + np.int64(trailing_zeros(x))
-            key[m] = (i << 32) | np.int64(slot[i])
+            k = slot[i]
+            sf[0, m] = u[k]
+            sf[1, m] = g[0, k]
+            sf[2, m] = ref[k]
+            if full:
+                sf[3, m] = g[1, k]
+                sf[4, m] = g[2, k]
+            cid[lo + m] = i
+            slot[i] = lo + m
             m += 1
             x &= x - one
-
-
-@njit(cache=True, boundscheck=False)
-def _compact(lo, na, nrn, buf, full, gmax):
-    """Drop the neurons at rest from the ``na`` listed neurons of the compact population
-    starting at ``lo`` and put the others in global index order (the order of the list does not
-    affect any result: every per-neuron operation is independent and collected spikes are sorted;
-    index order makes the targets of one presynaptic neuron long runs, see :func:`_build_runs`).
-    Only the list is read, never the whole population: the neurons listed at the last compaction
-    are still in index order, those activated since follow in the order they came and are sorted
-    (keys global index << 32 | position, so a key's order is its index's; :func:`_sort_keys`), then merged in.
-    ``full``: the population has NMDA/GABA conductances (moved too); a neuron at rest whose GABA conductance is
-    in (0, gmax] leaves the list (a lazy-GABA population's ``g_gaba`` holds that conductance already).
-    Returns the new count."""
-    u, g, ref, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.cid, nrn.slot
-    sf, key, merged = buf.scr_f, buf.scr_i, buf.col_buf
-    j = 0
-    for k in range(lo, lo + na):
-        i = cid[k]
-        x, gk, r = u[k], g[0, k], ref[k]
-        if full:
-            gn, gb = g[1, k], g[2, k]
-            if _at_rest(x, gk, gn, r, gb, gmax):
-                slot[i] = -1
-                continue
-            sf[3, j] = gn
-            sf[4, j] = gb
-        elif x == 0.0 and gk == 0.0 and r == 0.0:
-            slot[i] = -1
-            continue
-        sf[0, j] = x
-        sf[1, j] = gk
-        sf[2, j] = r
-        key[j] = (np.int64(i) << 32) | j
-        j += 1
-    p = 1
-    while p < j and key[p] > key[p - 1]:
-        p += 1
-    src = key
-    if p < j:
-        tail = key[p:j]
-        _sort_keys(tail, lo, slot, buf.bits)
-        a = b = m = 0
-        nt = j - p
-        while a < p and b < nt:
-            if key[a] < tail[b]:
-                merged[m] = key[a]
-                a += 1
-            else:
-                merged[m] = tail[b]
-                b += 1
-            m += 1
-        merged[m : m + p - a] = key[a:p]
-        merged[m + p - a : j] = tail[b:nt]
-        src = merged
-    for m in range(j):
-        v = src[m]
-        i = v >> 32
-        q = v & 0xFFFFFFFF
-        k = lo + m
-        u[k] = sf[0, q]
-        g[0, k] = sf[1, q]
-        ref[k] = sf[2, q]
-        if full:
-            g[1, k] = sf[3, q]
-            g[2, k] = sf[4, q]
-        cid[k] = i
-        slot[i] = k
-    return j
+    u[lo : lo + m] = sf[0, :m]
+    g[0, lo : lo + m] = sf[1, :m]
+    ref[lo : lo + m] = sf[2, :m]
+    if full:
+        g[1, lo : lo + m] = sf[3, :m]
+        g[2, lo : lo + m] = sf[4, :m]
+    return m
 
 
 @njit(cache=True, boundscheck=False)

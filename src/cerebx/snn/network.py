@@ -57,7 +57,7 @@ def pack(inputs: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     return flat, in_off
 
 
-_SCRATCH = ("col_buf", "acc", "acc_j", "out_idx", "out_t", "scr_f", "scr_i", "bits")
+_SCRATCH = ("col_buf", "acc", "acc_j", "out_idx", "out_t", "scr_f", "bits")
 """The kernels' scratch buffers: each is written before it is read (``acc`` is all zeros between calls)."""
 _CACHES = ("c_k", "c_q", "c_l")
 """The sparse projections' delivery caches (``kernels._build_runs``), valid while ``sp_c``'s epoch is current."""
@@ -244,7 +244,6 @@ class Network:
         self.c_l = np.zeros(nsyn, dtype=np.int64)
         self.pop_ep = np.ones(len(topo.names), dtype=np.int64)
         self.scr_f = np.zeros((5, n), dtype=np.float32)
-        self.scr_i = np.zeros(n, dtype=np.int64)
         self.bits = np.zeros(n // 64 + 2, dtype=np.uint64)
         self.sl = _sparse_learning(topo)
         self.learn = True
@@ -266,7 +265,7 @@ class Network:
             plasticity=kernels.Plasticity(self.pl_i, self.pl_f, self.kern, self.pf_t, self.pf_j, self.pf_head,
                                           self.pf_lost, self.pl_dirty),
             buffers=kernels.Buffers(self.col_buf, self.acc, self.acc_j, self.out_idx, self.out_t, self.scr_f,
-                                    self.scr_i, self.bits),
+                                    self.bits),
             learning=self.sl if len(self.sl.sr_i) else learning.NO_LEARNING,
         )
 
@@ -451,6 +450,7 @@ class Network:
             for pi in np.flatnonzero(self.pop_lazy > 0):
                 lo, na = int(self.pop_lo[pi]), int(self.n_act[pi])
                 self.g_gaba[self.cid[lo : lo + na]] = self._g[2, lo : lo + na]
+        self.__dict__.pop("scr_i", None)  # the compaction's sort keys, pickled before it read a bitmap instead
         if "bits" not in state:  # pickled before the compaction's bitmap
             self.bits = np.zeros(len(self._ref) // 64 + 2, dtype=np.uint64)
         if self.scr_f.shape[0] < 5:  # its compaction scratch had 3 rows

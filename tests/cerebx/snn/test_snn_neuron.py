@@ -317,19 +317,47 @@ def test_delivery_caches_and_compaction_are_exact_and_consistent():
         np.testing.assert_array_equal(getattr(a, key), getattr(b, key))
 
 
-@pytest.mark.parametrize("lo, span, n", [(0, 64, 64), (7, 1000, 1), (130, 60_000, 10_000), (5, 200, 0)])
-def test_the_compactions_sort_orders_keys_as_np_sort_and_leaves_its_bitmap_clear(lo, span, n):
-    """_sort_keys (the bitmap sort of a compaction's newly listed neurons) against np.sort: keys index << 32 |
-    position for distinct indices in [lo, lo + span), positions shuffled."""
-    rng = np.random.default_rng(span + n)
-    idx = lo + rng.choice(span, n, replace=False).astype(np.int64)
-    keys = (idx << 32) | rng.permutation(n).astype(np.int64)
-    slot = np.full(lo + span, -1, np.int32)
-    bits = np.zeros((lo + span) // 64 + 2, np.uint64)
-    got = keys.copy()
-    kernels._sort_keys(got, lo, slot, bits)
-    np.testing.assert_array_equal(got, np.sort(keys))
-    assert not bits.any()
+@pytest.mark.parametrize("full", [False, True])
+@pytest.mark.parametrize("n_sorted, n_tail, seed", [(0, 0, 0), (1, 0, 1), (0, 500, 2), (300, 700, 3), (1000, 1, 4)])
+def test_a_compaction_keeps_the_listed_neurons_off_rest_in_index_order(full, n_sorted, n_tail, seed):
+    """_compact on a list of a sorted part (the last compaction's) followed by neurons listed since, in the order
+    they came: the neurons not at rest, each with its state, in index order at the front; slot and cid inverse,
+    the others off the list (slot -1); the bitmap left clear. ``full``: NMDA and GABA move too, and a neuron
+    at rest whose GABA is within the lazy bound leaves the list."""
+    net = Network(full_network(fibers=5, per_joint=20), parallel=False, compact_min=1)
+    nrn, buf = net.arrays.neurons, net.arrays.buffers
+    gc = net.index("gc")
+    lo, n = gc.start, gc.stop - gc.start
+    rng = np.random.default_rng(seed)
+    chosen = lo + rng.choice(n, n_sorted + n_tail, replace=False)
+    listed = np.concatenate([np.sort(chosen[:n_sorted]), chosen[n_sorted:]])
+    na = len(listed)
+    nrn.slot[gc] = -1
+    nrn.cid[lo : lo + na] = listed
+    nrn.slot[listed] = np.arange(lo, lo + na)
+    state = rng.random((5, na)).astype(np.float32)
+    rest = rng.random(na) < 0.4
+    state[:4, rest] = 0.0  # u, g_AMPA, ref, g_NMDA at rest
+    state[4, rest] = np.where(rng.random(rest.sum()) < 0.5, 0.0, 0.5)  # GABA: 0, or within the bound below
+    gaba_bound = np.float32(1.0)
+    nrn.u[lo : lo + na], nrn.g[0, lo : lo + na], nrn.ref[lo : lo + na] = state[0], state[1], state[2]
+    nrn.g[1, lo : lo + na], nrn.g[2, lo : lo + na] = state[3], state[4]
+    if not full:  # an AMPA-only population: rest is u, g_AMPA and ref at 0
+        rest = (state[0] == 0) & (state[1] == 0) & (state[2] == 0)
+    keep = np.flatnonzero(~rest)
+    order = keep[np.argsort(listed[keep])]
+    m = kernels._compact(lo, na, nrn, buf, full, gaba_bound)
+    assert m == len(keep)
+    np.testing.assert_array_equal(nrn.cid[lo : lo + m], listed[order])
+    np.testing.assert_array_equal(nrn.slot[listed[order]], np.arange(lo, lo + m))
+    assert (nrn.slot[listed[rest]] == -1).all()
+    np.testing.assert_array_equal(nrn.u[lo : lo + m], state[0, order])
+    np.testing.assert_array_equal(nrn.g[0, lo : lo + m], state[1, order])
+    np.testing.assert_array_equal(nrn.ref[lo : lo + m], state[2, order])
+    if full:
+        np.testing.assert_array_equal(nrn.g[1, lo : lo + m], state[3, order])
+        np.testing.assert_array_equal(nrn.g[2, lo : lo + m], state[4, order])
+    assert not buf.bits.any()
 
 
 def test_a_failed_first_write_of_the_weights_fails_the_build(monkeypatch):
