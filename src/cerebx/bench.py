@@ -6,7 +6,8 @@ all run as they would in an experiment. The encoder output is computed before th
 (the encoders are part of the controller's cost, not the network's), so ``rt_factor`` and
 ``us_per_step`` measure ``Network.step`` alone. As many steps again follow with the kernels timed part by
 part (``per_step_us``, :meth:`~cerebx.snn.network.Network.start_profile`), with the mean number of granule
-cells off rest integrated per step (``listed_neurons``: how quiet the granule layer is).
+cells off rest per step (``listed_neurons``: how quiet the granule layer is; for a lumped population also the classes
+it integrates instead, ``<population> (classes)``).
 """
 
 from __future__ import annotations
@@ -37,10 +38,12 @@ def _per_step_parts(net: Network, inputs: list[np.ndarray]) -> tuple[dict[str, f
     net.step(inputs[0])  # a profiled step runs code of its own: compiled (or loaded) before the clock starts
     net.start_profile()
     listed = np.zeros_like(net.n_act)
+    classes = np.zeros_like(net.n_act)
     t0 = time.perf_counter()
     for x in inputs[1:]:
         net.step(x)
         listed += net.n_act
+        classes += net.lp.n_cls - net.lp.n_free
     wall = time.perf_counter() - t0
     n = max(1, len(inputs) - 1)
     us = 1e6 / n
@@ -48,7 +51,9 @@ def _per_step_parts(net: Network, inputs: list[np.ndarray]) -> tuple[dict[str, f
     out["total"] = round(wall * us, 2)
     net.prof = None
     compact = np.flatnonzero(net.pop_i[:, I_COMPACT])
-    return out, {net.topo.names[i]: round(float(listed[i]) / n, 1) for i in compact}
+    lumped = set(net.lumped)
+    return out, {net.topo.names[i]: round(float(listed[i]) / n, 1) for i in compact} | {
+        f"{name} (classes)": round(float(classes[net.topo.index[name]]) / n, 1) for name in sorted(lumped)}
 
 
 def bench_network(network_cfg: NetworkConfig, seconds: float = 3.0, warmup: float = 0.5,

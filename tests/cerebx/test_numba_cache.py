@@ -11,6 +11,7 @@ import pytest
 from cerebx import numba_cache
 from cerebx.cli import main
 from cerebx.compile_progress import CompileProgress
+from cerebx.estimate import duration
 from cerebx.numba_cache import MIN_REPORTED_S, cold_kernels
 
 SNN = ["+task=circle", "+experiment=small_snn", "trials=1"]
@@ -75,7 +76,7 @@ def test_a_run_with_a_cold_cache_says_it_compiles(in_tmp, monkeypatch, capsys):
     assert err[0] == (f"numba: {n} kernels of this run are not compiled yet (first run since an install or a change): "
                       f"compiling them first, ~{n * 0.9:.0f} s, once (cached in {in_tmp / 'cold'})")
     assert err[1].startswith("run: estimate: 2 s simulated") and err[1].endswith(
-        f"on a quiet 2-core machine (~{n * 0.9:.0f} s of it compiling numba kernels, once)")
+        f"on a quiet 2-core machine (~{duration(n * 0.9)} of it compiling numba kernels, once)")
     assert started == [n, True]
 
 

@@ -42,6 +42,11 @@ the same order as without the cache. Conductances below 1e-12 nS and
 |u| below 1e-6 mV become exactly 0 (V itself is only resolved to 7.6e-6 mV in float32 near -65
 mV), so a neuron returns to rest a few tens of ms after its last input.
 
+A compact population whose input makes equal neurons stay equal (the thesis granule layer: AMPA from box-coded
+mossy fibres, one weight) is *lumped* instead (``snn/lumping.py``): its neurons are kept in classes of equal state
+and input count, each class integrated once by the same kernel, and only the neurons whose input changed move
+between classes; ``Lumps`` holds them, and the compact list is written from them when Python reads the state.
+
 Rest under GABA (the granule layer under Golgi inhibition): in a compact population with
 ``clamp_at_rest`` and E_GABA <= E_L, a neuron at rest whose only input is a GABA conductance up to
 ``Populations.lazy`` (``topology.lazy_gaba_nS``: the step from rest is then negative and clamped to
@@ -70,7 +75,9 @@ from numba.cpython.unsafe.numbers import trailing_zeros
 from numba.extending import intrinsic, overload
 
 from cerebx.kernel_struct import KernelStruct
+from cerebx.snn import lumping
 from cerebx.snn.learning import NoLearning, SparseLearning, run_rules
+from cerebx.snn.lumping import Lumps
 from cerebx.snn.topology import (
     I_COMPACT,
     I_HI,
@@ -283,6 +290,7 @@ class NetworkArrays(NamedTuple):
     plasticity: Plasticity
     buffers: Buffers
     learning: SparseLearning | NoLearning  # the sparse projections' rules (snn/learning.py), if any
+    lumps: Lumps  # the lumped populations' classes (snn/lumping.py)
 
 
 class KernelState(KernelStruct, fields=NetworkArrays):
@@ -1161,6 +1169,7 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
     when the sum leaves [0, lazy] (it would then move from rest).
     """
     nrn, pops, dl, plast, buf = net.neurons, net.populations, net.delivery, net.plasticity, net.buffers
+    lumps = net.lumps
     u, g, ref, flag, cid, slot = nrn.u, nrn.g, nrn.ref, nrn.flag, nrn.cid, nrn.slot
     n_act, n_rest, pop_ep = nrn.n_act, nrn.n_rest, nrn.pop_ep
     g_gaba = nrn.g_gaba
@@ -1196,6 +1205,9 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
             if t % ratio != 0:
                 continue
             plo = pop_i[pp, I_LO]
+            if lumps.proj[pp] == p:  # a lumped population: only the neurons whose input changed move
+                lumping.arrival_window(lumps, pp, p, t, n_sub, ratio, dl, n_act, plo)
+                continue
             compact = pop_i[pp, I_COMPACT] != 0
             lazy = compact and rec == 2 and pop_lazy[pp] > 0.0
             gmax = np.float32(pop_lazy[pp])
@@ -1358,6 +1370,23 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
             if kind == KIND_INPUT or (t + 1) % pop_i[pi, I_RATIO] != 0:
                 continue
             lo = pop_i[pi, I_LO]
+            if lumps.proj[pi] >= 0:  # its classes, each one neuron's arithmetic for all its members
+                nc = lumps.n_cls[pi]
+                if nc == 0:
+                    continue
+                tk = prof_lap(prof, pb + BOOKKEEPING, tk)
+                cnt, nr = _lif_poly(lumps.cu[lo : lo + nc], lumps.cg[lo : lo + nc], lumps.cref[lo : lo + nc],
+                                    lumps.cflag[lo : lo + nc], pops, pi)
+                tk = prof_lap(prof, pi, tk)
+                if cnt > 0:
+                    n_out = lumping.collect(lumps, pi, lo, ring_idx, nxt, ring_n, out_idx, out_t, n_out, s + 1)
+                if nr > lumps.n_free[pi]:
+                    lumping.dissolve(lumps, pi, lo, n_act)
+                lumping.merge(lumps, pi, lo)
+                if not lumping.worth_it(lumps, pi, n_act):  # back to the list for good (the same results)
+                    lumping.unlump(lumps, pi, lo, pop_i[pi, I_HI], nrn)
+                    lumps.proj[pi] = -1
+                continue
             na = n_act[pi]
             if pop_lazy[pi] > 0.0:  # the listed neurons' GABA, then every neuron's decayed as the loop decays it
                 gg = g[2]

@@ -9,7 +9,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from cerebx.snn import kernels, learning
+from cerebx.snn import kernels, learning, lumping
+from cerebx.snn.learning import R_NPOST, R_POST_LO
 from cerebx.snn.plasticity import HISTORY_MAX, TraceSpec
 from cerebx.snn.schema import NetworkConfig
 from cerebx.snn.topology import (
@@ -133,7 +134,7 @@ class Network:
     STATE_KEYS = ("V", "g", "ref", "ring_idx", "ring_n", "pf_t", "pf_j", "pf_head", "pf_lost", "dense_w", "w")
 
     def __init__(self, cfg: NetworkConfig, parallel: bool = True, pf_ring: int = PF_RING,
-                 compact_min: int = COMPACT_MIN, seed: int = 0):
+                 compact_min: int = COMPACT_MIN, seed: int = 0, lumped: bool = True):
         t_start = time.perf_counter()
         self.cfg = cfg
         self.parallel = parallel
@@ -156,7 +157,7 @@ class Network:
         filling = threading.Thread(target=fill, name="cerebx-weights", daemon=True)
         filling.start()
         try:
-            self._set_up(cfg, topo, pf_ring, compact_min)
+            self._set_up(cfg, topo, pf_ring, compact_min, lumped)
         finally:
             filling.join()
         if failed:
@@ -164,7 +165,7 @@ class Network:
         self.reset_state()
         self.build_s = time.perf_counter() - t_start
 
-    def _set_up(self, cfg: NetworkConfig, topo: Topology, pf_ring: int, compact_min: int) -> None:
+    def _set_up(self, cfg: NetworkConfig, topo: Topology, pf_ring: int, compact_min: int, lumped: bool) -> None:
         """Every array but the weights' values, and the kernels' handle on them."""
         self.n_sub = topo.n_sub
         self.fingerprint = cfg.fingerprint()
@@ -246,6 +247,13 @@ class Network:
         self.scr_f = np.zeros((5, n), dtype=np.float32)
         self.bits = np.zeros(n // 64 + 2, dtype=np.uint64)
         self.sl = _sparse_learning(topo)
+        if lumped:  # populations stepped as classes of equal neurons (snn/lumping.py; the same results)
+            rules = [(int(r[R_POST_LO]), int(r[R_NPOST])) for r in self.sl.sr_i]
+            proj, w = lumping.eligible(self.pop_i, self.pop_lazy, self.pop_nmda, sp, sp_i, self.de_i, rules,
+                                       self.n_sub)
+        else:
+            proj, w = np.full(len(topo.names), -1, np.int64), np.zeros(len(topo.names), np.float32)
+        self.lp = lumping.build(n, proj, w, self.pop_i)
         self.learn = True
         self.t_sub = 0
         self._all_changed = True  # every weight counts as changed until the first changed_ranges()
@@ -267,6 +275,7 @@ class Network:
             buffers=kernels.Buffers(self.col_buf, self.acc, self.acc_j, self.out_idx, self.out_t, self.scr_f,
                                     self.bits),
             learning=self.sl if len(self.sl.sr_i) else learning.NO_LEARNING,
+            lumps=self.lp,
         )
 
     # ------------------------------------------------------------------ state
@@ -302,9 +311,35 @@ class Network:
             self.u[lo : lo + na], self._g[:, lo : lo + na] = u[live], gg[:, live]
             self._ref[lo : lo + na] = r[live]
             self.u[lo + na : hi], self._g[:, lo + na : hi], self._ref[lo + na : hi] = 0, 0, 0
+        self._lump()
+
+    @property
+    def lumped(self) -> list[str]:
+        """The populations stepped as classes of neurons with equal state and input (:mod:`cerebx.snn.lumping`)."""
+        return [self.topo.names[pi] for pi in np.flatnonzero(self.lp.proj >= 0)]
+
+    def _lump(self) -> None:
+        """The lumped populations' classes from their compact lists."""
+        for pi in np.flatnonzero(self.lp.proj >= 0):
+            k = int(self.lp.proj[pi])
+            lumping.lump(self.lp, int(pi), int(self.pop_lo[pi]), int(self.pop_hi[pi]),
+                         (int(self.sp_i[k, S_PRE_LO]), int(self.sp_i[k, S_N_PRE])), self.arrays.neurons)
+
+    def _unlump(self) -> None:
+        """The lumped populations' compact lists written from their classes (the state Python reads)."""
+        for pi in np.flatnonzero(self.lp.proj >= 0):
+            lumping.unlump(self.lp, int(pi), int(self.pop_lo[pi]), int(self.pop_hi[pi]), self.arrays.neurons)
+
+    def _unlump_from(self, lp: lumping.Lumps) -> None:
+        """The compact lists written from the classes ``lp`` (a network pickled with its classes)."""
+        nrn = kernels.Neurons(self.u, self._g, self._ref, self.flag, self.cid, self.slot, self.n_act, self.n_rest,
+                              self.pop_ep, self.w, self.g_gaba)
+        for pi in np.flatnonzero(lp.proj >= 0):
+            lumping.unlump(lp, int(pi), int(self.pop_lo[pi]), int(self.pop_hi[pi]), nrn)
 
     def _neurons(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Full per-neuron (V, g, ref) assembled from the kernel state."""
+        self._unlump()
         V, g, ref = self.el.copy(), np.zeros_like(self._g), np.zeros_like(self._ref)
         for pi in range(len(self.pop_lo)):
             lo = int(self.pop_lo[pi])
@@ -412,7 +447,9 @@ class Network:
         which the loop's thread pickles while the network waits): the kernels' scratch buffers (written before
         they are read; ``acc`` is all zeros between calls) and the sparse delivery caches (rebuilt on first
         use), each left as its dtype and shape; the kernels' handles on the arrays are made again too."""
+        self._unlump()  # the lumped populations' state in their compact lists; the classes are rebuilt from them
         state = self.__dict__.copy()
+        state["lp"] = (_LEFT_OUT, self.lp.proj, self.lp.w)
         state.pop("_chunk_idx", None)  # step_many's output scratch (rebuilt on use)
         state["_stats_cache"] = {}  # the weight statistics' first pass is read whole after a load
         state.pop("arrays", None)
@@ -456,10 +493,19 @@ class Network:
         if self.scr_f.shape[0] < 5:  # its compaction scratch had 3 rows
             self.scr_f = np.zeros((5, self.scr_f.shape[1]), np.float32)
         self.prof = None
+        lp = state.get("lp")
+        if isinstance(lp, lumping.Lumps):  # pickled whole (not by __getstate__): its compact lists are stale then
+            self.lp = lumping.build(len(self._ref), lp.proj, lp.w, self.pop_i)
+            self._unlump_from(lp)
+        elif isinstance(lp, tuple) and lp and lp[0] == _LEFT_OUT:  # the classes rebuilt from the compact lists
+            self.lp = lumping.build(len(self._ref), lp[1], lp[2], self.pop_i)
+        else:  # pickled before lumped populations: none is lumped
+            self.lp = lumping.empty(len(self._ref), len(self.pop_lo))
         if stale:
             self.sp_c[:, 0] = 0  # no cache is valid (epochs start at 1): each is rebuilt when first used
         self.arrays = self._kernel_arrays()
         self._state = kernels.kernel_state(self.arrays)
+        self._lump()
 
     def _state_array(self, key: str) -> np.ndarray:
         return getattr(self.sl, key[3:]) if key.startswith("sl_") else getattr(self, key)
@@ -517,8 +563,13 @@ class Network:
         return weight_stats(w, beside, cache, cache.runs_of(rows * n_post, n_post))
 
     def integrators(self) -> dict[str, dict]:
-        """The integrator each neuron population uses (:func:`~cerebx.snn.topology.integrators`)."""
-        return integrators(self.topo)
+        """The integrator each neuron population uses (:func:`~cerebx.snn.topology.integrators`); a lumped
+        population (:attr:`lumped`) says so with ``lumped: true`` (the same arithmetic, once per class of equal
+        neurons)."""
+        out = integrators(self.topo)
+        for name in self.lumped:
+            out[name]["lumped"] = True
+        return out
 
     @property
     def plastic_projections(self) -> list[str]:

@@ -24,7 +24,7 @@ def _inputs(steps: int, n_mf: int, seed: int) -> list[np.ndarray]:
 
 def test_a_profiled_network_steps_exactly_like_an_unprofiled_one():
     cfg = network(fibers=5, per_joint=10)
-    plain, timed = (Network(cfg, parallel=False, compact_min=1000) for _ in range(2))
+    plain, timed = (Network(cfg, parallel=False, compact_min=1000, lumped=False) for _ in range(2))
     inputs = _inputs(300, plain.index("mf").stop, seed=2)
     timed.start_profile()
     t0 = time.perf_counter()
@@ -33,13 +33,18 @@ def test_a_profiled_network_steps_exactly_like_an_unprofiled_one():
     spikes_plain = [plain.step(x).idx.copy() for x in inputs]
     unlisted = Network(cfg, parallel=False, compact_min=10**9)  # every GC integrated, no list to compact
     spikes_unlisted = [unlisted.step(x).idx.copy() for x in inputs]
+    lumped = Network(cfg, parallel=False, compact_min=1000)  # GCs with equal state stepped once (snn/lumping.py)
+    lumped.start_profile()
+    spikes_lumped = [lumped.step(x).idx.copy() for x in inputs]
     assert sum(len(s) for s in spikes_plain) > 100
     assert plain.pop_ep[plain.topo.index["gc"]] > 3  # the GC list was compacted (sorted and merged) repeatedly
     assert all(np.array_equal(a, b) for a, b in zip(spikes_plain, spikes_timed))
     assert all(np.array_equal(a, b) for a, b in zip(spikes_plain, spikes_unlisted))
+    assert all(np.array_equal(a, b) for a, b in zip(spikes_plain, spikes_lumped))
     for key, value in plain.state_arrays().items():
         np.testing.assert_array_equal(timed.state_arrays()[key], value, err_msg=key)
         np.testing.assert_array_equal(unlisted.state_arrays()[key], value, err_msg=key)
+        np.testing.assert_array_equal(lumped.state_arrays()[key], value, err_msg=key)
     prof = timed.profile()
     assert set(prof) == {"integrate.gc", "integrate.pc", "integrate.dcn", *PROF_PARTS}
     assert all(prof[k] > 0 for k in ("integrate.gc", "integrate.pc", "integrate.dcn", "delivery", "bookkeeping"))

@@ -260,7 +260,7 @@ def test_a_pickled_network_goes_on_as_the_original():
     """A checkpoint pickles the network without its scratch buffers and delivery caches (made again, the caches
     rebuilt on first use): the restored network gives the same spikes, weights and state as the original."""
     cfg = full_network(fibers=5, per_joint=20)
-    a = Network(cfg, parallel=False, compact_min=1)
+    a = Network(cfg, parallel=False, compact_min=1, lumped=False)
     _drive(a, 150)
     assert a.sp_c[:, 0].any() and a.c_l.any()  # caches in use, to be left out
     assert not a.acc.any()  # the LTD accumulator is all zeros between calls
@@ -284,8 +284,8 @@ def test_delivery_caches_and_compaction_are_exact_and_consistent():
     results; the compact list stays consistent (slot/cid inverse, resting neurons off the list)
     and a compaction leaves it in global index order."""
     cfg = full_network(fibers=5, per_joint=20)
-    a = Network(cfg, parallel=False, compact_min=1)
-    b = Network(cfg, parallel=False, compact_min=1)
+    a = Network(cfg, parallel=False, compact_min=1, lumped=False)
+    b = Network(cfg, parallel=False, compact_min=1, lumped=False)
     gi = a.topo.index["gc"]
     gc = a.index("gc")
     rng = np.random.default_rng(3)

@@ -183,7 +183,7 @@ class SNNControllerImpl(Controller):
         self._in_flight = 0  # chunks handed to the network thread and not yet collected (at most 2)
         self._thread: NetworkThread | None = None
         seed = getattr(getattr(ctx, "cfg", None), "seed", 0)  # random connectors draw from the run's seed
-        self.net = Network(self.net_cfg, parallel=cfg.parallel and not self.pipeline, seed=seed)
+        self.net = Network(self.net_cfg, parallel=cfg.parallel and not self.pipeline, seed=seed, lumped=cfg.lumped)
         self.net.learn = cfg.plasticity
         io = self.net_cfg.io
         self.sl_mf, self.sl_cf, self.sl_dcn = (self.net.index(p) for p in (io.mossy, io.climbing, io.output))

@@ -52,7 +52,10 @@ class SNNController(ControllerConfig):
     is decoded into a joint torque (or agonist/antagonist muscle commands); the PF-PC synapses learn from
     the CF error (docs/models.md#kernel-stdp). The network comes from the ``network`` config group."""
 
-    added_without_effect: ClassVar[dict[str, Any]] = {"output": "torque", "decoder.spikes_full_scale": 100.0}
+    # ``lumped``: a run recorded before it stepped every granule cell itself, with the same results (so it counts
+    # as the same experiment as today's default)
+    added_without_effect: ClassVar[dict[str, Any]] = {"output": "torque", "decoder.spikes_full_scale": 100.0,
+                                                      "lumped": True}
 
     kind: Literal["snn"] = "snn"
     output: Literal["torque", "agonist_antagonist"] = Field(
@@ -85,6 +88,11 @@ class SNNController(ControllerConfig):
         "nearest future and past stamped torques, decaying by 0.998 per step when starved)")
     plasticity: bool = True
     parallel: bool = Field(True, description="use numba threads in the network kernels (when not pipelined)")
+    lumped: bool = Field(
+        True,
+        description="step a population of neurons with one kind of input (the granule layer) as classes of "
+        "neurons with equal state (identical results; summary.json's integrators say which populations are lumped)",
+    )
     pipeline: bool = Field(
         True,
         description="simulate the network one pathway-delay chunk ahead on a second thread "
