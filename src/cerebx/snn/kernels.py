@@ -1206,8 +1206,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                 continue
             plo = pop_i[pp, I_LO]
             if lumps.proj[pp] == p:  # a lumped population: only the neurons whose input changed move
-                lumping.arrival_window(lumps, pp, p, t, n_sub, ratio, dl, n_act, plo)
-                continue
+                if lumping.arrival_window(lumps, pp, p, t, n_sub, ratio, dl, nrn, plo, pop_i[pp, I_HI]) == 0:
+                    continue
             compact = pop_i[pp, I_COMPACT] != 0
             lazy = compact and rec == 2 and pop_lazy[pp] > 0.0
             gmax = np.float32(pop_lazy[pp])

@@ -195,19 +195,21 @@ def _move(lp, pi, lo, n_act, nt):
 
 
 @njit(cache=True, boundscheck=False)
-def arrival_window(lp, pi, p, t, n_sub, ratio, dl, n_act, lo):
+def arrival_window(lp, pi, p, t, n_sub, ratio, dl, nrn, lo, hi):
     """The lumped population ``pi``'s input at its delivery step ``t`` (projection ``p``): when the input
     population's spikes of one control step arrive in this window (``dl``: the kernels' ``Delivery``), move the
     neurons whose count changed since the
     previous such window and add each class's count of spikes to its conductance. The spikes arrive at ``t``
     itself (the projection's delay is a multiple of the population's step: :func:`eligible`), so each adds the
-    weight unscaled, exactly as the unlumped delivery's ``w * 1`` does. Returns whether this was an arrival
-    window."""
+    weight unscaled, exactly as the unlumped delivery's ``w * 1`` does. Returns 0 when done (an arrival window or
+    not); 1 when a cell's count would change by more than KMAX (a fibre given several times in one step): the
+    population then goes back to its list for good (``nrn``: the kernels' ``Neurons``; [lo, hi): its range) and
+    the caller delivers this window's spikes to the list."""
     sp_i, sp_ptr, sp_post, ring_idx, ring_n = dl.sp_i, dl.sp_ptr, dl.sp_post, dl.ring_idx, dl.ring_n
     delay = sp_i[p, S_DELAY]
     a = (t - delay) % n_sub
     if a >= ratio or t - delay - a < 0:
-        return False
+        return 0
     pre_lo, n_pre, off = sp_i[p, S_PRE_LO], sp_i[p, S_N_PRE], sp_i[p, S_ROW]
     R = ring_idx.shape[0]
     sl = (t - a - delay) % R
@@ -239,8 +241,16 @@ def arrival_window(lp, pi, p, t, n_sub, ratio, dl, n_act, lo):
         cc[pre_lo + j] = 0
         plist[pre_lo + k] = j
     lp.pn[pi] = ncur
+    for k in range(nt):
+        if abs(lp.dd[lp.tl[k]]) > KMAX:  # beyond the class table: the list takes over, exactly
+            for q in range(nt):
+                lp.dd[lp.tl[q]] = 0
+                lp.tm[lp.tl[q]] = 0
+            unlump(lp, pi, lo, hi, nrn)
+            lp.proj[pi] = -1
+            return 1
     if nt > 0:
-        _move(lp, pi, lo, n_act, nt)
+        _move(lp, pi, lo, nrn.n_act, nt)
     # each class's spikes: the same float32 additions, one at a time, as a listed neuron's. One pass per spike:
     # this code is inlined into run_step, whose fast-math would let the compiler sum a class's spikes in one
     # loop as count x w, which rounds differently
@@ -253,7 +263,7 @@ def arrival_window(lp, pi, p, t, n_sub, ratio, dl, n_act, lo):
         for c in range(cg.shape[0]):
             if ccnt[c] > k:
                 cg[c] += ws
-    return True
+    return 0
 
 
 @njit(cache=True, boundscheck=False)

@@ -126,3 +126,17 @@ def test_fibres_that_fire_at_random_send_the_population_back_to_its_list_with_th
     assert lumped.lumped == []
     assert np.array_equal(spikes[0], spikes[1])
     _same_state(lumped, listed)
+
+
+def test_a_fibre_given_many_times_in_one_step_hands_the_population_back_to_its_list_exactly(small):
+    """Nine copies of one fibre in a step change its cells' counts by more than the class table holds
+    (lumping.KMAX): the population goes back to its list at that window, which delivers every copy."""
+    lumped = Network(small, parallel=False, compact_min=COMPACT)
+    listed = Network(small, parallel=False, compact_min=COMPACT, lumped=False)
+    inputs = _drive(listed, small, 120, seed=4)
+    mf = listed.index(small.io.mossy)
+    inputs[60] = np.concatenate([np.full(9, mf.start, np.int32), inputs[60]])
+    spikes = [_run(net, inputs) for net in (lumped, listed)]
+    assert lumped.lumped == []
+    assert np.array_equal(spikes[0], spikes[1])
+    _same_state(lumped, listed)
