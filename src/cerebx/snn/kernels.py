@@ -1383,9 +1383,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                 if nr > lumps.n_free[pi]:
                     lumping.dissolve(lumps, pi, lo, n_act)
                 lumping.merge(lumps, pi, lo)
-                if not lumping.worth_it(lumps, pi, n_act):  # back to the list for good (the same results)
-                    lumping.unlump(lumps, pi, lo, pop_i[pi, I_HI], nrn)
-                    lumps.proj[pi] = -1
+                if not lumping.worth_it(lumps, pi, n_act):
+                    lumping.release(lumps, pi, lo, pop_i[pi, I_HI], nrn)
                 continue
             na = n_act[pi]
             if pop_lazy[pi] > 0.0:  # the listed neurons' GABA, then every neuron's decayed as the loop decays it

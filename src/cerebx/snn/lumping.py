@@ -86,13 +86,18 @@ class Lumps(NamedTuple):
 
 def empty(n: int, n_pop: int) -> Lumps:
     """No lumped population (every array sized for ``n`` neurons, ``split`` one row)."""
-    i32 = lambda: np.zeros(n, np.int32)  # noqa: E731
-    return Lumps(np.full(n_pop, -1, np.int64), np.zeros(n_pop, np.float32), np.full(n, -1, np.int32),
-                 np.full(n, -1, np.int32), np.full(n, -1, np.int32), np.zeros(n, np.float32),
-                 np.zeros(n, np.float32), np.zeros(n, np.float32), np.zeros(n, np.uint8), i32(),
-                 np.full(n, -1, np.int32), i32(), np.zeros(n_pop, np.int64), i32(), np.zeros(n_pop, np.int64),
-                 i32(), i32(), i32(), i32(), np.zeros(n_pop, np.int64), i32(), np.zeros(n, np.uint8), i32(),
-                 np.zeros((1, SPLIT_COLS), np.int32), np.zeros(SPLIT_COLS, np.int64), i32(), np.zeros(1, np.int32))
+    def i32(fill: int = 0) -> np.ndarray:
+        return np.full(n, fill, np.int32)
+
+    def per_pop(fill: int = 0) -> np.ndarray:
+        return np.full(n_pop, fill, np.int64)
+
+    return Lumps(proj=per_pop(-1), w=np.zeros(n_pop, np.float32), cls=i32(-1), nx=i32(-1), pv=i32(-1),
+                 cu=np.zeros(n, np.float32), cg=np.zeros(n, np.float32), cref=np.zeros(n, np.float32),
+                 cflag=np.zeros(n, np.uint8), ccnt=i32(), chead=i32(-1), csize=i32(), n_cls=per_pop(), cfree=i32(),
+                 n_free=per_pop(), pc=i32(), cc=i32(), plist=i32(), clist=i32(), pn=per_pop(), dd=i32(),
+                 tm=np.zeros(n, np.uint8), tl=i32(), split=np.zeros((1, SPLIT_COLS), np.int32),
+                 used=np.zeros(SPLIT_COLS, np.int64), emp=i32(), htab=np.zeros(1, np.int32))
 
 
 @njit(cache=True, boundscheck=False)
@@ -246,8 +251,7 @@ def arrival_window(lp, pi, p, t, n_sub, ratio, dl, nrn, lo, hi):
             for q in range(nt):
                 lp.dd[lp.tl[q]] = 0
                 lp.tm[lp.tl[q]] = 0
-            unlump(lp, pi, lo, hi, nrn)
-            lp.proj[pi] = -1
+            release(lp, pi, lo, hi, nrn)
             return 1
     if nt > 0:
         _move(lp, pi, lo, nrn.n_act, nt)
@@ -392,6 +396,13 @@ def merge(lp, pi, lo):
             k = (k + 1) & mask
     for q in range(nu):
         htab[lp.used[q]] = 0
+
+
+@njit(cache=True, boundscheck=False)
+def release(lp, pi, lo, hi, nrn):
+    """Population ``pi`` back to its compact list for good (:func:`unlump`; the same results from then on)."""
+    unlump(lp, pi, lo, hi, nrn)
+    lp.proj[pi] = -1
 
 
 LUMP_MAX = 4  # a population whose classes exceed 1/LUMP_MAX of its neurons off rest goes back to its list

@@ -330,13 +330,6 @@ class Network:
         for pi in np.flatnonzero(self.lp.proj >= 0):
             lumping.unlump(self.lp, int(pi), int(self.pop_lo[pi]), int(self.pop_hi[pi]), self.arrays.neurons)
 
-    def _unlump_from(self, lp: lumping.Lumps) -> None:
-        """The compact lists written from the classes ``lp`` (a network pickled with its classes)."""
-        nrn = kernels.Neurons(self.u, self._g, self._ref, self.flag, self.cid, self.slot, self.n_act, self.n_rest,
-                              self.pop_ep, self.w, self.g_gaba)
-        for pi in np.flatnonzero(lp.proj >= 0):
-            lumping.unlump(lp, int(pi), int(self.pop_lo[pi]), int(self.pop_hi[pi]), nrn)
-
     def _neurons(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Full per-neuron (V, g, ref) assembled from the kernel state."""
         self._unlump()
@@ -494,18 +487,19 @@ class Network:
             self.scr_f = np.zeros((5, self.scr_f.shape[1]), np.float32)
         self.prof = None
         lp = state.get("lp")
-        if isinstance(lp, lumping.Lumps):  # pickled whole (not by __getstate__): its compact lists are stale then
-            self.lp = lumping.build(len(self._ref), lp.proj, lp.w, self.pop_i)
-            self._unlump_from(lp)
-        elif isinstance(lp, tuple) and lp and lp[0] == _LEFT_OUT:  # the classes rebuilt from the compact lists
+        # by __getstate__: the classes are rebuilt from the compact lists (below); pickled whole (its __dict__), the
+        # classes are the state as they are
+        relump = not isinstance(lp, lumping.Lumps) and isinstance(lp, tuple) and lp[0] == _LEFT_OUT
+        if relump:
             self.lp = lumping.build(len(self._ref), lp[1], lp[2], self.pop_i)
-        else:  # pickled before lumped populations: none is lumped
+        elif not isinstance(lp, lumping.Lumps):  # pickled before lumped populations: none is lumped
             self.lp = lumping.empty(len(self._ref), len(self.pop_lo))
         if stale:
             self.sp_c[:, 0] = 0  # no cache is valid (epochs start at 1): each is rebuilt when first used
         self.arrays = self._kernel_arrays()
         self._state = kernels.kernel_state(self.arrays)
-        self._lump()
+        if relump:
+            self._lump()
 
     def _state_array(self, key: str) -> np.ndarray:
         return getattr(self.sl, key[3:]) if key.startswith("sl_") else getattr(self, key)
