@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -16,7 +18,7 @@ from cerebx.recording.cdr import decode_spikes
 from cerebx.schema.controller import GivenRanges
 from cerebx.signals import Deferred
 from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_sides, chunk_torques
-from cerebx.snn.encoders import ClimbingEncoder, EncoderPair, MossyEncoder
+from cerebx.snn.encoders import ClimbingEncoder, EncoderPair, MossyEncoder, compose_steps
 from cerebx.snn.presets import network as full_network
 from cerebx.snn.topology import build_topology
 
@@ -134,6 +136,36 @@ def make_ctrl(fibers=5, per_joint=10, **kw) -> SNNControllerImpl:
     ccfg = SNNController(network=net, **kw)
     cfg = SimpleNamespace(controller=ccfg, seed=3)
     return SNNControllerImpl(ccfg, BuildContext(cfg=cfg, task=_Task()))
+
+
+def spy_chunks(ctrl, before=None, after=None):
+    """Wrap the simulation of each chunk, whichever input path the controller takes (FIFOs of encoded ticks, or
+    pipelined with the built-in encoders, the ring the network thread encodes into): ``before(first)`` ahead of
+    it (may raise), ``after(flat, in_off, first)`` with its packed inputs once it ran."""
+    if ctrl._aff is None:
+        simulate = ctrl._simulate_packed
+
+        def spy(flat, in_off, first):
+            if before:
+                before(first)
+            out = simulate(flat, in_off, first)
+            if after:
+                after(flat, in_off, first)
+            return out
+
+        ctrl._simulate_packed = spy
+        return
+    simulate_ticks = ctrl._simulate_ticks
+
+    def spy_ticks(ticks, n, first):
+        if before:
+            before(first)
+        out = simulate_ticks(ticks, n, first)
+        if after:  # the ring still holds the chunk's ticks
+            after(*compose_steps(ctrl._aff.state, first, n), first)
+        return out
+
+    ctrl._simulate_ticks = spy_ticks
 
 
 def drive(ctrl, n, t0=0):
@@ -292,13 +324,7 @@ def test_cf_pathway_delay_shorter_than_mf(pipeline):
     ctrl = make_ctrl(pathway_delay_ms=50.0, cf_pathway_delay_ms=40.0, pipeline=pipeline)
     ctrl.reset(np.random.default_rng(0))
     seen: list[np.ndarray] = []
-    simulate = ctrl._simulate_packed
-
-    def spy(flat, in_off, first):
-        seen.extend(flat[a:b] for a, b in zip(in_off[:-1], in_off[1:]))
-        return simulate(flat, in_off, first)
-
-    ctrl._simulate_packed = spy
+    spy_chunks(ctrl, after=lambda flat, in_off, first: seen.extend(flat[a:b] for a, b in zip(in_off[:-1], in_off[1:])))
     for k in range(60):  # samples only at ticks 0-9, with a large error (CF near 10 Hz)
         t = k * 0.002
         q, qd = np.full(6, 0.2), np.zeros(6)
@@ -437,13 +463,7 @@ def test_next_chunk_is_queued_behind_the_one_in_flight_with_the_same_results(mon
     for pipeline in (True, False):
         ctrl = make_ctrl(pathway_delay_ms=50.0, pipeline=pipeline)
         ctrl.reset(np.random.default_rng(0))
-        simulate = ctrl._simulate_packed
-
-        def spy(flat, in_off, first, simulate=simulate, seen=firsts[pipeline]):
-            seen.append(first)
-            return simulate(flat, in_off, first)
-
-        ctrl._simulate_packed = spy
+        spy_chunks(ctrl, before=firsts[pipeline].append)
         runs[pipeline] = drive(ctrl, 300)
         ctrl.end_trial(0)
         assert ctrl._in_flight == 0
@@ -456,15 +476,14 @@ def test_next_chunk_is_queued_behind_the_one_in_flight_with_the_same_results(mon
 def test_a_failed_chunk_is_raised_once_and_leaves_nothing_in_flight():
     ctrl = make_ctrl(pathway_delay_ms=50.0)
     ctrl.reset(np.random.default_rng(0))
-    simulate, calls = ctrl._simulate_packed, []
+    calls = []
 
-    def failing(flat, in_off, first):
+    def failing(first):
         calls.append(1)
         if len(calls) == 3:
             raise FloatingPointError("chunk 3 failed")
-        return simulate(flat, in_off, first)
 
-    ctrl._simulate_packed = failing
+    spy_chunks(ctrl, before=failing)
     with pytest.raises(FloatingPointError, match="chunk 3 failed"):
         drive(ctrl, 300)
     assert ctrl._in_flight == 0
@@ -566,3 +585,60 @@ def test_a_deferred_trial_end_read_at_once_or_cut_short_by_the_next_trial_waits_
     assert isinstance(d2, Deferred) and not d2.ready
     assert d2["dcn_rate_hz"] == a2["dcn_rate_hz"] and d2.ready and not deferred._in_flight  # read: collected
     np.testing.assert_array_equal(drive(waited, 100, 263), drive(deferred, 100, 263))
+
+
+def _listed(ctrl):
+    """``ctrl`` with its encoders on the loop's thread and FIFOs of encoded ticks (the path plugin encoders take)."""
+    ctrl._aff = None
+    ctrl._reset_loop_state()
+    return ctrl
+
+
+def _irregular_drive(ctrl, ticks, t0=0, seed=0, late=True):
+    """Sensor samples with gaps and a large, changing error (CF bursts), as a delayed link delivers them (up to
+    two ticks ``late``)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(t0, t0 + ticks):
+        t = k * 0.002
+        q = 0.4 * np.sin(np.pi * t + np.arange(6))
+        qd = 0.4 * np.pi * np.cos(np.pi * t + np.arange(6))
+        stamp = t - 0.002 * rng.integers(0, 3) if late else t
+        s = None if rng.random() < 0.2 else SensorMsg(stamp, q - rng.normal(0, 0.2, 6), qd)
+        out.append(ctrl.control(ControlInput(k, t, q, qd, s)).tau)
+    return np.array(out)
+
+
+@pytest.mark.parametrize("delays", [dict(pathway_delay_ms=50.0), dict(pathway_delay_ms=50.0, cf_pathway_delay_ms=40.0),
+                                    dict(pathway_delay_ms=20.0, cf_pathway_delay_ms=30.0, error_reference_lag_ms=10.0),
+                                    dict(pathway_delay_ms=50.0, efferent="stamp")])
+def test_encoders_on_the_network_thread_give_what_the_loops_thread_gives(delays, tmp_path):
+    """Pipelined, the built-in encoders run in the network's chunks (AfferentRing): the same torques, error, CF
+    bursts and generator state as encoded a tick at a time into FIFOs, through sensor gaps, both pathway
+    delays, a pickle and a saved state mid-run (each path reads the other's), and a reset."""
+    ring, listed = make_ctrl(**delays), _listed(make_ctrl(**delays))
+    assert ring._aff is not None and listed._aff is None and ring.pipeline
+    for c in (ring, listed):
+        c.reset(np.random.default_rng(7))
+    np.testing.assert_array_equal(_irregular_drive(ring, 157), _irregular_drive(listed, 157))
+    np.testing.assert_array_equal(ring.last_error, listed.last_error)
+    np.testing.assert_array_equal(ring.cf.burst_left, listed.cf.burst_left)
+    assert ring.cf.rng.bit_generator.state == listed.cf.rng.bit_generator.state
+    ring2, listed2 = pickle.loads(pickle.dumps(ring)), pickle.loads(pickle.dumps(listed))
+    assert ring2._aff is not None
+    a = [_irregular_drive(c, 61, 157, seed=1) for c in (ring, listed, ring2, listed2)]
+    for x in a[1:]:
+        np.testing.assert_array_equal(a[0], x)
+    ring.save_state(tmp_path / "ring.npz")
+    listed.save_state(tmp_path / "listed.npz")
+    crossed = [make_ctrl(**delays), _listed(make_ctrl(**delays))]
+    crossed[0].load_state(tmp_path / "listed.npz")
+    crossed[1].load_state(tmp_path / "ring.npz")
+    # (a saved state keeps no desired states of earlier ticks: samples on time)
+    b = [_irregular_drive(c, 83, 218, seed=2, late=False) for c in (ring, listed, *crossed)]
+    for x in b[1:]:
+        np.testing.assert_array_equal(b[0], x)
+    for c in (ring, listed):
+        c.end_trial(0)
+        c.reset(np.random.default_rng(9))
+    np.testing.assert_array_equal(_irregular_drive(ring, 40), _irregular_drive(listed, 40))

@@ -25,6 +25,22 @@ def test_mean_filter_is_15_tap_average():
     assert outs[29] == pytest.approx(np.mean(range(16, 31)))
 
 
+def test_mean_filter_one_sample_a_tick_is_the_running_mean_bit_for_bit():
+    """The one-call path (one sample arrived) gives the doubles of push-then-mean, across the exact recomputation
+    of the sum every 1000 samples, and mixes with ticks where several or no samples arrive."""
+    rng = np.random.default_rng(5)
+    sig = (Signal("joint.torque", 6),)
+    fast, ref = MeanFilter(sig, 15), MeanFilter(sig, 15)
+    for tick in range(2600):
+        k = 1 if tick % 97 else int(rng.integers(0, 3))  # now and then none or two at once
+        msgs = [Message(0.0, {"joint.torque": rng.normal(0.0, 30.0, 6)}) for _ in range(k)]
+        got = fast.receive(msgs, 0.0)["joint.torque"]
+        for m in msgs:
+            ref.means["joint.torque"].push(m.values["joint.torque"])
+        want = ref.means["joint.torque"].mean()
+        assert got.tobytes() == want.tobytes(), tick
+
+
 def test_future_past_filter_hand_computed():
     f = FuturePastFilter(TAU, FuturePastFilterConfig(past_samples=2, min_future_samples=2))
     dt = 0.002

@@ -48,7 +48,7 @@ from cerebx.persistence.state import load_state_npz, save_state_npz
 from cerebx.recording.spike_chunks import chunk_spike_messages
 from cerebx.signals import Deferred
 from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_sides, chunk_torques
-from cerebx.snn.encoders import EncoderPair
+from cerebx.snn.encoders import AfferentRing, EncoderPair, compose_steps, encode_ticks
 from cerebx.snn.kernels import OUTPUTS, prof_lap, prof_now, run_chunk
 from cerebx.snn.network import Network, pack
 from cerebx.snn.schema import layout_problem
@@ -115,6 +115,17 @@ def _run_chunk_outputs(net, clock, chunk, outputs, prof):  # pragma: no cover
     taus, counts, words, starts = _chunk_outputs(idx_buf[:total], off, decode, record, first, step_s)
     prof_lap(prof, net.populations.pop_i.shape[0] + OUTPUTS, tk)
     return taus, counts, words, starts, net.plasticity.pf_lost.sum()
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _run_ticks_chunk_outputs(aff, ticks, steps, net, clock, idx_buf, off, outputs, prof):  # pragma: no cover
+    """:func:`_run_chunk_outputs` on the ticks the loop kept (:class:`~cerebx.snn.encoders.AfferentRing`): they
+    are encoded first (``ticks``: the arguments of :func:`~cerebx.snn.encoders.encode_ticks` after the ring)
+    and the chunk's ``steps`` inputs packed from the ring, all in the same compiled call."""
+    signals, sensed, u = ticks
+    encode_ticks(aff, signals, sensed, u)
+    flat, in_off = compose_steps(aff, outputs[2], steps)
+    return _run_chunk_outputs(net, clock, (flat, in_off, idx_buf, off), outputs, prof)
 
 
 class NetworkThread:
@@ -235,11 +246,43 @@ class SNNControllerImpl(Controller):
         # outputs not yet emitted (held back by the efferent delay unless they are stamped instead)
         self._ready: deque[np.ndarray] = deque([np.zeros(self.width)] * (k if self.hold else 0))
         self._net_step = 0  # network steps simulated so far (step m is stamped m * 2 ms)
+        self._fifos_to_ring()
         self._des: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._dcn_spikes = 0
         self._steps = 0
         self._no_closing()
-        self.last_error = np.zeros(self.n_ctrl)
+        self._last_error = np.zeros(self.n_ctrl)
+
+    def _fifos_to_ring(self) -> None:
+        """With the encoders on the network thread (``_aff``), the FIFOs of encoded ticks become its ring."""
+        if self._aff is not None:
+            self._aff.from_fifos(self._net_step, self.k_in, list(self._pending), list(self._mf_lag),
+                                 list(self._cf_lag))
+            self._pending = self._mf_lag = self._cf_lag = None  # type: ignore[assignment]
+
+    def _fifos(self) -> tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray]]:
+        """The FIFOs of encoded ticks (the shared input FIFO, the MF and CF lags), nothing in flight: with the
+        encoders on the network thread, the ticks kept are encoded here first."""
+        self._join()
+        if self._aff is None:
+            return list(self._pending), list(self._mf_lag), list(self._cf_lag)
+        self._aff.encode_now()
+        return self._aff.to_fifos(self._net_step, self.k_in)
+
+    def _n_pending(self) -> int:
+        """Network inputs that exist and have not been handed to the network."""
+        if self._aff is None:
+            return len(self._pending)
+        return self.k_in + self._aff.ticks - self._net_step - self._in_flight * self.chunk
+
+    @property
+    def last_error(self) -> np.ndarray:
+        """The CF error of the newest tick with a sensor sample."""
+        if self._aff is not None:
+            self._join()
+            self._aff.encode_now()
+            return self._aff.error
+        return self._last_error
 
     def _no_closing(self) -> None:
         """No trial waits for the chunks in flight to close (:meth:`end_trial`)."""
@@ -274,6 +317,25 @@ class SNNControllerImpl(Controller):
             return Chunk(first_step, taus, counts, None, None, lost)
         return Chunk(first_step, taus, counts, words, starts, lost)
 
+    def _simulate_ticks(self, ticks: tuple[np.ndarray, np.ndarray, Any], n: int, first_step: int) -> Chunk:
+        """:meth:`_simulate_packed` of the ``n`` steps from ``first_step`` on, their inputs packed from the ring of
+        encoded ticks after the ``ticks`` kept are encoded (:class:`~cerebx.snn.encoders.AfferentRing`)."""
+        aff = self._aff.state
+        if self._shed >= 2:
+            encode_ticks(aff, *ticks)
+            return self._simulate_packed(np.zeros(0, np.int32), np.zeros(n + 1, np.int64), first_step)
+        recording = bool(self.recorder is not None and self._shed < 3 and self.record)
+        record = (self._record_lo, self._record_hi) if recording else (_NONE, _NONE)
+        net = self.net
+        idx_buf, off = net.chunk_buffers(n)
+        taus, counts, words, starts, lost = _run_ticks_chunk_outputs(
+            aff, ticks, n, net._state, (net.t_sub, net.n_sub, net.learn, net.n_threads), idx_buf, off,
+            (self._decode, record, first_step, STEP_S), net.prof)
+        net.t_sub += net.n_sub * n
+        if not recording:
+            return Chunk(first_step, taus, counts, None, None, lost)
+        return Chunk(first_step, taus, counts, words, starts, lost)
+
     def _absorb(self, chunk: Chunk) -> None:
         """Queue a simulated chunk's outputs and log its recorded spikes (``_net_step`` is advanced by the
         caller, which may launch the next chunk first)."""
@@ -290,21 +352,33 @@ class SNNControllerImpl(Controller):
 
     def _run_now(self) -> None:
         """Simulate the next pending input on this thread."""
-        chunk = self._simulate([self._pending.popleft()], self._net_step)
+        if self._aff is not None:
+            chunk = self._simulate_ticks(self._aff.take(), 1, self._net_step)
+        else:
+            chunk = self._simulate([self._pending.popleft()], self._net_step)
         self._net_step += 1
         self._absorb(chunk)
 
     def _launch(self) -> None:
         """Hand the next chunk of pending inputs to the network thread (packed here, so that the thread's
         work is compiled code from the start)."""
-        flat, in_off = pack([self._pending.popleft() for _ in range(self.chunk)])
         first = self._net_step + self._in_flight * self.chunk  # after the chunk still in flight, if one is
+        if self._aff is not None:
+            ticks, n = self._aff.take(), self.chunk
+
+            def simulate() -> Chunk:
+                return self._simulate_ticks(ticks, n, first)
+        else:
+            flat, in_off = pack([self._pending.popleft() for _ in range(self.chunk)])
+
+            def simulate() -> Chunk:
+                return self._simulate_packed(flat, in_off, first)
         clock = phase_clock.active()
 
         def work() -> Chunk:
             t0, c0 = (time.perf_counter(), time.thread_time()) if clock is not None else (0.0, 0.0)
             try:
-                return self._simulate_packed(flat, in_off, first)
+                return simulate()
             finally:
                 if clock is not None:
                     clock.add_background("network", time.perf_counter() - t0, time.thread_time() - c0)
@@ -319,7 +393,7 @@ class SNNControllerImpl(Controller):
         chunk, whose inputs are there, is queued first, behind the one in flight: the network thread goes on
         to it the moment it is done, instead of sleeping until this thread has woken up, collected and handed
         it over (two thread wake-ups a chunk, ~0.1 ms of the network's ~1.8 ms)."""
-        if launch_next and self._in_flight == 1 and len(self._pending) >= self.chunk:
+        if launch_next and self._in_flight == 1 and self._n_pending() >= self.chunk:
             self._launch()
         while self._in_flight:
             self._in_flight -= 1
@@ -351,10 +425,12 @@ class SNNControllerImpl(Controller):
         part of the state; a restored controller starts its own when it first needs one. The desired states
         of the last 2,000 ticks go in as three arrays (ticks, q_des, qd_des): as 4,000 small arrays they were
         two thirds of the time a checkpoint held up the loop (20 of 30 ms)."""
-        self._join()
+        pending, mf_lag, cf_lag = self._fifos()  # joins
         state = self.__dict__.copy()
         state["_thread"] = None
         state.pop("_pair", None)  # made again from the encoders restored
+        state.pop("_aff", None)  # as is the ring, from the FIFOs
+        state["_pending"], state["_mf_lag"], state["_cf_lag"] = deque(pending), deque(mf_lag), deque(cf_lag)
         des = self._des
         if des:
             state["_des"] = ("stacked", np.fromiter(des, np.int64, len(des)),
@@ -372,7 +448,11 @@ class SNNControllerImpl(Controller):
         self.__dict__.update(state)
         self._in_flight, self._thread = 0, None
         self._no_closing()  # pickled after every chunk was collected, so none was waiting (older code: none)
+        if "_last_error" not in state:  # older code kept it as an attribute
+            self._last_error = state.get("last_error", np.zeros(self.n_ctrl))
+            self.__dict__.pop("last_error", None)
         self._derive_kernel_args()
+        self._fifos_to_ring()
 
     def _derive_kernel_args(self) -> None:
         """The decoder's gains and the recorded populations' bounds as the chunk kernels take them, their
@@ -385,6 +465,12 @@ class SNNControllerImpl(Controller):
                         self.muscles, scale, bool(self.cfg.decoder.saturate))
         self._spike_topics = tuple(f"/spikes/{name}" for name in self.record)
         self._pair = EncoderPair.of(self.mf, self.cf, self.sl_mf.start, self.sl_cf.start)
+        # pipelined, the built-in encoders run on the network thread, in the chunk that needs their ticks: the
+        # ring holds from the oldest tick a step still needs (the longer pathway) to the newest kept (at most
+        # the FIFOs' slack, with chunks in flight, ahead of the network)
+        span = max(self.k_delay, self.k_cf) + self.k_in + (self.k_delay if self.hold else 0) + 4 * self.chunk + 8
+        self._aff = AfferentRing.of(self.mf, self.cf, self.sl_mf.start, self.sl_cf.start, self.k_delay, self.k_cf,
+                                    span) if self.pipeline else None
 
     def _on_network_thread(self, fn: Any, *args: Any) -> Any:
         """Run ``fn(*args)`` on the network thread, idle while no chunk is in flight (between trials); returns
@@ -404,7 +490,7 @@ class SNNControllerImpl(Controller):
                 self._join(launch_next=True)
             else:
                 self._run_now()
-        if not self._in_flight and len(self._pending) >= self.chunk:
+        if not self._in_flight and self._n_pending() >= self.chunk:
             self._launch()
 
     def prepare_real_time(self) -> None:
@@ -412,6 +498,9 @@ class SNNControllerImpl(Controller):
         state, and leave out the periodic weight summaries (a pass over every plastic weight takes longer than
         the pathway delay leaves between two ticks; the learned state is still saved at the end)."""
         self._simulate_packed(*pack([]), self._net_step)  # a chunk of no steps: the network's kernels, decoding
+        if self._aff is not None:  # and with the encoders on the network thread, encoding no tick
+            self._simulate_ticks((np.zeros((0, 6, self.n_ctrl)), np.zeros(0, np.int64),
+                                  np.zeros((0, self.cf.burst_left.shape[0]))), 0, self._net_step)
         z = np.zeros(self.n_ctrl)
         copy.deepcopy(self.mf).active(z, z, z, z)
         self.cf.error(z, z, z, z)
@@ -428,6 +517,7 @@ class SNNControllerImpl(Controller):
         self.net.learn = self.cfg.plasticity and level == 0
 
     def reset(self, rng: np.random.Generator) -> None:
+        self._join()  # pipelined, the network thread writes the CF bursts
         self.cf.rng = rng
         self.cf.reset()
         self.net.reset_state()
@@ -448,7 +538,17 @@ class SNNControllerImpl(Controller):
         self._des[inp.tick] = (inp.q_des, inp.qd_des)
         self._des.pop(inp.tick - 2000, None)
         s = inp.sensor
-        if s is None:
+        if self._aff is not None:  # the tick's signals kept; the network thread encodes them
+            if s is None:
+                self._aff.kept.append(None)
+            else:
+                q_des, qd_des = self._desired_at(s.stamp_s, inp)
+                if self.cfg.error_reference_lag_ms:
+                    self._aff.kept.append((q_des, qd_des, *self._desired_at(
+                        s.stamp_s - self.cfg.error_reference_lag_ms / 1000.0, inp), s.q, s.qd))
+                else:
+                    self._aff.kept.append((q_des, qd_des, q_des, qd_des, s.q, s.qd))
+        elif s is None:
             mf = cf = np.zeros(0, np.int32)
         else:
             q_des, qd_des = self._desired_at(s.stamp_s, inp)
@@ -457,15 +557,16 @@ class SNNControllerImpl(Controller):
                 q_des_cf, qd_des_cf = self._desired_at(s.stamp_s - self.cfg.error_reference_lag_ms / 1000.0, inp)
             both = self._pair.active(q_des, qd_des, q_des_cf, qd_des_cf, s.q, s.qd) if self._pair else None
             if both is not None:
-                mf, cf, self.last_error = both
+                mf, cf, self._last_error = both
             else:
                 mf = (self.mf.active(q_des, s.q, qd_des, s.qd) + self.sl_mf.start).astype(np.int32, copy=False)
                 e = self.cf.error(q_des_cf, s.q, qd_des_cf, s.qd)
-                self.last_error = e
+                self._last_error = e
                 cf = (self.cf.active(e) + self.sl_cf.start).astype(np.int32, copy=False)
-        self._mf_lag.append(mf)
-        self._cf_lag.append(cf)
-        self._pending.append(np.concatenate([self._mf_lag.popleft(), self._cf_lag.popleft()]))
+        if self._aff is None:
+            self._mf_lag.append(mf)
+            self._cf_lag.append(cf)
+            self._pending.append(np.concatenate([self._mf_lag.popleft(), self._cf_lag.popleft()]))
         self._advance()
         self._steps += 1
         stamp = inp.t_s if self.hold else inp.t_s + self.k_delay * STEP_S
@@ -474,6 +575,8 @@ class SNNControllerImpl(Controller):
             ag, at = np.zeros(self.n_joints), np.zeros(self.n_joints)
             ag[: self.n_ctrl], at[: self.n_ctrl] = out[: self.n_ctrl], out[self.n_ctrl:]
             return CommandMsg(stamp, {"muscle.ag": ag, "muscle.at": at})
+        if self.n_joints == self.n_ctrl:
+            return TorqueMsg(stamp, out.copy())
         tau = np.zeros(self.n_joints)
         tau[: self.n_ctrl] = out
         return TorqueMsg(stamp, tau)
@@ -546,7 +649,7 @@ class SNNControllerImpl(Controller):
 
     # ------------------------------------------------------------------ state
     def save_state(self, path: Path) -> bool:
-        self._join()
+        pending, mf_lag, cf_lag = self._fifos()  # joins
         path = Path(path)
         arrays = {f"net_{k}": v for k, v in self.net.state_arrays().items()}
         arrays["cf_burst_left"] = self.cf.burst_left
@@ -555,9 +658,8 @@ class SNNControllerImpl(Controller):
                 "network": self.net_cfg.name, "layout": self.net_cfg.layout(), "rng": self.cf.rng.bit_generator.state}
         if isinstance(getattr(self.mf, "rng", None), np.random.Generator):
             meta["mf_rng"] = self.mf.rng.bit_generator.state
-        arrays["in_fifo"] = np.array(json.dumps([a.tolist() for a in self._pending]))
-        arrays["lag_fifos"] = np.array(json.dumps([[a.tolist() for a in self._mf_lag],
-                                                   [a.tolist() for a in self._cf_lag]]))
+        arrays["in_fifo"] = np.array(json.dumps([a.tolist() for a in pending]))
+        arrays["lag_fifos"] = np.array(json.dumps([[a.tolist() for a in mf_lag], [a.tolist() for a in cf_lag]]))
         save_state_npz(path, meta, **arrays)
         return True
 
@@ -572,6 +674,9 @@ class SNNControllerImpl(Controller):
         problem = layout_problem(meta.get("layout"), self.net_cfg)
         if problem:
             raise StateMismatchError(f"{path}: {problem}")
+        self._join()  # the network thread writes the network and, pipelined, the CF bursts
+        if self._aff is not None:  # the ticks kept draw from the generator as it was
+            self._aff.encode_now()
         try:
             self.net.load_arrays({k[4:]: data[k] for k in data.files if k.startswith("net_")})
         except (KeyError, ValueError) as exc:
@@ -581,7 +686,6 @@ class SNNControllerImpl(Controller):
         if "mf_rng" in meta and isinstance(getattr(self.mf, "rng", None), np.random.Generator):
             self.mf.rng.bit_generator.state = meta["mf_rng"]
         fifo = json.loads(str(data["in_fifo"]))
-        self._join()
         lags = json.loads(str(data["lag_fifos"])) if "lag_fifos" in data.files else [[], []]
         out_fifo = data["out_fifo"]
         same = (len(fifo) + len(out_fifo) == self.k_in + (self.k_delay if self.hold else 0)
@@ -592,3 +696,4 @@ class SNNControllerImpl(Controller):
             self._ready = deque(np.asarray(r, dtype=float) for r in out_fifo)
             self._mf_lag = deque(np.asarray(a, dtype=np.int32) for a in lags[0])
             self._cf_lag = deque(np.asarray(a, dtype=np.int32) for a in lags[1])
+            self._fifos_to_ring()
