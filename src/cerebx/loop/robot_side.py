@@ -70,7 +70,8 @@ from cerebx.recording.recorder import Recorder
 from cerebx.recording.summary import trial_fields
 from cerebx.schema.stages import SupervisorConfig
 from cerebx.signals import Message
-from cerebx.stages.receivers import _push
+from cerebx.stages.muscles import _ekeberg
+from cerebx.stages.receivers import _push_mean
 from cerebx.stages.supervisor import Supervisor, _correct
 from cerebx.wiring import wire
 
@@ -381,12 +382,13 @@ def pair(end: LinkEnd, first: Packet, facts: dict[str, Any], timeout_s: float) -
 
 def prepare_real_time() -> None:
     """Before pairing: load (or on a new machine compile) the compiled helpers a robot-side tick calls (the
-    command check, the arm's saturation, the mean filter, the supervisor, the trial's rows), for the argument
-    types a tick gives them, so that the paced loop's first ticks do not wait for them."""
+    command check, the arm's saturation, the mean filter, the supervisor, the muscles, the trial's rows), for
+    the argument types a tick gives them, so that the paced loop's first ticks do not wait for them."""
     z, zz = np.zeros(1), np.zeros((1, 1))
     all_finite(z)
     _saturate(z, z, np.zeros(1))
-    _push(np.zeros((1, 1)), np.zeros(1), 0, z)
+    _push_mean(np.zeros((1, 1)), np.zeros(1), 0, z, 1)
+    _ekeberg(z, z, z, z, z, z, z, z, z, z)
     _correct(z, z, z, z, z, z, 0.0, np.zeros(1), np.zeros(1))
     _put_row(z, z, z, z, z, zz.copy(), zz.copy(), zz.copy(), 0)
 

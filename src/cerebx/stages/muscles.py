@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import numba
 import numpy as np
 
 from cerebx.builders import BuildContext
@@ -27,6 +28,19 @@ def ekeberg_torque(ag: np.ndarray, at: np.ndarray, q: np.ndarray, qd: np.ndarray
     return active, passive
 
 
+@numba.njit(cache=True, boundscheck=False)
+def _ekeberg(ag, at, q, qd, alpha, beta, gamma, delta, c, q_rest):  # pragma: no cover - numba
+    """:func:`ekeberg_torque` and the sum joint by joint, as new arrays: the array form's operations in its
+    order, so the same doubles (one compiled call instead of eleven array operations, ~9 us a tick)."""
+    n = alpha.size
+    active, passive, total = np.empty(n), np.empty(n), np.empty(n)
+    for j in range(n):
+        a = alpha[j] * (ag[j] - at[j])
+        b = beta[j] * (ag[j] + at[j] + 2.0 * c[j] + gamma[j]) * (q_rest[j] - q[j]) + delta[j] * qd[j]
+        active[j], passive[j], total[j] = a, b, a + b
+    return active, passive, total
+
+
 class Ekeberg(Stage):
     """Robot side: muscle.ag, muscle.at (link) and joint.q, joint.qd (the plant) -> joint.torque."""
 
@@ -42,12 +56,18 @@ class Ekeberg(Stage):
         io = cfg.io(n_joints)
         self.reads, self.writes = io.reads, io.writes
         self.active = self.passive = np.zeros(n_joints)
+        self._params = tuple(self.params[k] for k in ("alpha", "beta", "gamma", "delta", "c", "q_rest"))
 
     def step(self, frame: Frame) -> None:
         sig = frame.signals
-        self.active, self.passive = ekeberg_torque(sig["muscle.ag"], sig["muscle.at"], sig["joint.q"],
-                                                   sig["joint.qd"], self.params)
-        self.emit(frame, "joint.torque", self.active + self.passive)
+        ag, at, q, qd = sig["muscle.ag"], sig["muscle.at"], sig["joint.q"], sig["joint.qd"]
+        n = self._params[0].size
+        if ag.shape == at.shape == q.shape == qd.shape == (n,):  # every tick: one compiled call
+            self.active, self.passive, total = _ekeberg(ag, at, q, qd, *self._params)
+        else:
+            self.active, self.passive = ekeberg_torque(ag, at, q, qd, self.params)
+            total = self.active + self.passive
+        self.emit(frame, "joint.torque", total)
 
     def record(self) -> dict[str, Any]:
         return {"tau_muscle_active": self.active, "tau_muscle_passive": self.passive}

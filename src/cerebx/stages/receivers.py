@@ -35,16 +35,9 @@ class Hold(Receiver):
 
 
 @numba.njit(cache=True, boundscheck=False)
-def _push(buf, total, i, x):  # pragma: no cover - numba
-    """``total += x - buf[i]; buf[i] = x``, element by element (the array form's doubles)."""
-    for j in range(total.size):
-        total[j] += x[j] - buf[i, j]
-        buf[i, j] = x[j]
-
-
-@numba.njit(cache=True, boundscheck=False)
 def _push_mean(buf, total, i, x, n):  # pragma: no cover - numba
-    """:func:`_push`, then the mean ``total / n`` as a new array (the same doubles as numpy's division)."""
+    """``total += x - buf[i]; buf[i] = x``, element by element (the array form's doubles), and the mean
+    ``total / n`` as a new array (the same doubles as numpy's division)."""
     out = np.empty(total.size)
     for j in range(total.size):
         total[j] += x[j] - buf[i, j]
@@ -67,7 +60,7 @@ class _RunningMean:
     def push(self, x: np.ndarray) -> None:
         if x.shape != self.sum.shape:
             raise ValueError(f"mean filter: a sample of shape {x.shape}, the filter's is {self.sum.shape}")
-        _push(self.buf, self.sum, self.count % self.taps, x)
+        _push_mean(self.buf, self.sum, self.count % self.taps, x, 1)
         self.count += 1
         if self.count % 1000 == 0:
             self.sum = self.buf.sum(0)

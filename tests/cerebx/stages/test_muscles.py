@@ -13,7 +13,7 @@ from cerebx.recording.reader import read_messages
 from cerebx.report.runs import Run, RunSet
 from cerebx.schema.muscles import EkebergConfig
 from cerebx.signals import Frame
-from cerebx.stages.muscles import Ekeberg
+from cerebx.stages.muscles import Ekeberg, ekeberg_torque
 from cerebx_thesis.report.baxter_muscles import fig4_6, payload_sag_cm
 
 pytestmark = pytest.mark.integration
@@ -51,6 +51,23 @@ def test_hand_computed_torque():
     assert tau[5] == pytest.approx(2.0, abs=1e-12)
     # J1, J3, J4 at rest with no command: nothing
     assert tau[[0, 2, 3]] == pytest.approx([0.0, 0.0, 0.0], abs=1e-15)
+
+
+def test_the_compiled_step_gives_the_array_form_bit_for_bit():
+    """The stage's one compiled call per tick against Eq. 4.6 as array operations: the same doubles, for random
+    commands, states and cocontractions."""
+    rng = np.random.default_rng(3)
+    for k in (0.0, 1.0, 9.0, 12.0):
+        cfg = EkebergConfig(cocontraction=k)
+        stage = Ekeberg(cfg, 6)
+        for _ in range(200):
+            ag, at = rng.random(6), rng.random(6)
+            q, qd = Q_REST + rng.normal(0, 0.5, 6), rng.normal(0, 3.0, 6)
+            frame = Frame(0, 0.0, {"muscle.ag": ag, "muscle.at": at, "joint.q": q, "joint.qd": qd})
+            stage.step(frame)
+            active, passive = ekeberg_torque(ag, at, q, qd, stage.params)
+            assert stage.active.tobytes() == active.tobytes() and stage.passive.tobytes() == passive.tobytes()
+            assert frame.signals["joint.torque"].tobytes() == (active + passive).tobytes()
 
 
 def test_passive_torque_pulls_towards_rest_and_damps():
