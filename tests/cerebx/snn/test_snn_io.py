@@ -641,3 +641,21 @@ def test_encoders_on_the_network_thread_give_what_the_loops_thread_gives(delays,
         c.end_trial(0)
         c.reset(np.random.default_rng(9))
     np.testing.assert_array_equal(_irregular_drive(ring, 40), _irregular_drive(listed, 40))
+
+
+def test_encoders_on_the_network_thread_go_on_while_spike_propagation_is_shed():
+    """Shed to level 2 (no spike propagation), the ring's ticks are still encoded as the FIFO path encodes them:
+    silent DCN, the same bursts and draws, and the same torques once propagation is back."""
+    ring, listed = make_ctrl(), _listed(make_ctrl())
+    for c in (ring, listed):
+        c.reset(np.random.default_rng(2))
+        c.shed(2)
+    a, b = _irregular_drive(ring, 90), _irregular_drive(listed, 90)
+    np.testing.assert_array_equal(a, b)
+    assert not a[ring.k_delay:].any()
+    np.testing.assert_array_equal(ring.last_error, listed.last_error)
+    np.testing.assert_array_equal(ring.cf.burst_left, listed.cf.burst_left)
+    assert ring.cf.rng.bit_generator.state == listed.cf.rng.bit_generator.state
+    for c in (ring, listed):
+        c.shed(0)
+    np.testing.assert_array_equal(_irregular_drive(ring, 120, 90), _irregular_drive(listed, 120, 90))

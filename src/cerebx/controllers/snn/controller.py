@@ -118,10 +118,12 @@ def _run_chunk_outputs(net, clock, chunk, outputs, prof):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def _run_ticks_chunk_outputs(aff, ticks, steps, net, clock, idx_buf, off, outputs, prof):  # pragma: no cover
-    """:func:`_run_chunk_outputs` on the ticks the loop kept (:class:`~cerebx.snn.encoders.AfferentRing`): they
-    are encoded first (``ticks``: the arguments of :func:`~cerebx.snn.encoders.encode_ticks` after the ring)
-    and the chunk's ``steps`` inputs packed from the ring, all in the same compiled call."""
+def _run_ticks_chunk_outputs(net, clock, chunk, outputs, prof):  # pragma: no cover
+    """:func:`_run_chunk_outputs` on the ticks the loop kept (:class:`~cerebx.snn.encoders.AfferentRing`), in the
+    same compiled call: ``chunk`` is the ring, the ticks (the arguments of
+    :func:`~cerebx.snn.encoders.encode_ticks` after the ring), the chunk's steps, and the spike buffer and step
+    offsets to fill. The ticks are encoded first and the steps' inputs packed from the ring."""
+    aff, ticks, steps, idx_buf, off = chunk
     signals, sensed, u = ticks
     encode_ticks(aff, signals, sensed, u)
     flat, in_off = compose_steps(aff, outputs[2], steps)
@@ -300,36 +302,29 @@ class SNNControllerImpl(Controller):
         network thread runs: its work is compiled code without the interpreter lock (interpreted work there
         holds up the loop's thread, which needs the lock back after every MuJoCo step); cutting the result
         into steps is left to :meth:`_absorb`."""
-        n = len(in_off) - 1
-        if self._shed >= 2:
-            self.net.t_sub += self.net.n_sub * n
-            return Chunk(first_step, np.zeros((n, self.width)), np.zeros(n, np.int64), None, None,
-                         int(self.net.pf_lost.sum()))
-        recording = bool(self.recorder is not None and self._shed < 3 and self.record)
-        record = (self._record_lo, self._record_hi) if recording else (_NONE, _NONE)
-        net = self.net
-        idx_buf, off = net.chunk_buffers(n)
-        taus, counts, words, starts, lost = _run_chunk_outputs(
-            net._state, (net.t_sub, net.n_sub, net.learn, net.n_threads), (flat, in_off, idx_buf, off),
-            (self._decode, record, first_step, STEP_S), net.prof)
-        net.t_sub += net.n_sub * n
-        if not recording:
-            return Chunk(first_step, taus, counts, None, None, lost)
-        return Chunk(first_step, taus, counts, words, starts, lost)
+        return self._run_chunk(_run_chunk_outputs, (flat, in_off), len(in_off) - 1, first_step)
 
-    def _simulate_ticks(self, ticks: tuple[np.ndarray, np.ndarray, Any], n: int, first_step: int) -> Chunk:
+    def _simulate_ticks(self, ticks: tuple[np.ndarray, np.ndarray, np.ndarray], n: int, first_step: int) -> Chunk:
         """:meth:`_simulate_packed` of the ``n`` steps from ``first_step`` on, their inputs packed from the ring of
         encoded ticks after the ``ticks`` kept are encoded (:class:`~cerebx.snn.encoders.AfferentRing`)."""
-        aff = self._aff.state
+        if self._shed >= 2:  # the encoders go on (bursts, draws); the network does not run
+            encode_ticks(self._aff.state, *ticks)
+        return self._run_chunk(_run_ticks_chunk_outputs, (self._aff.state, ticks, n), n, first_step)
+
+    def _run_chunk(self, kernel: Any, inputs: tuple, n: int, first_step: int) -> Chunk:
+        """``kernel`` (:func:`_run_chunk_outputs` or :func:`_run_ticks_chunk_outputs`) over ``n`` steps from
+        ``first_step`` on, ``inputs`` its chunk's first members (the spike buffer and step offsets follow). With
+        spike propagation shed the network is not run and the DCN stay silent."""
+        net = self.net
         if self._shed >= 2:
-            encode_ticks(aff, *ticks)
-            return self._simulate_packed(np.zeros(0, np.int32), np.zeros(n + 1, np.int64), first_step)
+            net.t_sub += net.n_sub * n
+            return Chunk(first_step, np.zeros((n, self.width)), np.zeros(n, np.int64), None, None,
+                         int(net.pf_lost.sum()))
         recording = bool(self.recorder is not None and self._shed < 3 and self.record)
         record = (self._record_lo, self._record_hi) if recording else (_NONE, _NONE)
-        net = self.net
         idx_buf, off = net.chunk_buffers(n)
-        taus, counts, words, starts, lost = _run_ticks_chunk_outputs(
-            aff, ticks, n, net._state, (net.t_sub, net.n_sub, net.learn, net.n_threads), idx_buf, off,
+        taus, counts, words, starts, lost = kernel(
+            net._state, (net.t_sub, net.n_sub, net.learn, net.n_threads), (*inputs, idx_buf, off),
             (self._decode, record, first_step, STEP_S), net.prof)
         net.t_sub += net.n_sub * n
         if not recording:
