@@ -15,8 +15,9 @@ them (a few hundred nanoseconds an array); a structref is passed as one pointer 
     state = CordState.of(Cord(fifo, 3))   # the same arrays: writes either way are seen both ways
 
 A jitted kernel reads ``state.fifo``, ``state.delay`` as attributes. Define the subclass at module level (its
-compiled code and its pickles name it by module and name). The handle pickles as the named tuple it was made
-of, so an object that keeps one checkpoints like its arrays.
+compiled code and its pickles name it by module and name). Pass the handle as an argument of its own, not inside
+a tuple: numba's dispatcher types a tuple holding one through Python at every call (~100 us, against ~1 us).
+The handle pickles as the named tuple it was made of, so an object that keeps one checkpoints like its arrays.
 """
 
 from __future__ import annotations
