@@ -300,16 +300,33 @@ def _both_active(q_des, qd_des, q_des_cf, qd_des_cf, q, qd, u, coders):  # pragm
     if min(q_des.size, q.size, qd_des.size, qd.size) < nj or min(q_des_cf.size, qd_des_cf.size, q.size,
                                                                  qd.size) < c.n_joints:
         return np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros(0), False
-    n = _mf_active(q_des, q, qd_des, qd, b.lo, b.hi, b.step, b.half_width, b.fibers, b.out)
-    mf = np.empty(n, np.int32)
-    for i in range(n):
+    # the scratch arrays take the global indices in place (each local index is read before it is replaced)
+    n_mf, n_cf, e = _encode_tick(b, c, q_des, qd_des, q_des_cf, qd_des_cf, q, qd, u, b.out, c.out)
+    return b.out[:n_mf].copy(), c.out[:n_cf].copy(), e, True
+
+
+@numba.njit(cache=True, nogil=True, boundscheck=False)
+def _encode_tick(b, c, q_des, qd_des, q_des_cf, qd_des_cf, q, qd, u, mf, cf):  # pragma: no cover - numba
+    """One tick of both encoders (``b``: :class:`BoxCoding`, ``c``: :class:`ErrorCoding`): the MF and CF fibres'
+    global indices written to the front of ``mf`` and ``cf``; returns their numbers and the error."""
+    n_mf = _mf_active(q_des, q, qd_des, qd, b.lo, b.hi, b.step, b.half_width, b.fibers, b.out)
+    for i in range(n_mf):
         mf[i] = b.out[i] + b.first
     e = _cf_error(q_des_cf, q, qd_des_cf, qd, c.kpos, c.kvel)
-    n = _cf_step(e, u, c.centres, c.width, c.rate_min_hz, c.rate_max_hz, c.max_burst, c.half, c.burst_left, c.out)
-    cf = np.empty(n, np.int32)
-    for i in range(n):
+    n_cf = _cf_step(e, u, c.centres, c.width, c.rate_min_hz, c.rate_max_hz, c.max_burst, c.half, c.burst_left,
+                    c.out)
+    for i in range(n_cf):
         cf[i] = c.out[i] + c.first
-    return mf, cf, e, True
+    return n_mf, n_cf, e
+
+
+def _coders(mf: MossyEncoder, cf: ClimbingEncoder, mf_first: int, cf_first: int) -> Coders:
+    """What the compiled encoders read of ``mf`` and ``cf`` (their arrays, not copies), with the global index of
+    each one's fibre 0."""
+    c = cf.cfg
+    return Coders(BoxCoding(mf.lo, mf.hi, mf.step, mf.half_width, mf.F, mf_first, mf._out),
+                  ErrorCoding(cf.n_joints, cf.kpos, cf.kvel, cf.centres, cf.width, c.rate_min_hz, c.rate_max_hz,
+                              c.max_burst, cf.half, cf.burst_left, cf_first, cf._out))
 
 
 class EncoderPair:
@@ -323,12 +340,8 @@ class EncoderPair:
     __slots__ = ("cf", "_coders")
 
     def __init__(self, mf: MossyEncoder, cf: ClimbingEncoder, mf_first: int, cf_first: int):
-        c = cf.cfg
         self.cf = cf
-        self._coders = CodersState.of(Coders(
-            BoxCoding(mf.lo, mf.hi, mf.step, mf.half_width, mf.F, mf_first, mf._out),
-            ErrorCoding(cf.n_joints, cf.kpos, cf.kvel, cf.centres, cf.width, c.rate_min_hz, c.rate_max_hz,
-                        c.max_burst, cf.half, cf.burst_left, cf_first, cf._out)))
+        self._coders = CodersState.of(_coders(mf, cf, mf_first, cf_first))
 
     @classmethod
     def of(cls, mf: object, cf: object, mf_first: int, cf_first: int) -> EncoderPair | None:
@@ -374,8 +387,7 @@ def encode_ticks(aff, signals, sensed, u):  # pragma: no cover - numba
     """Encode the next ``sensed.size`` ticks into the ring, in order: tick i with ``sensed[i] = r >= 0`` from
     ``signals[r]`` = (q_des, qd_des, q_des_cf, qd_des_cf, q, qd), each (n_joints,), with the CF fibres'
     uniforms ``u[r]``; a tick without a sensor sample (-1) has no fibres and draws nothing. The same operations
-    as :func:`_both_active`, so the same fibres, error and bursts."""
-    b, c = aff.coders.mf, aff.coders.cf
+    as :func:`_both_active` (:func:`_encode_tick`), so the same fibres, error and bursts."""
     R = aff.mf_n.shape[0]
     for i in range(sensed.shape[0]):
         slot = aff.rows[0] % R
@@ -385,16 +397,8 @@ def encode_ticks(aff, signals, sensed, u):  # pragma: no cover - numba
             aff.cf_n[slot] = 0
         else:
             x = signals[r]
-            n = _mf_active(x[0], x[4], x[1], x[5], b.lo, b.hi, b.step, b.half_width, b.fibers, b.out)
-            for k in range(n):
-                aff.mf[slot, k] = b.out[k] + b.first
-            aff.mf_n[slot] = n
-            e = _cf_error(x[2], x[4], x[3], x[5], c.kpos, c.kvel)
-            n = _cf_step(e, u[r], c.centres, c.width, c.rate_min_hz, c.rate_max_hz, c.max_burst, c.half,
-                         c.burst_left, c.out)
-            for k in range(n):
-                aff.cf[slot, k] = c.out[k] + c.first
-            aff.cf_n[slot] = n
+            aff.mf_n[slot], aff.cf_n[slot], e = _encode_tick(aff.coders.mf, aff.coders.cf, x[0], x[1], x[2], x[3],
+                                                             x[4], x[5], u[r], aff.mf[slot], aff.cf[slot])
             aff.err[:] = e
         aff.rows[0] += 1
 
@@ -442,20 +446,17 @@ class AfferentRing:
     def __init__(self, mf: MossyEncoder, cf: ClimbingEncoder, mf_first: int, cf_first: int, k_mf: int,
                  k_cf: int, span: int):
         """``span``: ticks the ring must hold at once (from the oldest a step still needs to the newest kept)."""
-        c = cf.cfg
         self.cf = cf
         self.n_joints = mf.n_joints
         R = span + 1
         self.R = R
         self._mf_range = (mf_first, mf_first + mf.n_fibers)
-        self.coders = Coders(
-            BoxCoding(mf.lo, mf.hi, mf.step, mf.half_width, mf.F, mf_first, mf._out),
-            ErrorCoding(cf.n_joints, cf.kpos, cf.kvel, cf.centres, cf.width, c.rate_min_hz, c.rate_max_hz,
-                        c.max_burst, cf.half, cf.burst_left, cf_first, cf._out))
         n_cf = cf.burst_left.shape[0]
-        self.arrays = Afferents(self.coders, np.zeros((R, mf.n_fibers), np.int32), np.zeros(R, np.int64),
-                                np.zeros((R, n_cf), np.int32), np.zeros(R, np.int64), np.zeros(cf.n_joints),
-                                np.zeros(1, np.int64), int(k_mf), int(k_cf), int(max(k_mf, k_cf)))
+        self.arrays = Afferents(_coders(mf, cf, mf_first, cf_first),
+                                mf=np.zeros((R, mf.n_fibers), np.int32), mf_n=np.zeros(R, np.int64),
+                                cf=np.zeros((R, n_cf), np.int32), cf_n=np.zeros(R, np.int64),
+                                err=np.zeros(cf.n_joints), rows=np.zeros(1, np.int64), k_mf=int(k_mf),
+                                k_cf=int(k_cf), shift=int(max(k_mf, k_cf)))
         self.state = AfferentState.of(self.arrays)
         self.kept: list = []  # ticks not yet taken to be encoded: six signals, or None without a sensor sample
         self.taken = 0  # ticks taken (the network thread may still be encoding them): counted here, not read there

@@ -489,7 +489,7 @@ class Network:
         lp = state.get("lp")
         # by __getstate__: the classes are rebuilt from the compact lists (below); pickled whole (its __dict__), the
         # classes are the state as they are
-        relump = not isinstance(lp, lumping.Lumps) and isinstance(lp, tuple) and lp[0] == _LEFT_OUT
+        relump = isinstance(lp, tuple) and not isinstance(lp, lumping.Lumps) and bool(lp) and lp[0] == _LEFT_OUT
         if relump:
             self.lp = lumping.build(len(self._ref), lp[1], lp[2], self.pop_i)
         elif not isinstance(lp, lumping.Lumps):  # pickled before lumped populations: none is lumped

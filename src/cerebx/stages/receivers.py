@@ -57,29 +57,19 @@ class _RunningMean:
         self.taps = taps
         self.value = np.zeros(n)
 
-    def push(self, x: np.ndarray) -> None:
+    def push(self, x: np.ndarray) -> np.ndarray:
+        """Add a sample; returns the new mean (also :attr:`value`), in one compiled call but every 1000th sample."""
         if x.shape != self.sum.shape:
             raise ValueError(f"mean filter: a sample of shape {x.shape}, the filter's is {self.sum.shape}")
-        _push_mean(self.buf, self.sum, self.count % self.taps, x, 1)
         self.count += 1
+        self.value = _push_mean(self.buf, self.sum, (self.count - 1) % self.taps, x, min(self.count, self.taps))
         if self.count % 1000 == 0:
             self.sum = self.buf.sum(0)
-
-    def mean(self) -> np.ndarray:
-        if self.count:
             self.value = self.sum / min(self.count, self.taps)
         return self.value
 
-    def push_mean(self, x: np.ndarray) -> np.ndarray:
-        """:meth:`push` then :meth:`mean`, in one compiled call but every 1000th sample (the sum recomputed)."""
-        if x.shape != self.sum.shape:
-            raise ValueError(f"mean filter: a sample of shape {x.shape}, the filter's is {self.sum.shape}")
-        count = self.count + 1
-        if count % 1000 == 0:
-            self.push(x)
-            return self.mean()
-        self.value = _push_mean(self.buf, self.sum, self.count % self.taps, x, min(count, self.taps))
-        self.count = count
+    def mean(self) -> np.ndarray:
+        """The mean of the last ``taps`` samples (zeros before the first)."""
         return self.value
 
 
@@ -93,9 +83,6 @@ class MeanFilter(Receiver):
         self.means = {s.name: _RunningMean(s.size, taps) for s in signals}
 
     def receive(self, arrived: list[Message], t_s: float) -> dict[str, np.ndarray]:
-        if len(arrived) == 1:  # every tick of a link without jitter: one compiled call per signal
-            values = arrived[0].values
-            return {name: rm.push_mean(values[name]) for name, rm in self.means.items()}
         for m in arrived:
             for name, rm in self.means.items():
                 rm.push(m.values[name])

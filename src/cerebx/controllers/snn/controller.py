@@ -362,21 +362,15 @@ class SNNControllerImpl(Controller):
         work is compiled code from the start)."""
         first = self._net_step + self._in_flight * self.chunk  # after the chunk still in flight, if one is
         if self._aff is not None:
-            ticks, n = self._aff.take(), self.chunk
-
-            def simulate() -> Chunk:
-                return self._simulate_ticks(ticks, n, first)
+            simulate, args = self._simulate_ticks, (self._aff.take(), self.chunk, first)
         else:
-            flat, in_off = pack([self._pending.popleft() for _ in range(self.chunk)])
-
-            def simulate() -> Chunk:
-                return self._simulate_packed(flat, in_off, first)
+            simulate, args = self._simulate_packed, (*pack([self._pending.popleft() for _ in range(self.chunk)]), first)
         clock = phase_clock.active()
 
         def work() -> Chunk:
             t0, c0 = (time.perf_counter(), time.thread_time()) if clock is not None else (0.0, 0.0)
             try:
-                return simulate()
+                return simulate(*args)
             finally:
                 if clock is not None:
                     clock.add_background("network", time.perf_counter() - t0, time.thread_time() - c0)
@@ -536,23 +530,16 @@ class SNNControllerImpl(Controller):
         self._des[inp.tick] = (inp.q_des, inp.qd_des)
         self._des.pop(inp.tick - 2000, None)
         s = inp.sensor
-        if self._aff is not None:  # the tick's signals kept; the network thread encodes them
-            if s is None:
-                self._aff.kept.append(None)
-            else:
-                q_des, qd_des = self._desired_at(s.stamp_s, inp)
-                if self.cfg.error_reference_lag_ms:
-                    self._aff.kept.append((q_des, qd_des, *self._desired_at(
-                        s.stamp_s - self.cfg.error_reference_lag_ms / 1000.0, inp), s.q, s.qd))
-                else:
-                    self._aff.kept.append((q_des, qd_des, q_des, qd_des, s.q, s.qd))
-        elif s is None:
-            mf = cf = np.zeros(0, np.int32)
-        else:
+        if s is not None:
             q_des, qd_des = self._desired_at(s.stamp_s, inp)
             q_des_cf, qd_des_cf = q_des, qd_des
             if self.cfg.error_reference_lag_ms:
                 q_des_cf, qd_des_cf = self._desired_at(s.stamp_s - self.cfg.error_reference_lag_ms / 1000.0, inp)
+        if self._aff is not None:  # the tick's signals kept; the network thread encodes them
+            self._aff.kept.append(None if s is None else (q_des, qd_des, q_des_cf, qd_des_cf, s.q, s.qd))
+        elif s is None:
+            mf = cf = np.zeros(0, np.int32)
+        else:
             both = self._pair.active(q_des, qd_des, q_des_cf, qd_des_cf, s.q, s.qd) if self._pair else None
             if both is not None:
                 mf, cf, self._last_error = both
