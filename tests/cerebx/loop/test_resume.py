@@ -34,20 +34,20 @@ def _summary(run_dir: Path) -> dict:
 
 
 def test_sigkilled_run_resumes_to_the_same_trials(tmp_path):
-    trials, every = 40, 5
+    trials, every = 24, 4
     whole, killed = tmp_path / "whole", tmp_path / "killed"
     ref = _cerebx(*RUN, f"trials={trials}", f"recording.checkpoint_every={every}", f"hydra.run.dir={whole}",
                   cwd=tmp_path)
     run = _cerebx(*RUN, f"trials={trials}", f"recording.checkpoint_every={every}", f"hydra.run.dir={killed}",
                   cwd=tmp_path)
-    _wait_for_checkpoint(killed, 15, run)
+    _wait_for_checkpoint(killed, 12, run)
     time.sleep(0.2)  # into the next trials, which the continuation runs again
     run.send_signal(signal.SIGKILL)
     run.wait()
     assert ref.wait() == 0, ref.stdout.read()
     assert not (killed / "summary.json").exists() or _summary(killed)["status"] != "completed"
     done_at_kill = checkpoint.read_head(killed)["trials_done"]  # the committed one (its .json copy may lag)
-    assert 15 <= done_at_kill < trials
+    assert 12 <= done_at_kill < trials
 
     cont = _cerebx(f"resume={killed}", cwd=tmp_path)
     out, _ = cont.communicate(timeout=300)
@@ -68,8 +68,11 @@ def test_sigkilled_run_resumes_to_the_same_trials(tmp_path):
     # the killed segment is still readable on its own, and the run reads as one log equal to the whole run's
     first = [m["trial"] for _t, _ns, m in read_messages(segs[0].path, ["/trial_metrics"])]
     assert first[:done_at_kill] == list(range(done_at_kill))
-    for topic in ("/trial_metrics", "/control", "/joint_states/actual"):
-        assert list(read_messages(killed, [topic])) == list(read_messages(whole, [topic])), topic
+    topics = ("/trial_metrics", "/control", "/joint_states/actual")
+    by_topic = [{t: [m for m in messages if m[0] == t] for t in topics}
+                for messages in (list(read_messages(d, list(topics))) for d in (killed, whole))]
+    for topic in topics:  # one pass over each log (its chunks decoded once), compared topic by topic
+        assert by_topic[0][topic] == by_topic[1][topic], topic
     assert channel_counts(killed) == channel_counts(whole)
     assert json.loads(read_metadata(killed)["summary"]["json"])["trials_completed"] == trials
 
@@ -77,18 +80,18 @@ def test_sigkilled_run_resumes_to_the_same_trials(tmp_path):
 def test_sigkilled_learning_run_resumes_to_the_same_weights(tmp_path):
     """The spiking network's weights: written ahead of the first checkpoint from the live array, then only
     their changed rows; a resumed process writes its own file ahead (after settling the committed journal)."""
-    args = ["+task=circle", "+experiment=small_snn", "recording.progress=off", "trials=30",
+    args = ["+task=circle", "+experiment=small_snn", "recording.progress=off", "trials=20",
             "recording.checkpoint_every=5"]
     whole, killed = tmp_path / "whole", tmp_path / "killed"
-    ref = _cerebx(*args, f"hydra.run.dir={whole}", cwd=tmp_path)
-    assert ref.wait() == 0, ref.stdout.read()
+    ref = _cerebx(*args, f"hydra.run.dir={whole}", cwd=tmp_path)  # beside the run that is killed
     run = _cerebx(*args, f"hydra.run.dir={killed}", cwd=tmp_path)
     _wait_for_checkpoint(killed, 10, run)
     run.send_signal(signal.SIGKILL)
     run.wait()
+    assert ref.wait() == 0, ref.stdout.read()
     head = checkpoint.read_head(killed)
     assert head["arrays"]["file"] == "checkpoint.5.arrays"  # written ahead, then journals on top
-    assert head["trials_done"] < 30
+    assert head["trials_done"] < 20
     cont = _cerebx(f"resume={killed}", cwd=tmp_path)
     out, _ = cont.communicate(timeout=300)
     assert cont.returncode == 0, out

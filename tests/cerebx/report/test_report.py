@@ -258,6 +258,11 @@ def test_init_from_a_study_with_the_same_sweep_pairs_jobs_by_sweep_value(tmp_pat
                    "    quick: {trials: 1}\n    full: {trials: 2}\n")
     with pytest.raises(ConfigError, match="init_from: 'a' is not a single-run study or one with the same sweep"):
         load_studies(bad)
+    # a report of some figures checks the sweeps of their studies and of those they start from, not every study's
+    assert set(load_studies(bad, only=["a"])) == {"a", "b"}
+    for wanted in (["b"], ["b~seed1"]):
+        with pytest.raises(ConfigError, match="init_from: 'a' is not a single-run study"):
+            load_studies(bad, only=wanted)
 
 
 def test_plant_realism_takes_the_study_runs_not_chapter_3_runs_on_the_same_plant(tmp_path):
