@@ -6,7 +6,8 @@ belong to that network alone, and its closed loop in another, as a run meets it.
 Output is JSON. Numbers are simulated seconds per wall second; ``per_step_us`` says where a control step's time
 goes, in microseconds per part (the PD loop's and each closed loop's main thread by phase, each network's kernels by
 part: :func:`cerebx.loop.timing.per_step_parts`), from extra timed steps after the untimed ones that give the
-factors.
+factors. ``versus`` beside each closed loop: its speed over the PD loop's, the two timed trial by trial in turns in
+one process (steady on a host whose speed drifts within seconds).
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from cerebx.loop.timing import closed_loop_rt
 from cerebx.lwpr.bench import bench_lwpr
 
 DEFAULT_NETWORKS = ("full", "multikernel")
+PD_LOOP = ["+task=circle", "controller=pd"]  # the plant's loop with PD, which a closed loop is timed against
 
 
 def _one_network(name: str, seconds: float, warmup: float, parallel: bool, started: float) -> dict[str, Any]:
@@ -41,13 +43,13 @@ def _one_network(name: str, seconds: float, warmup: float, parallel: bool, start
     # Python, which the pipelined loop never does)
     loop_overrides = ["+task=circle", f"network={name}", f"controller.parallel={str(parallel).lower()}"]
     cmd = [sys.executable, "-m", "cerebx.cli", "bench", "--loop", json.dumps(loop_overrides), "--seconds", str(seconds),
-           "--warmup", str(warmup), "--parts"]
+           "--warmup", str(warmup), "--parts", "--versus", json.dumps(PD_LOOP)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         out["closed_loop"] = {"error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}
         return out
     loop = json.loads(proc.stdout)
-    keys = ("build_s", "rt_factor", "cpu_rt_factor", "us_per_step", "cpu_us_per_step", "per_step_us")
+    keys = ("build_s", "rt_factor", "cpu_rt_factor", "us_per_step", "cpu_us_per_step", "per_step_us", "versus")
     out["closed_loop"] = {k: loop[k] for k in keys}
     return out
 
@@ -56,7 +58,7 @@ def _plant_pd(seconds: float) -> dict[str, Any]:
     rows = {}
     for label, extra in (("baxter_pd", []), ("baxter_pd_physics_1ms", ["plant.physics_dt_ms=1.0"]),
                          ("baxter_sea_pd", ["plant=baxter_sea"])):
-        r = closed_loop_rt(["+task=circle", "controller=pd", *extra], seconds=seconds, warmup_s=1.0, parts=not extra)
+        r = closed_loop_rt([*PD_LOOP, *extra], seconds=seconds, warmup_s=1.0, parts=not extra)
         rows[label] = {k: r[k] for k in ("rt_factor", "us_per_step", "cpu_us_per_step", "per_step_us") if k in r}
     return rows
 
@@ -76,12 +78,15 @@ def main(argv: list[str]) -> dict[str, Any]:
     ap.add_argument("--one", help=argparse.SUPPRESS)
     ap.add_argument("--loop", help=argparse.SUPPRESS)
     ap.add_argument("--parts", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--versus", help=argparse.SUPPRESS)
     ap.add_argument("--started", type=float, default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.lwpr:
         return {"lwpr": bench_lwpr()}
     if args.loop:
-        return closed_loop_rt(json.loads(args.loop), seconds=args.seconds, warmup_s=args.warmup, parts=args.parts)
+        versus = json.loads(args.versus) if args.versus else None
+        return closed_loop_rt(json.loads(args.loop), seconds=args.seconds, warmup_s=args.warmup, parts=args.parts,
+                              versus=versus)
     if args.one:
         return _one_network(args.one, args.seconds, args.warmup, not args.serial, args.started or time.time())
     report: dict[str, Any] = {"cpus": os.cpu_count(), "plant_pd": _plant_pd(args.seconds), "networks": {}}

@@ -7,6 +7,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from cerebx import phase_clock
 from cerebx.build import build_components
 from cerebx.config import load
@@ -16,7 +18,8 @@ from cerebx.recording.recorder import Recorder
 
 
 def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float = 1.0,
-                   record_to: Path | None = None, parts: bool = False) -> dict[str, Any]:
+                   record_to: Path | None = None, parts: bool = False,
+                   versus: list[str] | None = None, rounds: int = 8) -> dict[str, Any]:
     """Run ``overrides`` for ``warmup_s`` (compilation, first-touch), then time ``seconds`` more: simulated
     seconds per wall second (``rt_factor``) and per CPU second of the process, all threads (``cpu_rt_factor``);
     ``cpu_us_per_step``: the CPU time per control step of the loop's own thread and of every other thread (a
@@ -24,7 +27,11 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
 
     With ``record_to`` the MCAP recording is on (as in a real run); otherwise it is off, which
     measures plant + controller + loop alone. With ``parts`` as many trials again follow, timed part by part
-    (:func:`per_step_parts`; the factors above come from the untimed trials).
+    (:func:`per_step_parts`; the factors above come from the untimed trials). With ``versus`` (the overrides of
+    another loop, e.g. the same plant and task with PD) that loop is built in this process too and ``rounds``
+    trials of each are then timed in turns, one of this loop after one of the other: ``versus`` in the result
+    (:func:`_in_turns`) gives their speed ratio pair by pair, which a host whose speed drifts within seconds
+    leaves far steadier than two factors taken minutes apart.
     """
     exp, _ = load(overrides)
     t0 = time.perf_counter()
@@ -48,6 +55,8 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
         if parts:
             first = warm_trials + timed_trials
             table = per_step_parts(loop, range(first, first + timed_trials), steps_per_trial)
+        if versus is not None:
+            turns = _in_turns(loop, warm_trials + timed_trials * (2 if parts else 1), versus, rounds, warm_trials)
     finally:
         if rec is not None:
             loop.settle()
@@ -60,7 +69,37 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
             "us_per_step": round(wall / steps * 1e6, 1),
             "cpu_us_per_step": {"main_thread": round(main_cpu / steps * 1e6, 1),
                                 "other_threads": round((cpu - main_cpu) / steps * 1e6, 1)},
-            "recording": record_to is not None, **({"per_step_us": table} if parts else {})}
+            "recording": record_to is not None, **({"per_step_us": table} if parts else {}),
+            **({"versus": turns} if versus is not None else {})}
+
+
+def _in_turns(loop: ClosedLoop, first: int, overrides: list[str], rounds: int, warm_trials: int) -> dict[str, Any]:
+    """Trials of ``loop`` (from trial ``first`` on) and of the loop ``overrides`` compose, one of each in turn,
+    ``rounds`` times, after ``warm_trials`` untimed ones of the other: per round, the other's wall time over
+    this loop's (this loop's speed as a fraction of the other's), and both factors; medians over the rounds."""
+    other = ClosedLoop(build_components(load(overrides)[0]), None)
+    other.start()
+    for i in range(warm_trials):
+        other.run_trial(i)
+    sim_this = loop.ctx.task.steps_per_trial * loop.dt_s
+    sim_other = other.ctx.task.steps_per_trial * other.dt_s
+    ratios, this_rt, other_rt = [], [], []
+    for r in range(rounds):
+        t0 = time.perf_counter()
+        other.run_trial(warm_trials + r)
+        t1 = time.perf_counter()
+        loop.run_trial(first + r)
+        t2 = time.perf_counter()
+        this_rt.append(sim_this / (t2 - t1))
+        other_rt.append(sim_other / (t1 - t0))
+        ratios.append(this_rt[-1] / other_rt[-1])
+
+    def median(xs: list[float]) -> float:
+        return float(np.median(xs))
+
+    return {"overrides": overrides, "rounds": rounds, "ratio_median": round(median(ratios), 3),
+            "ratio_min": round(min(ratios), 3), "ratio_max": round(max(ratios), 3),
+            "rt_factor_median": round(median(this_rt), 2), "versus_rt_factor_median": round(median(other_rt), 2)}
 
 
 def per_step_parts(loop: ClosedLoop, trials: range, steps_per_trial: int) -> dict[str, Any]:

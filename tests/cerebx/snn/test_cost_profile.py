@@ -84,3 +84,13 @@ def test_the_network_bench_splits_a_step_into_parts():
     assert {"integrate.gc", "integrate.pc", "integrate.dcn", *PROF_PARTS, "total"} == set(parts)
     assert 0 < sum(v for k, v in parts.items() if k != "total") < parts["total"]
     assert out["listed_neurons"] == {}  # 3,750 GCs: below the size from which a population keeps a list
+
+
+@pytest.mark.integration
+def test_two_loops_timed_in_turns_give_their_speed_ratio():
+    pd = ["+task=circle", "controller=pd"]
+    same = closed_loop_rt(pd, seconds=0.1, warmup_s=0.1, versus=pd, rounds=5)["versus"]
+    assert same["rounds"] == 5 and same["overrides"] == pd
+    assert same["ratio_min"] <= same["ratio_median"] <= same["ratio_max"]
+    assert 0.5 < same["ratio_median"] < 2.0  # a loop against itself: as fast, up to the host's noise
+    assert same["rt_factor_median"] > 0 and same["versus_rt_factor_median"] > 0
