@@ -87,7 +87,7 @@ def _scan(fh) -> Iterator[Any]:
         yield rec
 
 
-def _stream_messages(fh, topics: list[str] | None) -> Iterator[tuple[str, int, Any]]:
+def _stream_messages(fh, topics: list[str] | None, decode: bool = True) -> Iterator[tuple[str, int, Any]]:
     schemas: dict[int, str] = {}
     channels: dict[int, tuple[str, Any]] = {}  # id -> topic, decoder
     for rec in _scan(fh):
@@ -100,6 +100,9 @@ def _stream_messages(fh, topics: list[str] | None) -> Iterator[tuple[str, int, A
         elif isinstance(rec, Message):
             ch = channels.get(rec.channel_id)
             if ch is not None:
+                if not decode:
+                    yield ch[0], rec.log_time, None
+                    continue
                 try:
                     yield ch[0], rec.log_time, ch[1](rec.data)
                 except (ValueError, struct.error):  # a damaged message: skipped like the incomplete tail
@@ -136,30 +139,37 @@ def read_messages(path: Path | str, topics: list[str] | None = None, start_ns: i
 
 
 def _read_segments(p: Path, topics: list[str] | None, start_ns: int | None,
-                   end_ns: int | None) -> Iterator[tuple[str, int, Any]]:
+                   end_ns: int | None, decode: bool = True) -> Iterator[tuple[str, int, Any]]:
     for seg in segments(p):
         lo = seg.start_ns if start_ns is None else max(start_ns, seg.start_ns)
         hi = seg.end_ns + 1 if seg.end_ns is not None else None  # the boundary itself: see owns()
         if end_ns is not None:
             hi = end_ns if hi is None else min(end_ns, hi)
         if hi is None or lo < hi:
-            for topic, t, msg in _read_file(seg.path, topics, lo, hi):
+            for topic, t, msg in _read_file(seg.path, topics, lo, hi, decode):
                 if seg.owns(topic, t):
                     yield topic, t, msg
 
 
 def _read_file(p: Path, topics: list[str] | None, start_ns: int | None,
-               end_ns: int | None) -> Iterator[tuple[str, int, Any]]:
+               end_ns: int | None, decode: bool = True) -> Iterator[tuple[str, int, Any]]:
+    """(topic, log time, message) of ``p`` in log-time order; ``decode`` False: None for each message (counting
+    needs no decoding)."""
     if not p.exists():
         raise CerebxError(f"{p}: no such file")
     with open(p, "rb") as fh:
         if not _has_summary(fh):
-            for topic, t, msg in _stream_messages(fh, topics):
+            for topic, t, msg in _stream_messages(fh, topics, decode):
                 if (start_ns is None or t >= start_ns) and (end_ns is None or t < end_ns):
                     yield topic, t, msg
             return
         reader = _reader(fh)
         try:
+            if not decode:
+                for _schema, channel, message in reader.iter_messages(
+                        topics=topics, starting_at=start_ns, ending_before=end_ns):
+                    yield channel.topic, message.log_time, None
+                return
             for _schema, channel, message, decoded in reader.iter_decoded_messages(
                     topics=topics, starting_at=start_ns, ending_before=end_ns):
                 yield channel.topic, message.log_time, decoded
@@ -180,7 +190,7 @@ def channel_counts(path: Path | str) -> dict[str, int]:
     """
     if Path(path).is_dir() and len(segments(path)) > 1:
         per_topic: dict[str, int] = {}
-        for topic, _t, _msg in read_messages(path):
+        for topic, _t, _msg in _read_segments(Path(path), None, None, None, decode=False):
             per_topic[topic] = per_topic.get(topic, 0) + 1
         return dict(sorted(per_topic.items()))
     p = mcap_path(path)
