@@ -1,7 +1,5 @@
 """``python -m cerebx`` is the ``cerebx`` command."""
 
-import sys
+from cerebx.cli import console
 
-from cerebx.cli import main
-
-sys.exit(main())
+console()
