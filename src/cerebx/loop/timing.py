@@ -3,11 +3,10 @@ goes (:func:`per_step_parts`)."""
 
 from __future__ import annotations
 
+import statistics
 import time
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from cerebx import phase_clock
 from cerebx.build import build_components
@@ -75,8 +74,8 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
 
 def _in_turns(loop: ClosedLoop, first: int, overrides: list[str], rounds: int, warm_trials: int) -> dict[str, Any]:
     """Trials of ``loop`` (from trial ``first`` on) and of the loop ``overrides`` compose, one of each in turn,
-    ``rounds`` times, after ``warm_trials`` untimed ones of the other: per round, the other's wall time over
-    this loop's (this loop's speed as a fraction of the other's), and both factors; medians over the rounds."""
+    ``rounds`` times, after ``warm_trials`` untimed ones of the other: per round, this loop's real-time factor
+    over the other's (its speed as a fraction of the other's), and both factors; medians over the rounds."""
     other = ClosedLoop(build_components(load(overrides)[0]), None)
     other.start()
     for i in range(warm_trials):
@@ -93,10 +92,7 @@ def _in_turns(loop: ClosedLoop, first: int, overrides: list[str], rounds: int, w
         this_rt.append(sim_this / (t2 - t1))
         other_rt.append(sim_other / (t1 - t0))
         ratios.append(this_rt[-1] / other_rt[-1])
-
-    def median(xs: list[float]) -> float:
-        return float(np.median(xs))
-
+    median = statistics.median
     return {"overrides": overrides, "rounds": rounds, "ratio_median": round(median(ratios), 3),
             "ratio_min": round(min(ratios), 3), "ratio_max": round(max(ratios), 3),
             "rt_factor_median": round(median(this_rt), 2), "versus_rt_factor_median": round(median(other_rt), 2)}
