@@ -98,5 +98,5 @@ def _main(argv: list[str] | None) -> int:
     return run_command(argv[0], argv[1:])
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+if __name__ == "__main__":  # `python -m cerebx.cli` (the bench's own subprocesses) as `python -m cerebx`
+    console()

@@ -92,10 +92,10 @@ def _in_turns(loop: ClosedLoop, first: int, overrides: list[str], rounds: int, w
         this_rt.append(sim_this / (t2 - t1))
         other_rt.append(sim_other / (t1 - t0))
         ratios.append(this_rt[-1] / other_rt[-1])
-    median = statistics.median
-    return {"overrides": overrides, "rounds": rounds, "ratio_median": round(median(ratios), 3),
+    return {"overrides": overrides, "rounds": rounds, "ratio_median": round(statistics.median(ratios), 3),
             "ratio_min": round(min(ratios), 3), "ratio_max": round(max(ratios), 3),
-            "rt_factor_median": round(median(this_rt), 2), "versus_rt_factor_median": round(median(other_rt), 2)}
+            "rt_factor_median": round(statistics.median(this_rt), 2),
+            "versus_rt_factor_median": round(statistics.median(other_rt), 2)}
 
 
 def per_step_parts(loop: ClosedLoop, trials: range, steps_per_trial: int) -> dict[str, Any]:

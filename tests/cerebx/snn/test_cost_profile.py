@@ -94,3 +94,7 @@ def test_two_loops_timed_in_turns_give_their_speed_ratio():
     assert same["ratio_min"] <= same["ratio_median"] <= same["ratio_max"]
     assert 0.5 < same["ratio_median"] < 2.0  # a loop against itself: as fast, up to the host's noise
     assert same["rt_factor_median"] > 0 and same["versus_rt_factor_median"] > 0
+    # a loop that steps its physics 5 times as often (0.1 ms against 0.5 ms; ~0.4 of PD's speed measured) is the
+    # slower one: the ratio is this loop's speed over the other's, not the inverse
+    finer = closed_loop_rt([*pd, "plant.physics_dt_ms=0.1"], seconds=0.1, warmup_s=0.1, versus=pd, rounds=5)
+    assert finer["versus"]["ratio_median"] < min(0.75, same["ratio_median"])
