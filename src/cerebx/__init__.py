@@ -7,3 +7,7 @@ stages declare (``loop/signals.py``).
 """
 
 __version__ = "0.1.0"
+
+from cerebx import vectors as _vectors
+
+_vectors.configure()  # before numba compiles anything: CEREBX_VECTOR_BITS (cerebx/vectors.py)

@@ -25,6 +25,7 @@ from cerebx.bench_learning import bench_learning
 from cerebx.config import load
 from cerebx.loop.timing import closed_loop_rt
 from cerebx.lwpr.bench import bench_lwpr
+from cerebx.vectors import vector_bits
 
 DEFAULT_NETWORKS = ("full", "multikernel")
 PD_LOOP = ["+task=circle", "controller=pd"]  # the plant's loop with PD, which a closed loop is timed against
@@ -89,7 +90,8 @@ def main(argv: list[str]) -> dict[str, Any]:
                               versus=versus)
     if args.one:
         return _one_network(args.one, args.seconds, args.warmup, not args.serial, args.started or time.time())
-    report: dict[str, Any] = {"cpus": os.cpu_count(), "plant_pd": _plant_pd(args.seconds), "networks": {}}
+    report: dict[str, Any] = {"cpus": os.cpu_count(), "vector_bits": vector_bits(), "plant_pd": _plant_pd(args.seconds),
+                              "networks": {}}
     for name in filter(None, args.networks.split(",")):
         cmd = [sys.executable, "-m", "cerebx.cli", "bench", "--one", name, "--seconds", str(args.seconds),
                "--warmup", str(args.warmup), "--started", repr(time.time())] + (["--serial"] if args.serial else [])

@@ -16,7 +16,7 @@ import os
 import sys
 import threading
 
-from cerebx import __version__
+from cerebx import __version__, vectors
 from cerebx.commands import COMMANDS, run_command
 from cerebx.commands.common import fail
 from cerebx.jobenv import numba_cache_dir
@@ -95,6 +95,8 @@ def _main(argv: list[str] | None) -> int:
         return 0
     if argv[0] not in COMMANDS:
         return fail([f"{argv[0]}: unknown command (choose from {', '.join(COMMANDS)})"])
+    if (bad := vectors.problem()) is not None:
+        return fail([bad])
     return run_command(argv[0], argv[1:])
 
 

@@ -61,9 +61,13 @@ def this_platform() -> dict[str, str]:
                     if ln.startswith("model name")), "")
     except OSError:
         pass
+    from cerebx.vectors import vector_bits
+
+    # kernels compiled for 512-bit vectors (CEREBX_VECTOR_BITS) round differently: another platform for digests
+    wide = {"vector_bits": "512"} if vector_bits() == 512 else {}
     return {"machine": platform.machine(), "cpu": cpu or platform.processor(), "python": platform.python_version(),
             "numpy": numpy.__version__, "numba": numba.__version__, "mujoco": mujoco.__version__,
-            "llvm_cpu": llvmlite.binding.get_host_cpu_name()}
+            "llvm_cpu": llvmlite.binding.get_host_cpu_name(), **wide}
 
 
 def digest(run_dir: Path) -> dict:

@@ -52,6 +52,7 @@ from cerebx.snn.encoders import AfferentRing, EncoderPair, compose_steps, encode
 from cerebx.snn.kernels import OUTPUTS, prof_lap, prof_now, run_chunk
 from cerebx.snn.network import Network, pack
 from cerebx.snn.schema import layout_problem
+from cerebx.vectors import vector_bits
 
 STEP_S = 0.002
 STATE_VERSION = 1
@@ -623,6 +624,7 @@ class SNNControllerImpl(Controller):
             "cf_pathway_delay_steps": self.k_cf,
             "fingerprint": self.fingerprint,
             "integrators": self.net.integrators(),
+            "vector_bits": vector_bits(),
             **self._built(),
         }
 

@@ -1,0 +1,67 @@
+"""The width of the SIMD vectors numba compiles cerebx's kernels for: ``CEREBX_VECTOR_BITS``.
+
+On a CPU with AVX-512, LLVM still prefers 256-bit vectors for most CPU models, and numba compiles for the host
+CPU as LLVM describes it, so the vectorised loops (every population's integration, the dense deliveries, the
+weight updates) run 8 float32 lanes wide. ``CEREBX_VECTOR_BITS=512`` lets them use the 16 lanes of AVX-512 (the
+host's LLVM features with ``-prefer-256-bit``, handed to numba as ``NUMBA_CPU_FEATURES``).
+
+Measured on the 2-core development machine (Emerald Rapids, 2026-11-29; docs/guide/speed.md#wide-vectors):
+the Golgi network's fused granule step 110-120 -> 71-81 us a call, its closed loop 3.1 -> 4.7x real time
+(medians); the thesis network's closed loop does not gain (its loop's thread sets the pace). Off by default
+because it changes results in the last bits where a loop takes an approximate reciprocal: the DCN's NMDA Mg
+block, whose 16-lane estimate (``vrcp14ps``) is not the 8-lane one (``vrcpps``); the Golgi network's granule
+step gives the same bits. A run records its setting (``controller_info.vector_bits``).
+
+It must be chosen before numba compiles or loads its first kernel: :func:`configure` runs when ``cerebx`` is
+imported (in a process that imported numba and compiled with it before, the width stays numba's). A
+``NUMBA_CPU_FEATURES`` or ``NUMBA_CPU_NAME`` set by the user wins (then nothing is changed here).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+ENV = "CEREBX_VECTOR_BITS"
+WIDE = "-prefer-256-bit"
+
+
+def problem(environ: dict[str, str] | None = None) -> str | None:
+    """A one-line error for a ``CEREBX_VECTOR_BITS`` other than 256 or 512 (the command line refuses it; an
+    import of cerebx leaves the width as numba picks it)."""
+    bits = (os.environ if environ is None else environ).get(ENV, "").strip()
+    return None if bits in ("", "256", "512") else f"{ENV}: expected 256 or 512, got {bits!r}"
+
+
+def configure(environ: dict[str, str] | None = None) -> None:
+    """With ``CEREBX_VECTOR_BITS=512`` (and neither ``NUMBA_CPU_FEATURES`` nor ``NUMBA_CPU_NAME`` set), give
+    numba the host's CPU features with 512-bit vectors preferred. Nothing is imported unless 512 is asked for."""
+    env = os.environ if environ is None else environ
+    if env.get(ENV, "").strip() != "512" or env.get("NUMBA_CPU_NAME"):
+        return
+    ours = env.get("NUMBA_CPU_FEATURES", "").endswith("," + WIDE)  # set by cerebx, maybe on another host
+    if env.get("NUMBA_CPU_FEATURES") and not ours:
+        return
+    import llvmlite.binding as ll
+
+    ll.initialize_native_target()
+    features = ll.get_host_cpu_features().flatten()
+    if "+avx512f" not in features.split(","):  # no 512-bit vectors on this CPU
+        if ours:
+            del env["NUMBA_CPU_FEATURES"]
+        return
+    # in the environment (numba reads it again whenever a NUMBA_ variable changes), where a job started from
+    # this process finds it and works out its own host's (above)
+    env["NUMBA_CPU_FEATURES"] = f"{features},{WIDE}"
+
+
+def vector_bits() -> int:
+    """The vector width this process's kernels are compiled for: 512 when 256-bit vectors are no longer preferred
+    on an AVX-512 CPU, else 256 (the width LLVM picks for the host; narrower on a CPU without AVX)."""
+    features = os.environ.get("NUMBA_CPU_FEATURES", "")
+    numba = sys.modules.get("numba")
+    if numba is not None:
+        from numba.core import config
+
+        features = config.CPU_FEATURES or features
+    return 512 if WIDE in features.split(",") and "+avx512f" in features.split(",") else 256

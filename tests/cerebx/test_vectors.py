@@ -1,0 +1,87 @@
+"""CEREBX_VECTOR_BITS: the width numba's kernels are compiled for (cerebx/vectors.py)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import llvmlite.binding as ll
+import pytest
+
+from cerebx import vectors
+
+ll.initialize_native_target()
+HOST = ll.get_host_cpu_features().flatten()
+AVX512 = "+avx512f" in HOST.split(",")
+
+
+def test_default_and_256_leave_numba_alone():
+    for env in ({}, {"CEREBX_VECTOR_BITS": "256"}, {"CEREBX_VECTOR_BITS": ""}):
+        before = dict(env)
+        vectors.configure(env)
+        assert env == before
+        assert vectors.problem(env) is None
+
+
+def test_a_bad_width_is_one_line_and_changes_nothing():
+    env = {"CEREBX_VECTOR_BITS": "128"}
+    vectors.configure(env)
+    assert env == {"CEREBX_VECTOR_BITS": "128"}
+    assert vectors.problem(env) == "CEREBX_VECTOR_BITS: expected 256 or 512, got '128'"
+
+
+def test_the_command_line_refuses_a_bad_width():
+    p = subprocess.run([sys.executable, "-m", "cerebx", "validate", "+task=circle"], capture_output=True, text=True,
+                       env={**_env(), "CEREBX_VECTOR_BITS": "wide"})
+    assert p.returncode == 2
+    assert p.stderr.strip() == "CEREBX_VECTOR_BITS: expected 256 or 512, got 'wide'"
+
+
+@pytest.mark.skipif(not AVX512, reason="this CPU has no AVX-512")
+def test_512_hands_numba_the_host_features_with_wide_vectors():
+    env = {"CEREBX_VECTOR_BITS": "512"}
+    vectors.configure(env)
+    assert env["NUMBA_CPU_FEATURES"] == HOST + ",-prefer-256-bit"
+    # a job started from that process (maybe on another host) works its own host's out again
+    env["NUMBA_CPU_FEATURES"] = "+avx512f,+sse2,-prefer-256-bit"
+    vectors.configure(env)
+    assert env["NUMBA_CPU_FEATURES"] == HOST + ",-prefer-256-bit"
+
+
+def test_512_leaves_the_users_own_numba_cpu_settings():
+    for key, value in (("NUMBA_CPU_FEATURES", "+sse2"), ("NUMBA_CPU_NAME", "generic")):
+        env = {"CEREBX_VECTOR_BITS": "512", key: value}
+        vectors.configure(env)
+        assert env == {"CEREBX_VECTOR_BITS": "512", key: value}
+
+
+@pytest.mark.skipif(not AVX512, reason="this CPU has no AVX-512")
+def test_a_process_reports_the_width_its_kernels_get():
+    code = "import cerebx, numba; from cerebx.vectors import vector_bits; print(vector_bits())"
+    for bits in ("256", "512"):
+        p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                           env={**_env(), "CEREBX_VECTOR_BITS": bits})
+        assert p.stdout.strip() == bits, p.stderr
+
+
+def _env() -> dict[str, str]:
+    import os
+
+    return {k: v for k, v in os.environ.items() if k not in ("NUMBA_CPU_FEATURES", "CEREBX_VECTOR_BITS")}
+
+
+@pytest.mark.skipif(not AVX512, reason="this CPU has no AVX-512")
+def test_512_compiles_16_lane_loops():
+    """A float32 loop like the integration loops: 8 lanes (ymm) by default, 16 (zmm) with 512."""
+    code = ("import cerebx, numpy as np\nfrom numba import njit\n"
+            "@njit(fastmath=True)\ndef f(u, g):\n    for i in range(u.shape[0]):\n"
+            "        u[i] = u[i] * np.float32(0.9) + g[i]\n"
+            "a = np.ones(64, np.float32)\nf(a, a)\nasm = next(iter(f.inspect_asm().values()))\n"
+            "print('zmm' in asm, 'ymm' in asm)")
+    out = {}
+    for bits in ("256", "512"):
+        p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                           env={**_env(), "CEREBX_VECTOR_BITS": bits})
+        out[bits] = p.stdout.split()
+    assert out["256"] == ["False", "True"]
+    assert out["512"][0] == "True"
