@@ -85,3 +85,16 @@ def test_512_compiles_16_lane_loops():
         out[bits] = p.stdout.split()
     assert out["256"] == ["False", "True"]
     assert out["512"][0] == "True"
+
+
+def test_512_kernels_have_their_own_cache_folder(tmp_path):
+    """The compile notice reads a cache folder's index files, which do not say for which width: 512-bit
+    kernels go to a folder of their own (unless the user names one)."""
+    from cerebx import jobenv
+
+    env = {"CEREBX_CACHE": str(tmp_path), "CEREBX_VECTOR_BITS": "512"}
+    assert jobenv.configure(env)["NUMBA_CACHE_DIR"] == str(tmp_path / "numba-512")
+    assert jobenv.numba_cache_dir({"CEREBX_CACHE": str(tmp_path)}) == tmp_path / "numba"
+    env = {"NUMBA_CACHE_DIR": "/elsewhere", "CEREBX_VECTOR_BITS": "512"}
+    jobenv.configure(env)
+    assert env["NUMBA_CACHE_DIR"] == "/elsewhere"
