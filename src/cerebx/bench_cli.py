@@ -7,7 +7,8 @@ Output is JSON. Numbers are simulated seconds per wall second; ``per_step_us`` s
 goes, in microseconds per part (the PD loop's and each closed loop's main thread by phase, each network's kernels by
 part: :func:`cerebx.loop.timing.per_step_parts`), from extra timed steps after the untimed ones that give the
 factors. ``versus`` beside each closed loop: its speed over the PD loop's, the two timed trial by trial in turns in
-one process (steady on a host whose speed drifts within seconds).
+one process (steady on a host whose speed drifts within seconds). ``load_average`` and ``vector_bits``: the host's
+load around the measurements and the kernels' vector width (``cerebx.vectors``).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ def _one_network(name: str, seconds: float, warmup: float, parallel: bool, start
     """Network alone, then the closed loop with the MuJoCo Baxter (circle task, plasticity on). ``started``:
     when the parent launched this process (its start-up, interpreter and imports, is measured from it)."""
     startup_s = time.time() - started
+    load_start = _load()
     exp, _ = load(["+task=circle", f"network={name}"])
     out = bench_network(exp.controller.network, seconds=seconds, warmup=warmup, parallel=parallel)
     out["startup_s"] = round(startup_s, 3)
@@ -52,6 +54,7 @@ def _one_network(name: str, seconds: float, warmup: float, parallel: bool, start
     loop = json.loads(proc.stdout)
     keys = ("build_s", "rt_factor", "cpu_rt_factor", "us_per_step", "cpu_us_per_step", "per_step_us", "versus")
     out["closed_loop"] = {k: loop[k] for k in keys}
+    out["load_average"] = {"start": load_start, "end": _load()}
     return out
 
 
@@ -90,8 +93,8 @@ def main(argv: list[str]) -> dict[str, Any]:
                               versus=versus)
     if args.one:
         return _one_network(args.one, args.seconds, args.warmup, not args.serial, args.started or time.time())
-    report: dict[str, Any] = {"cpus": os.cpu_count(), "vector_bits": vector_bits(), "plant_pd": _plant_pd(args.seconds),
-                              "networks": {}}
+    report: dict[str, Any] = {"cpus": os.cpu_count(), "vector_bits": vector_bits(),
+                              "load_average": {"start": _load()}, "plant_pd": _plant_pd(args.seconds), "networks": {}}
     for name in filter(None, args.networks.split(",")):
         cmd = [sys.executable, "-m", "cerebx.cli", "bench", "--one", name, "--seconds", str(args.seconds),
                "--warmup", str(args.warmup), "--started", repr(time.time())] + (["--serial"] if args.serial else [])
@@ -103,4 +106,11 @@ def main(argv: list[str]) -> dict[str, Any]:
     if args.learning != "":
         names = [n for n in (args.learning or "").split(",") if n]
         report["learning"] = bench_learning(names, args.trials, args.rounds, args.seconds, args.warmup)
+    report["load_average"]["end"] = _load()
     return report
+
+
+def _load() -> list[float]:
+    """The host's load averages (1, 5, 15 min) now: how busy it was around a measurement (this host's speed, and
+    so every factor, moves with what else it runs)."""
+    return [round(x, 2) for x in os.getloadavg()]

@@ -29,3 +29,14 @@ def test_a_timed_learning_run_reports_factors_and_phases(tmp_path):
     assert {"plant", "recording", "loop"} <= set(run["phase_times"]["wall_s"])
     loop = closed_loop(["+experiment=demo"], seconds=1.0, warmup=0.5)
     assert loop["rt_factor"] > 0 and loop["cpu_rt_factor"] > 0
+
+
+def test_the_report_says_how_busy_the_host_was_and_the_vector_width(monkeypatch):
+    from cerebx import bench_cli
+
+    monkeypatch.setattr(bench_cli, "_plant_pd", lambda seconds: {})
+    report = bench_cli.main(["--networks", "", "--learning", ""])
+    assert report["vector_bits"] in (256, 512)
+    for when in ("start", "end"):
+        load = report["load_average"][when]
+        assert len(load) == 3 and all(isinstance(x, float) and x >= 0 for x in load)
