@@ -56,8 +56,8 @@ def configure(environ: dict[str, str] | None = None) -> None:
 
 
 def vector_bits() -> int:
-    """The vector width this process's kernels are compiled for: 512 when 256-bit vectors are no longer preferred
-    on an AVX-512 CPU, else 256 (the width LLVM picks for the host; narrower on a CPU without AVX)."""
+    """512 when this process's kernels are compiled with 256-bit vectors no longer preferred on an AVX-512 CPU,
+    else 256: numba's default, which is 256-bit vectors on most AVX-512 CPUs (and narrower without AVX2)."""
     features = os.environ.get("NUMBA_CPU_FEATURES", "")
     numba = sys.modules.get("numba")
     if numba is not None:

