@@ -51,7 +51,7 @@ def numba_cache_dir(environ: dict[str, str] | None = None) -> Path:
     ``numba-512`` for kernels compiled with ``CEREBX_VECTOR_BITS=512`` (whether a run's kernels are compiled
     already is read from the folder's index files, which do not say for which width)."""
     env = os.environ if environ is None else environ
-    name = "numba-512" if env.get(vectors.ENV, "").strip() == "512" else "numba"
+    name = "numba-512" if vectors.asked(env) else "numba"
     if env.get("CEREBX_CACHE"):
         return Path(env["CEREBX_CACHE"]) / name
     checkout = source_checkout()

@@ -33,26 +33,27 @@ def problem(environ: dict[str, str] | None = None) -> str | None:
     return None if bits in ("", "256", "512") else f"{ENV}: expected 256 or 512, got {bits!r}"
 
 
+def asked(environ: dict[str, str] | None = None) -> bool:
+    """Whether ``CEREBX_VECTOR_BITS`` asks for 512-bit vectors."""
+    return (os.environ if environ is None else environ).get(ENV, "").strip() == "512"
+
+
 def configure(environ: dict[str, str] | None = None) -> None:
     """With ``CEREBX_VECTOR_BITS=512`` (and neither ``NUMBA_CPU_FEATURES`` nor ``NUMBA_CPU_NAME`` set), give
     numba the host's CPU features with 512-bit vectors preferred. Nothing is imported unless 512 is asked for."""
     env = os.environ if environ is None else environ
-    if env.get(ENV, "").strip() != "512" or env.get("NUMBA_CPU_NAME"):
-        return
-    ours = env.get("NUMBA_CPU_FEATURES", "").endswith("," + WIDE)  # set by cerebx, maybe on another host
-    if env.get("NUMBA_CPU_FEATURES") and not ours:
+    if env.get("NUMBA_CPU_FEATURES", "").endswith("," + WIDE):  # set by cerebx, maybe on another host: again
+        del env["NUMBA_CPU_FEATURES"]
+    if not asked(env) or env.get("NUMBA_CPU_FEATURES") or env.get("NUMBA_CPU_NAME"):
         return
     import llvmlite.binding as ll
 
     ll.initialize_native_target()
     features = ll.get_host_cpu_features().flatten()
-    if "+avx512f" not in features.split(","):  # no 512-bit vectors on this CPU
-        if ours:
-            del env["NUMBA_CPU_FEATURES"]
-        return
-    # in the environment (numba reads it again whenever a NUMBA_ variable changes), where a job started from
-    # this process finds it and works out its own host's (above)
-    env["NUMBA_CPU_FEATURES"] = f"{features},{WIDE}"
+    if "+avx512f" in features.split(","):  # else no 512-bit vectors on this CPU
+        # in the environment (numba reads it again whenever a NUMBA_ variable changes), where a job started from
+        # this process finds it and works out its own host's
+        env["NUMBA_CPU_FEATURES"] = f"{features},{WIDE}"
 
 
 def vector_bits() -> int:
@@ -64,4 +65,5 @@ def vector_bits() -> int:
         from numba.core import config
 
         features = config.CPU_FEATURES or features
-    return 512 if WIDE in features.split(",") and "+avx512f" in features.split(",") else 256
+    flags = features.split(",")
+    return 512 if WIDE in flags and "+avx512f" in flags else 256
