@@ -336,16 +336,28 @@ def stability_improvement_pct(mae: list[float], at_trial: int, n: int = FINAL_TR
     return float(100.0 * (1.0 - m[max(0, at_trial - n):at_trial].std() / m[:n].std()))
 
 
+def residual_row(mass: float, t: int) -> str:
+    return f"{mass:g} kg: MAE over trials {t - FINAL_TRIALS}–{t} (rad)"
+
+
+def spread_row(mass: float, t: int) -> str:
+    return f"{mass:g} kg: std of the MAE over trials {t - FINAL_TRIALS}–{t} (rad)"
+
+
 def headline(r: Run) -> dict[str, float]:
     """Fig. 11's numbers of one run (one mass, one seed): the error reduction and the stability improvement by
-    trials 200 and 400 (counted from the run's start), as far as the run goes."""
+    trials 200 and 400 (counted from the run's start), as far as the run goes, and what they are made of: the
+    mean and the standard deviation of the MAE over the first 30 trials and over the 30 before each."""
     m, mass = list(_mae_sum(r)), float(r.get("plant.object_mass_kg"))
-    out = {}
+    a = np.asarray(m, float)
+    out = {spread_row(mass, FINAL_TRIALS): float(a[:FINAL_TRIALS].std())}
     for t in AT_TRIALS:
         if t <= len(m) + r.warmup:
             k = min(t, len(m))
             out[reduction_row(mass, t)] = improvement_pct(m, k)
             out[stability_row(mass, t)] = stability_improvement_pct(m, k)
+            out[residual_row(mass, t)] = float(a[max(0, k - FINAL_TRIALS):k].mean())
+            out[spread_row(mass, t)] = float(a[max(0, k - FINAL_TRIALS):k].std())
     return out
 
 
@@ -392,6 +404,8 @@ def fig12(runs: RunSet, stem: Path) -> Figure:
                           f"{ours[stability_row(mass, t)]:.1f} %"])
         table.append([f"{mass:g} kg: first-trial MAE / accuracy gain (rad)", "–",
                       f"{m[0]:.3f} / {accuracy_gain(m):.3f}"])
+        for q in [residual_row(mass, t) for t in at] + [spread_row(mass, t) for t in (FINAL_TRIALS, *at)]:
+            table.append([q, "–", f"{ours[q]:.4f}"])
     ax_a.set_xlabel("trial")
     ax_a.set_ylabel("MAE, sum over joints (rad)")
     ax_a.legend(fontsize=8)
@@ -420,12 +434,13 @@ def fig12(runs: RunSet, stem: Path) -> Figure:
     caption = ("MAE per trial with objects of 0.5-2 kg held at the hand; the crude inverse dynamics ignores the "
                "object. Paper: heavier objects start worse and gain more. Error reduction by trial t: 1 - mean MAE "
                "of the 30 trials before t / MAE of the first trial; stability improvement: 1 - std of the MAE over "
-               "those 30 trials / its std over the first 30 (Fig. 11's caption)."
-               + (f" Both over {n_seeds} independently learned seeds: mean and 95 % interval in the table; the checks "
+               "those 30 trials / its std over the first 30 (Fig. 11's caption); the table gives those means and "
+               "standard deviations too."
+               + (f" All over {n_seeds} independently learned seeds: mean and 95 % interval in the table; the checks "
                   "on them decide on the mean over seeds; the curves show the first seed." if n_seeds > 1 else ""))
     conv = _learnt(runs, by_mass, lambda m: f"{m:g} kg", "luque2011_fig12")
-    return Figure([png], caption, with_intervals(table, intervals), checks=checks, convergence=conv,
-                  intervals=intervals)
+    return Figure([png], caption, with_intervals(table, intervals, lambda q: 4 if q.endswith("(rad)") else 3),
+                  checks=checks, convergence=conv, intervals=intervals)
 
 
 def _fig11_checks(masses: list[float], intervals: dict[str, Interval]) -> list[Check]:

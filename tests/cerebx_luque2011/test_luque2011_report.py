@@ -43,6 +43,10 @@ def test_error_reduction_and_stability_improvement_of_one_run():
     h = report.headline(run)
     assert h["0.5 kg: error reduction by trial 200"] == pytest.approx(100 * (1 - 0.4 / 1.1))
     assert h["0.5 kg: stability improvement, trials 370–400 vs 0–30"] == pytest.approx(80.0)
+    # what the two are made of: the mean and the spread of the MAE over the first 30 trials and the 30 before t
+    assert h["0.5 kg: MAE over trials 170–200 (rad)"] == pytest.approx(0.4)
+    assert h["0.5 kg: std of the MAE over trials 0–30 (rad)"] == pytest.approx(0.1)
+    assert h["0.5 kg: std of the MAE over trials 370–400 (rad)"] == pytest.approx(0.02)
 
 
 def test_fig12_gives_the_error_reduction_over_seeds_and_checks_fig11s_numbers(tmp_path):
@@ -60,6 +64,8 @@ def test_fig12_gives_the_error_reduction_over_seeds_and_checks_fig11s_numbers(tm
     assert fig.intervals == ivs
     row = next(r for r in fig.table if r[0] == "2 kg: error reduction by trial 400")
     assert row[1] == "79.3 %" and "; over seeds " in row[2] and "(3 seeds)" in row[2]
+    row = next(r for r in fig.table if r[0] == "2 kg: MAE over trials 170–200 (rad)")
+    assert row[1] == "–" and "; over seeds " in row[2] and ivs[row[0]].paper is None
     holds = {c.claim.split(" (")[0]: c.holds for c in fig.checks}
     assert holds["accuracy gain grows with the mass"] and holds["heavier objects start with a higher error"]
     assert holds["the error is significantly reduced for every mass: by at least 30 % by trial 400"]
