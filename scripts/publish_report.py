@@ -239,9 +239,11 @@ def checks_markdown(figures: list[dict[str, Any]], link_base: str = "../results"
 
 def intervals_markdown(figures: list[dict[str, Any]]) -> str:
     """The headline numbers: the paper's beside cerebx's mean and 95 % interval over seeds, and whether the
-    paper's number falls inside (– with one seed or no paper number)."""
+    paper's number falls inside (– with one seed). A quantity the paper gives no number for (what a figure's
+    table adds to explain one) stays in its figure's table and the CSV, not here."""
     rows = [(e["name"], q, iv, next((r[1] for r in e.get("table") or [] if r and r[0] == q), "–"))
             for e in figures if not e.get("kept_from") for q, iv in (e.get("intervals") or {}).items()]
+    rows = [row for row in rows if row[3] != "–"]
     if not rows:
         return ""
     out = ["| figure | quantity | paper | cerebx, mean [95 % interval] | seeds | paper inside |",

@@ -176,9 +176,11 @@ def test_checks_pages_and_hero_are_made_from_figures_json(tmp_path):
     bare = {"claim": "levels off", "holds": False, "numbers": "", "explained_at": None}
     iv = {"mean": 3.5, "ci_low": 3.1, "ci_high": 3.9, "n": 3, "paper_in_ci": "yes"}
     table = [["quantity", "paper", "cerebx"], ["PD average MAE ÷ SNN average MAE", "3 to 4× larger", "3.5"],
-             ["unrelated", "1", "1"]]
+             ["unrelated", "1", "1"], ["SNN MAE over trials 170–200 (rad)", "–", "0.06"]]
+    no_paper = {"mean": 0.06, "ci_low": 0.05, "ci_high": 0.07, "n": 3, "paper_in_ci": "–"}
     report = {"profile": "full", "commit": "abc123", "built_at": "2026-11-27T12:00:00+00:00",
-              "figures": [_entry("fig3_4", [ok, why], {"PD average MAE ÷ SNN average MAE": iv}, table),
+              "figures": [_entry("fig3_4", [ok, why], {"PD average MAE ÷ SNN average MAE": iv,
+                                                       "SNN MAE over trials 170–200 (rad)": no_paper}, table),
                           _entry("fig3_3", [bare])]}
     checks = publisher.checks_markdown(report["figures"])
     assert "| `fig3_4` | 2 | 1 | 1 | 0 |" in checks and "| all | 3 | 1 | 1 | 1 |" in checks
@@ -186,6 +188,7 @@ def test_checks_pages_and_hero_are_made_from_figures_json(tmp_path):
     page = publisher.page_markdown(["fig3_4"], report, "../results")
     assert page.startswith("**In the published report (full profile):** 1 of 2 shape checks hold, 1 fail with")
     assert "| `fig3_4` | PD average MAE ÷ SNN average MAE | 3 to 4× larger | 3.5 [3.1, 3.9] | 3 | yes |" in page
+    assert "170–200" not in page  # a quantity without a paper number stays in its figure's table
     pages = tmp_path / "pages"
     pages.mkdir()
     (pages / "ch3.md").write_text('--8<-- "docs/results/stamp.md"\n--8<-- "docs/results/fig3_4.md"\n')
