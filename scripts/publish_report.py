@@ -19,7 +19,8 @@ from its runs without running anything: ``cerebx report RUNS --out REPORT_DIR``)
 With ``--keep-missing``, a figure the new report did not draw (its runs not finished yet) keeps its earlier
 published entry and images, marked with the profile and date it came from (``kept_from``), and the stamp
 lists it. It rewrites the README's hero block (between ``<!-- hero:start -->`` and ``<!-- hero:end -->``) from the
-hero figure's entry (``--hero``, default fig3_4): its image, caption and the paper's ratios beside cerebx's.
+hero figure's entry (``--hero``, default fig3_4): its image, caption and the paper's ratios beside cerebx's; and
+the same block of the docs' home page (``--home``, default docs/index.md).
 
 A docs page includes a figure with ``--8<-- "docs/results/<figure>.md"`` and the stamp with
 ``--8<-- "docs/results/stamp.md"``; the snippets' image links are relative to the including page
@@ -355,10 +356,12 @@ def _kept(report: dict[str, Any], out: Path) -> tuple[list[dict[str, Any]], dict
 
 
 def publish(report_dir: Path, out: Path, link_base: str = "../results", pages_dir: Path | None = None,
-            readme_path: Path | None = None, hero: str = "fig3_4", keep_missing: bool = False) -> list[str]:
+            readme_path: Path | None = None, hero: str = "fig3_4", keep_missing: bool = False,
+            home_path: Path | None = None) -> list[str]:
     """Replace ``out`` with the published form of the report in ``report_dir`` (with an opening table for
-    each reproduction page of ``pages_dir``, and the hero block of ``readme_path`` rewritten; ``keep_missing``:
-    the earlier published figures the report does not draw are kept, marked); returns the figure names."""
+    each reproduction page of ``pages_dir``, and the hero blocks of ``readme_path`` and of the docs' home page
+    ``home_path`` rewritten; ``keep_missing``: the earlier published figures the report does not draw are kept,
+    marked); returns the figure names."""
     report_dir, out = Path(report_dir), Path(out)
     report = load_report(report_dir)
     images = [(report_dir / f, Path(f).name) for e in report.get("figures") or [] for f in e.get("files") or []]
@@ -379,11 +382,12 @@ def publish(report_dir: Path, out: Path, link_base: str = "../results", pages_di
         _png(src, out / "figures" / name)
     for name, data in kept_images.items():
         (out / "figures" / name).write_bytes(data)
-    if readme_path is not None and readme_path.is_file():
-        rel = Path(os.path.relpath(out, readme_path.parent)).as_posix()
-        block = hero_block({**report, "command": portable(report.get("command"))}, hero, f"{rel}/figures")
-        if block is not None:
-            update_readme(readme_path, block)
+    for page in (readme_path, home_path):
+        if page is not None and Path(page).is_file():
+            rel = Path(os.path.relpath(out, Path(page).parent)).as_posix()
+            block = hero_block({**report, "command": portable(report.get("command"))}, hero, f"{rel}/figures")
+            if block is not None:
+                update_readme(Path(page), block)
     return [e["name"] for e in report.get("figures") or []]
 
 
@@ -397,12 +401,15 @@ def main(argv: list[str] | None = None) -> int:
                     help="the reproduction pages whose opening tables to write (default docs/reproductions)")
     ap.add_argument("--readme", type=Path, default=Path("README.md"),
                     help="the README whose hero block to rewrite (default README.md; a missing one is skipped)")
+    ap.add_argument("--home", type=Path, default=Path("docs/index.md"),
+                    help="the docs' home page whose hero block to rewrite (default docs/index.md; a missing one "
+                         "is skipped)")
     ap.add_argument("--hero", default="fig3_4", help="the hero figure (default fig3_4)")
     ap.add_argument("--keep-missing", action="store_true",
                     help="keep the earlier published figures this report does not draw, marked as such")
     a = ap.parse_args(argv)
     try:
-        names = publish(a.report, a.out, a.link_base, a.pages, a.readme, a.hero, a.keep_missing)
+        names = publish(a.report, a.out, a.link_base, a.pages, a.readme, a.hero, a.keep_missing, a.home)
     except PublishError as err:
         print(f"publish_report: {err}", file=sys.stderr)
         return 2

@@ -153,6 +153,13 @@ def test_publishing_a_report_built_from_synthetic_runs(tmp_path, monkeypatch):
     assert "2 runs of the quick profile" in stamp and "between 2025-03-01 and 2025-03-04" in stamp
     assert MACHINE_PATH.search(stamp + (out / "figures.json").read_text()) is None
     assert (out / "figures" / "toy_fig1.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # the README's and the docs' home page's hero blocks, each with the image's path from where it lies
+    readme, home = tmp_path / "README.md", tmp_path / "docs" / "index.md"
+    for page in (readme, home):
+        page.write_text("# x\n<!-- hero:start -->\n<!-- hero:end -->\n")
+    publisher.publish(report, out, readme_path=readme, hero="toy_fig1", home_path=home)
+    assert "![Toy figure](docs/results/figures/toy_fig1.png)" in readme.read_text()
+    assert "![Toy figure](results/figures/toy_fig1.png)" in home.read_text()
     # publishing again gives the same files; a folder that is no published report is not replaced
     first = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
     publisher.publish(report, out)
