@@ -348,8 +348,8 @@ def headline(r: Run) -> dict[str, float]:
     """Fig. 11's numbers of one run (one mass, one seed): the error reduction and the stability improvement by
     trials 200 and 400 (counted from the run's start), as far as the run goes, and what they are made of: the
     mean and the standard deviation of the MAE over the first 30 trials and over the 30 before each."""
-    m, mass = list(_mae_sum(r)), float(r.get("plant.object_mass_kg"))
-    a = np.asarray(m, float)
+    a, mass = np.asarray(_mae_sum(r), float), float(r.get("plant.object_mass_kg"))
+    m = list(a)
     out = {spread_row(mass, FINAL_TRIALS): float(a[:FINAL_TRIALS].std())}
     for t in AT_TRIALS:
         if t <= len(m) + r.warmup:
