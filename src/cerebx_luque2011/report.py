@@ -348,16 +348,16 @@ def headline(r: Run) -> dict[str, float]:
     """Fig. 11's numbers of one run (one mass, one seed): the error reduction and the stability improvement by
     trials 200 and 400 (counted from the run's start), as far as the run goes, and what they are made of: the
     mean and the standard deviation of the MAE over the first 30 trials and over the 30 before each."""
-    a, mass = np.asarray(_mae_sum(r), float), float(r.get("plant.object_mass_kg"))
-    m = list(a)
-    out = {spread_row(mass, FINAL_TRIALS): float(a[:FINAL_TRIALS].std())}
+    m, mass = _mae_sum(r), float(r.get("plant.object_mass_kg"))
+    out = {spread_row(mass, FINAL_TRIALS): float(m[:FINAL_TRIALS].std())}
     for t in AT_TRIALS:
         if t <= len(m) + r.warmup:
             k = min(t, len(m))
+            window = m[max(0, k - FINAL_TRIALS):k]
             out[reduction_row(mass, t)] = improvement_pct(m, k)
             out[stability_row(mass, t)] = stability_improvement_pct(m, k)
-            out[residual_row(mass, t)] = float(a[max(0, k - FINAL_TRIALS):k].mean())
-            out[spread_row(mass, t)] = float(a[max(0, k - FINAL_TRIALS):k].std())
+            out[residual_row(mass, t)] = float(window.mean())
+            out[spread_row(mass, t)] = float(window.std())
     return out
 
 
