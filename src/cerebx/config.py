@@ -399,12 +399,17 @@ def _literal_prefix(path: str) -> Path:
     return Path(*keep) if keep else Path(".")
 
 
+PROBE = ".cerebx-probe-"
+"""The name (and the process id) of the folder :func:`_can_make` makes and removes in a folder to see that runs can
+go there; another cerebx started at the same moment (a report's sweep in parts) may see it meanwhile."""
+
+
 def _can_make(folder: Path) -> str | None:
     """Why ``folder`` cannot be a run folder (None if it can); whatever is created to find out is removed."""
     if folder.exists():
         if not folder.is_dir():
             return "it exists and is not a folder"
-        probe = folder / f".cerebx-probe-{os.getpid()}"
+        probe = folder / f"{PROBE}{os.getpid()}"
         try:
             probe.mkdir()
             probe.rmdir()
@@ -484,17 +489,20 @@ def _refused_folder(value: str) -> str | None:
 
 def _holds_runs(folder: Path) -> bool:
     """``folder`` is empty, a run's or a sweep's (its jobs' folders, even of a sweep cut short before it wrote
-    multirun.yaml), or holds only logs (the report writes a study's log first)."""
+    multirun.yaml), or holds only logs (the report writes a study's log first). Two sweeps started together
+    into one folder (a report's sweep in parts) see each other's half-made entries: the other's creation probe
+    and a job folder Hydra has made but not yet written in; empty folders hold nothing a run could spoil."""
     try:
-        entries = list(folder.iterdir())
+        entries = [e for e in folder.iterdir() if not e.name.startswith(PROBE)]
     except OSError:
         return True  # not readable: whether a run can go there is for the creation probe to say
     return (any(e.name in RUN_MARKERS for e in entries)
-            or all((e.is_file() and e.suffix == ".log") or (e.is_dir() and _is_run(e)) for e in entries))
+            or all((e.is_file() and e.suffix == ".log") or (e.is_dir() and _is_run_or_empty(e)) for e in entries))
 
 
-def _is_run(folder: Path) -> bool:
+def _is_run_or_empty(folder: Path) -> bool:
     try:
-        return any(e.name in RUN_MARKERS for e in folder.iterdir())
+        names = [e.name for e in folder.iterdir()]
     except OSError:
         return False
+    return not names or any(n in RUN_MARKERS for n in names)

@@ -261,3 +261,22 @@ def test_a_run_folder_made_meanwhile_by_another_cerebx_is_no_problem(tmp_path, m
     monkeypatch.setattr(Path, "mkdir", real_mkdir)
     (tmp_path / "file").write_text("x")
     assert config._can_make(tmp_path / "file") == "it exists and is not a folder"
+
+
+def test_a_sweep_folder_another_sweep_is_starting_in_is_no_problem(tmp_path):
+    """A report runs a long sweep as two `cerebx run -m` side by side into one folder. The one that checks the
+    folder second may see the first's creation probe, or a job folder Hydra made but has not written in yet:
+    neither is "a folder that holds no run" (a flaky refusal with exit 2 once, on CI)."""
+    from cerebx import config
+
+    sweep = tmp_path / "my_lab_rate_limits"
+    sweep.mkdir()
+    (sweep / "study.1.log").write_text("cerebx run -m ...\n")
+    (sweep / "study.2.log").write_text("cerebx run -m ...\n")
+    (sweep / f"{config.PROBE}4242").mkdir()  # the other's probe, there for a moment
+    (sweep / "robot.1.max_rate_Nm_per_ms=0.03").mkdir()  # its first job's folder, not written in yet
+    assert config.check_output_dir([f"hydra.sweep.dir={sweep}"], multirun=True) == []
+    (sweep / "robot.1.max_rate_Nm_per_ms=0.03" / "notes.txt").write_text("not a run's")
+    assert config.check_output_dir([f"hydra.sweep.dir={sweep}"], multirun=True) == [
+        f"hydra.sweep.dir: {sweep}: is an existing folder that holds no run; give a new folder, e.g. runs/mine "
+        "(or an empty one)"]

@@ -18,6 +18,7 @@ fewer). The figures draw their curves from the first seed and take their headlin
 from __future__ import annotations
 
 import functools
+import os
 import re
 import shutil
 import signal
@@ -38,6 +39,7 @@ from hydra.errors import HydraException
 from omegaconf import OmegaConf
 from pydantic import ValidationError
 
+from cerebx import runfiles
 from cerebx.config import compose_with_choices, expand_sweep, load, to_plain
 from cerebx.errors import CerebxError, ConfigError
 from cerebx.loop.resume import stale
@@ -443,6 +445,24 @@ def group(jobs: list[Job], parts: int = 1) -> list[Study]:
     return list(studies.values())
 
 
+def failure_cause(j: Job | Study, logname: str) -> str | None:
+    """The line that says why ``j`` did not finish, for the report's own output (its log may be gone when that is
+    read, e.g. on CI): a job's refusal (``error.txt``), else the last line of its log (a refused command's one
+    line, a traceback's last)."""
+    for job in j.jobs if isinstance(j, Study) else [j]:
+        try:
+            return f"{job.label}: {(job.run_dir / runfiles.ERROR).read_text().strip()}"
+        except OSError:
+            pass
+    try:
+        with open(j.run_dir / logname, "rb") as f:
+            f.seek(max(0, f.seek(0, os.SEEK_END) - 4096))
+            lines = [ln.strip() for ln in f.read().decode(errors="replace").splitlines() if ln.strip()]
+    except OSError:
+        return None
+    return lines[-1][:300] if lines else None
+
+
 Runner = Callable[[Any], int]  # runs one Job, or one Study
 
 
@@ -557,7 +577,8 @@ class _Scheduler:
             self.log(f"[{self._clock()}] done  {j.name}: {j.describe()} ({len(self.finished) - self.reused}/"
                      f"{len(self.todo)})" + (f", though it exited with {rc} ({why})" if rc else ""))
         else:
-            self.failed[j.name] = f"{j.name}: failed (exit code {rc}, {why})"
+            cause = failure_cause(j, logname)
+            self.failed[j.name] = f"{j.name}: failed (exit code {rc}, {why})" + (f": {cause}" if cause else "")
             self.log(self.failed[j.name])
 
     def _clock(self) -> str:

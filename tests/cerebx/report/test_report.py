@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import shutil
 import signal
+import sys
 
 import matplotlib.image as mpimg
 import pytest
@@ -213,6 +214,30 @@ def test_a_job_is_judged_by_its_own_run_not_by_its_exit_code(tmp_path):
     failed = execute(plan("quick", tmp_path, ["fig3_4_pd"]), runner=fake, parallel=1, log=lines.append)
     assert len(failed) == 4 and not any("delay.total_ms=0:" in f for f in failed)
     assert any("done  fig3_4_pd/delay.total_ms=0" in line and "though it exited with 1" in line for line in lines)
+
+
+def test_a_failed_job_says_why_in_the_report_s_own_output(tmp_path):
+    """Its log may be gone when the report's output is read (CI keeps the output only): the failure line
+    carries a job's refusal (error.txt), else its log's last line."""
+    from cerebx.report.studies import _run_logged
+
+    def refused(job: Job) -> int:
+        job.run_dir.mkdir(parents=True)
+        (job.run_dir / "error.txt").write_text("delay.total_ms: not a number\n")
+        return 1
+
+    def crashed(job: Job) -> int:
+        job.run_dir.mkdir(parents=True, exist_ok=True)
+        cmd = [sys.executable, "-c", "import sys; print('working'); sys.exit('hydra.sweep.dir: x: went wrong')"]
+        return _run_logged(cmd, job.run_dir / "job.log", "w")
+
+    jobs = plan("quick", tmp_path / "a", ["fig3_4_pd"])[:1]
+    assert execute(jobs, runner=refused, log=lambda line: None) == [
+        f"{jobs[0].name}: failed (exit code 1, see {jobs[0].run_dir / 'job.log'}): "
+        f"{jobs[0].label}: delay.total_ms: not a number"]
+    jobs = plan("quick", tmp_path / "b", ["fig3_4_pd"])[:1]
+    assert execute(jobs, runner=crashed, log=lambda line: None)[0].endswith(
+        "(exit code 1, see " + str(jobs[0].run_dir / "job.log") + "): hydra.sweep.dir: x: went wrong")
 
 
 def test_studies_are_multiruns_of_their_presets(tmp_path):
