@@ -299,36 +299,48 @@ class SNNControllerImpl(Controller):
         """Run the network over ``inputs`` (one GIL-free call) and decode its output."""
         return self._simulate_packed(*pack(inputs), first_step)
 
-    def _simulate_packed(self, flat: np.ndarray, in_off: np.ndarray, first_step: int) -> Chunk:
+    def _simulate_packed(self, flat: np.ndarray, in_off: np.ndarray, first_step: int,
+                         mode: tuple[int, bool] | None = None) -> Chunk:
         """Run the network over packed inputs (:func:`~cerebx.snn.network.pack`) and decode the whole chunk at
         once. With spike propagation shed the network is not run and the DCN stay silent. This is what the
         network thread runs: its work is compiled code without the interpreter lock (interpreted work there
         holds up the loop's thread, which needs the lock back after every MuJoCo step); cutting the result
-        into steps is left to :meth:`_absorb`."""
-        return self._run_chunk(_run_chunk_outputs, (flat, in_off), len(in_off) - 1, first_step)
+        into steps is left to :meth:`_absorb`. ``mode``: the chunk's :meth:`_mode`, taken when it was handed
+        over (default: now)."""
+        return self._run_chunk(_run_chunk_outputs, (flat, in_off), len(in_off) - 1, first_step, (), mode)
 
-    def _simulate_ticks(self, ticks: tuple[np.ndarray, np.ndarray, np.ndarray], n: int, first_step: int) -> Chunk:
+    def _simulate_ticks(self, ticks: tuple[np.ndarray, np.ndarray, np.ndarray], n: int, first_step: int,
+                        mode: tuple[int, bool] | None = None) -> Chunk:
         """:meth:`_simulate_packed` of the ``n`` steps from ``first_step`` on, their inputs packed from the ring of
         encoded ticks after the ``ticks`` kept are encoded (:class:`~cerebx.snn.encoders.AfferentRing`)."""
-        if self._shed >= 2:  # the encoders go on (bursts, draws); the network does not run
+        mode = self._mode() if mode is None else mode
+        if mode[0] >= 2:  # the encoders go on (bursts, draws); the network does not run
             encode_ticks(self._aff.state, *ticks)
-        return self._run_chunk(_run_ticks_chunk_outputs, (ticks, n), n, first_step, (self._aff.state,))
+        return self._run_chunk(_run_ticks_chunk_outputs, (ticks, n), n, first_step, (self._aff.state,), mode)
 
-    def _run_chunk(self, kernel: Any, inputs: tuple, n: int, first_step: int, lead: tuple = ()) -> Chunk:
+    def _mode(self) -> tuple[int, bool]:
+        """What a chunk handed over now runs with: the shedding level and whether the network learns. Taken on
+        the loop's thread when the chunk is handed over, not read on the network thread when it runs: a
+        :meth:`shed` meanwhile applies from the next chunk on, whatever the two threads' timing."""
+        return self._shed, self.net.learn
+
+    def _run_chunk(self, kernel: Any, inputs: tuple, n: int, first_step: int, lead: tuple = (),
+                   mode: tuple[int, bool] | None = None) -> Chunk:
         """``kernel`` (:func:`_run_chunk_outputs` or :func:`_run_ticks_chunk_outputs`, whose arguments ``lead``
         come first) over ``n`` steps from ``first_step`` on, ``inputs`` its chunk's first members (the spike
         buffer and step offsets follow). With spike propagation shed the network is not run and the DCN stay
         silent."""
         net = self.net
-        if self._shed >= 2:
+        shed, learn = self._mode() if mode is None else mode
+        if shed >= 2:
             net.t_sub += net.n_sub * n
             return Chunk(first_step, np.zeros((n, self.width)), np.zeros(n, np.int64), None, None,
                          int(net.pf_lost.sum()))
-        recording = bool(self.recorder is not None and self._shed < 3 and self.record)
+        recording = bool(self.recorder is not None and shed < 3 and self.record)
         record = (self._record_lo, self._record_hi) if recording else (_NONE, _NONE)
         idx_buf, off = net.chunk_buffers(n)
         taus, counts, words, starts, lost = kernel(
-            *lead, net._state, (net.t_sub, net.n_sub, net.learn, net.n_threads), (*inputs, idx_buf, off),
+            *lead, net._state, (net.t_sub, net.n_sub, learn, net.n_threads), (*inputs, idx_buf, off),
             (self._decode, record, first_step, STEP_S), net.prof)
         net.t_sub += net.n_sub * n
         if not recording:
@@ -363,9 +375,10 @@ class SNNControllerImpl(Controller):
         work is compiled code from the start)."""
         first = self._net_step + self._in_flight * self.chunk  # after the chunk still in flight, if one is
         if self._aff is not None:
-            simulate, args = self._simulate_ticks, (self._aff.take(), self.chunk, first)
+            simulate, args = self._simulate_ticks, (self._aff.take(), self.chunk, first, self._mode())
         else:
-            simulate, args = self._simulate_packed, (*pack([self._pending.popleft() for _ in range(self.chunk)]), first)
+            simulate, args = self._simulate_packed, (*pack([self._pending.popleft() for _ in range(self.chunk)]), first,
+                                                     self._mode())
         clock = phase_clock.active()
 
         def work() -> Chunk:
