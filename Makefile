@@ -6,8 +6,9 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 DOCS_STAMP := $(VENV)/.docs-stamp
 SLURM_STAMP := $(VENV)/.slurm-stamp
-# 512-bit kernels (CEREBX_VECTOR_BITS=512, docs/guide/speed.md#wide-vectors) are cached apart, as cerebx.jobenv does
-export NUMBA_CACHE_DIR ?= $(CURDIR)/.cache/numba$(if $(filter 512,$(CEREBX_VECTOR_BITS)),-512,)
+# kernels compiled for 256-bit vectors (CEREBX_VECTOR_BITS=256, docs/guide/speed.md#wide-vectors) are cached apart,
+# as cerebx.jobenv does
+export NUMBA_CACHE_DIR ?= $(CURDIR)/.cache/numba$(if $(filter 256,$(CEREBX_VECTOR_BITS)),-256,)
 export CEREBX_CACHE ?= $(CURDIR)/.cache/cerebx
 
 # The default experiment of `make run`; override e.g. `make run RUN_ARGS="+task=eight delay=gamma45"`.

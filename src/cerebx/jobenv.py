@@ -48,10 +48,10 @@ def source_checkout() -> Path | None:
 
 def numba_cache_dir(environ: dict[str, str] | None = None) -> Path:
     """numba's cache folder: ``numba`` under ``CEREBX_CACHE``, the checkout's ``.cache`` or ``~/.cache/cerebx``;
-    ``numba-512`` for kernels compiled with ``CEREBX_VECTOR_BITS=512`` (whether a run's kernels are compiled
+    ``numba-256`` for kernels compiled with ``CEREBX_VECTOR_BITS=256`` (whether a run's kernels are compiled
     already is read from the folder's index files, which do not say for which width)."""
     env = os.environ if environ is None else environ
-    name = "numba-512" if vectors.asked(env) else "numba"
+    name = "numba" if vectors.asked(env) else "numba-256"
     if env.get("CEREBX_CACHE"):
         return Path(env["CEREBX_CACHE"]) / name
     checkout = source_checkout()

@@ -130,6 +130,17 @@ from cerebx.snn.topology import (
     S_TEACHING,
 )
 
+FAST = {"nnan", "ninf", "nsz", "contract", "afn", "reassoc"}
+"""The fast-math flags of :func:`_lif_full` (the DCN's step): numba's ``fastmath=True`` without ``arcp``, so that
+its Mg block's ``1 / (1 + e)`` stays a division. With ``arcp`` it became the CPU's reciprocal estimate refined
+once, whose bits may depend on the vector width (``vrcpps`` on 8 lanes, ``vrcp14ps`` on 16) and on the CPU maker,
+while the loop's scalar remainder divided exactly; without it the step's results do not depend on the width
+(:mod:`cerebx.vectors`; tests/cerebx/test_vectors.py), and it was not slower (docs/guide/speed.md#wide-vectors).
+The other kernels keep ``fastmath=True`` (inlined helpers take their caller's flags): the granule layer's fused
+step equals the listed and the sub-stepped ones bit for bit only as the compiler arranges all three with it
+(:data:`FUSED`), and in the networks shipped every population with NMDA input takes :func:`_lif_full` (a
+population with NMDA input and bifixed sub-steps, :func:`_lif_full_fine`, still takes the estimate)."""
+
 G_FLOOR = np.float32(1e-12)  # conductances below this (nS) become exactly 0 (avoids denormals)
 U_FLOOR = np.float32(1e-6)  # |V - E_L| below this (mV) becomes exactly 0 (neuron back at rest)
 COMPACT_FRACTION = 4  # compact a population when at least 1/4 of its listed neurons are at rest
@@ -513,7 +524,7 @@ def _end_full(u, ref, flag, gs, p):
     return int(cnt)
 
 
-@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
+@njit(cache=True, fastmath=FAST, error_model="numpy", boundscheck=False)
 def _lif_full(u, gA, gN, gG, ref, flag, p):
     """One step of a population with AMPA, NMDA (Mg block, Eq. 2.8) and GABA conductances
     (float32; vectorised passes as in :func:`_lif_poly`)."""
