@@ -236,7 +236,8 @@ class Recorder:
         compresses a chunk when a message fills it, in the middle of a tick, where the network thread then
         waits for the loop's thread to hand it its next inputs (~0.3 ms a 256 kB chunk with zstd, seven a
         ``make_run`` trial); finishing it here lets the compression run while the loop would wait anyway (the
-        flush lets go of the interpreter lock). Whether it does depends only on the messages logged, so the
+        network thread's compiled code needs no interpreter lock, which the writer holds most of the time it
+        compresses: docs/guide/speed.md). Whether it does depends only on the messages logged, so the
         file stays the same from run to run; its messages are the same either way, only the chunks are
         smaller."""
         if self._early and self._pending >= self._early and not self.closed:
