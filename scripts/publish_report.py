@@ -382,10 +382,11 @@ def publish(report_dir: Path, out: Path, link_base: str = "../results", pages_di
         _png(src, out / "figures" / name)
     for name, data in kept_images.items():
         (out / "figures" / name).write_bytes(data)
+    portable_report = {**report, "command": portable(report.get("command"))}
     for page in (readme_path, home_path):
         if page is not None and Path(page).is_file():
             rel = Path(os.path.relpath(out, Path(page).parent)).as_posix()
-            block = hero_block({**report, "command": portable(report.get("command"))}, hero, f"{rel}/figures")
+            block = hero_block(portable_report, hero, f"{rel}/figures")
             if block is not None:
                 update_readme(Path(page), block)
     return [e["name"] for e in report.get("figures") or []]

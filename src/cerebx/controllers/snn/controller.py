@@ -307,7 +307,8 @@ class SNNControllerImpl(Controller):
         holds up the loop's thread, which needs the lock back after every MuJoCo step); cutting the result
         into steps is left to :meth:`_absorb`. ``mode``: the chunk's :meth:`_mode`, taken when it was handed
         over (default: now)."""
-        return self._run_chunk(_run_chunk_outputs, (flat, in_off), len(in_off) - 1, first_step, (), mode)
+        return self._run_chunk(_run_chunk_outputs, (flat, in_off), len(in_off) - 1, first_step, (),
+                               self._mode() if mode is None else mode)
 
     def _simulate_ticks(self, ticks: tuple[np.ndarray, np.ndarray, np.ndarray], n: int, first_step: int,
                         mode: tuple[int, bool] | None = None) -> Chunk:
@@ -324,14 +325,14 @@ class SNNControllerImpl(Controller):
         :meth:`shed` meanwhile applies from the next chunk on, whatever the two threads' timing."""
         return self._shed, self.net.learn
 
-    def _run_chunk(self, kernel: Any, inputs: tuple, n: int, first_step: int, lead: tuple = (),
-                   mode: tuple[int, bool] | None = None) -> Chunk:
+    def _run_chunk(self, kernel: Any, inputs: tuple, n: int, first_step: int, lead: tuple,
+                   mode: tuple[int, bool]) -> Chunk:
         """``kernel`` (:func:`_run_chunk_outputs` or :func:`_run_ticks_chunk_outputs`, whose arguments ``lead``
         come first) over ``n`` steps from ``first_step`` on, ``inputs`` its chunk's first members (the spike
-        buffer and step offsets follow). With spike propagation shed the network is not run and the DCN stay
-        silent."""
+        buffer and step offsets follow), with ``mode`` (:meth:`_mode`). With spike propagation shed the network is
+        not run and the DCN stay silent."""
         net = self.net
-        shed, learn = self._mode() if mode is None else mode
+        shed, learn = mode
         if shed >= 2:
             net.t_sub += net.n_sub * n
             return Chunk(first_step, np.zeros((n, self.width)), np.zeros(n, np.int64), None, None,
