@@ -14,7 +14,7 @@ from cerebx.controllers.position import PositionServo
 from cerebx.loop.phases import all_finite
 from cerebx.plants.base import PlantEvent
 from cerebx.plants.baxter import JOINTS, BaxterArm, baxter_model, kinematic_model
-from cerebx.plants.mujoco_arm import _saturate
+from cerebx.plants.mujoco_arm import _saturate, without_step_timers
 from cerebx.schema.controller import PositionController
 from cerebx.schema.plant import BaxterConfig
 
@@ -318,3 +318,37 @@ def test_saturation_is_numpy_s_clip_nan_and_infinities_included():
     loop_finite = all_finite(np.array([1.0, 2.0])), all_finite(np.array([1.0, np.nan])), all_finite(np.zeros(0))
     assert loop_finite == (True, False, True)
     assert not all_finite(np.array([[1.0], [-np.inf]]))
+
+
+def _swing(arm: BaxterArm, n: int) -> np.ndarray:
+    arm.reset(np.zeros(arm.n_joints), np.random.default_rng(0))
+    out = []
+    for k in range(n):
+        arm.data.ctrl[:6] = -2.0 * arm.data.qpos[:6] + 0.5 * np.sin(0.05 * k)
+        mujoco.mj_step(arm.model, arm.data, nstep=4)
+        out.append(arm.data.qpos.copy())
+    return np.array(out)
+
+
+def test_mujoco_s_step_timers_are_off_the_motion_the_same_and_a_timer_of_your_own_kept():
+    """An arm turns MuJoCo's per-stage clock reads off (``without_step_timers``): the steps are counted, no time
+    is summed, and the arm moves exactly as with the timers on; a timer callback someone installed stays."""
+    step = mujoco.mjtTimer.mjTIMER_STEP
+    try:
+        arm = BaxterArm(BaxterConfig(frictionloss_Nm=[0.3] * 4 + [0.1] * 2))
+        off = _swing(arm, 200)
+        assert arm.data.timer[step].number == 800 and arm.data.timer[step].duration == 0.0
+        mujoco.set_mjcb_time(None)
+        on = _swing(arm, 200)
+        assert arm.data.timer[step].duration > 0.0
+        assert np.array_equal(on, off)
+
+        def own() -> float:
+            return 1.0
+
+        mujoco.set_mjcb_time(own)
+        BaxterArm(BaxterConfig())
+        assert mujoco.get_mjcb_time() is own
+    finally:
+        mujoco.set_mjcb_time(None)
+        without_step_timers()

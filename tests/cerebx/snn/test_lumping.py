@@ -12,6 +12,7 @@ import pytest
 
 from cerebx.config import load
 from cerebx.controllers.snn.schema import BoxEncoder
+from cerebx.snn import lumping
 from cerebx.snn.encoders import MossyEncoder
 from cerebx.snn.network import Network
 
@@ -140,3 +141,46 @@ def test_a_fibre_given_many_times_in_one_step_hands_the_population_back_to_its_l
     assert lumped.lumped == []
     assert np.array_equal(spikes[0], spikes[1])
     _same_state(lumped, listed)
+
+
+def _lumps_of(states: list[tuple[float, float, float, int]], sizes: list[int]) -> lumping.Lumps:
+    """One population's classes (slots 0..), class c with state ``states[c]`` (u, g, refractory, count) and
+    ``sizes[c]`` members, numbered in class order; the hash table sized as :func:`lumping.build` sizes it."""
+    n = sum(sizes)
+    lp = lumping.empty(n, 1)._replace(htab=np.zeros(1 << int(np.ceil(np.log2(2 * (n + 1)))), np.int32),
+                                      used=np.zeros(n, np.int64))
+    i = 0
+    for c, ((u, g, r, k), m) in enumerate(zip(states, sizes, strict=True)):
+        lp.cu[c], lp.cg[c], lp.cref[c], lp.ccnt[c], lp.csize[c], lp.chead[c] = u, g, r, k, m, i
+        for j in range(m):
+            lp.cls[i], lp.pv[i], lp.nx[i] = c, i - 1 if j else -1, i + 1 if j < m - 1 else -1
+            i += 1
+    lp.n_cls[0] = len(states)
+    return lp
+
+
+@pytest.mark.parametrize("n_pairs", [3, 150])
+def test_classes_that_reached_the_same_state_merge_into_one_with_every_member(n_pairs):
+    """Pairs of classes with equal bits and count (and one that differs from its twin only in the count) merge,
+    each member then in the class of its old state; the probe table is empty again. 300 classes probe a table
+    much larger than the first-level one the merge starts from; 6, a table of 16 slots."""
+    rng = np.random.default_rng(1)
+    twins = [(float(u), float(g), float(r), int(k)) for u, g, r, k in
+             zip(rng.normal(size=n_pairs).astype(np.float32), rng.random(n_pairs).astype(np.float32),
+                 rng.integers(0, 3, n_pairs), rng.integers(0, 5, n_pairs), strict=True)]
+    states = [s for s in twins for _ in range(2)] + [twins[0][:3] + (twins[0][3] + 1,)]
+    sizes = list(rng.integers(1, 4, len(states)))
+    lp = _lumps_of(states, sizes)
+    before = [states[c] for c in lp.cls]
+    lumping.merge(lp, 0, 0)
+    live = np.flatnonzero(lp.csize[: lp.n_cls[0]] > 0)
+    assert len(live) == n_pairs + 1
+    for c in live:
+        members, i = [], lp.chead[c]
+        while i >= 0:
+            members.append(i)
+            i = lp.nx[i]
+        assert len(members) == lp.csize[c] and all(lp.cls[i] == c for i in members)
+    after = [(float(lp.cu[c]), float(lp.cg[c]), float(lp.cref[c]), int(lp.ccnt[c])) for c in lp.cls]
+    assert after == before
+    assert not lp.htab.any()
