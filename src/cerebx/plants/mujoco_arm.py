@@ -14,6 +14,7 @@ itself and calls around each physics step while they are active.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from typing import Any
 
@@ -38,9 +39,17 @@ def _saturate(tau, limit, out):  # pragma: no cover - numba
         out[j] = x
 
 
-@numba.cfunc(numba.float64(), cache=True)
-def _no_time():  # pragma: no cover - numba
-    return 0.0
+@functools.cache
+def _no_time() -> Any:
+    """A compiled ``double (*)(void)`` returning 0, made on first use (~0.03 s once numba has compiled or loaded
+    anything; not cached on disk: as a kernel of the run's own it would count toward the first run's compile
+    notice at a kernel's ~0.9 s)."""
+
+    @numba.cfunc(numba.float64())
+    def zero() -> float:  # pragma: no cover - numba
+        return 0.0
+
+    return zero
 
 
 def without_step_timers() -> None:
@@ -52,7 +61,7 @@ def without_step_timers() -> None:
     physics steps) took 32-35 instead of 37-40 µs (docs/guide/speed.md#mujoco-timers). The callback is global to
     the process; ``mujoco.set_mjcb_time(None)`` brings the timers back."""
     if mujoco.get_mjcb_time() is None:
-        mujoco.set_mjcb_time(_no_time.ctypes)
+        mujoco.set_mjcb_time(_no_time().ctypes)
 
 
 class MujocoArm(Plant):
@@ -85,6 +94,11 @@ class MujocoArm(Plant):
         lag_s = getattr(cfg, "torque_lag_ms", 0.0) / 1000.0
         self._lag_gain = 1.0 - np.exp(-self.physics_dt_s / lag_s) if lag_s > 0 else 1.0
         self._rng = np.random.default_rng(0)
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """Unpickled (a resumed run's checkpoint): the step timers off in this process too."""
+        self.__dict__.update(state)
+        without_step_timers()
 
     def reset(self, q0: np.ndarray, rng: np.random.Generator) -> None:
         mujoco.mj_resetData(self.model, self.data)

@@ -352,3 +352,18 @@ def test_mujoco_s_step_timers_are_off_the_motion_the_same_and_a_timer_of_your_ow
     finally:
         mujoco.set_mjcb_time(None)
         without_step_timers()
+
+
+def test_an_unpickled_arm_turns_the_timers_off_again():
+    """A resumed run unpickles its plant instead of building it: the timers are off there as well."""
+    import pickle
+
+    arm = BaxterArm(BaxterConfig())
+    try:
+        mujoco.set_mjcb_time(None)
+        back = pickle.loads(pickle.dumps(arm))
+        assert mujoco.get_mjcb_time() is not None
+        mujoco.mj_step(back.model, back.data)
+        assert back.data.timer[mujoco.mjtTimer.mjTIMER_STEP].duration == 0.0
+    finally:
+        without_step_timers()
