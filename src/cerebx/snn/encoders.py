@@ -13,6 +13,7 @@ a burst of floor(x / c_k) spikes (clipped to 1..max_burst), one per step.
 
 from __future__ import annotations
 
+from itertools import chain
 from typing import NamedTuple
 
 import numba
@@ -484,12 +485,13 @@ class AfferentRing:
         rows = [k for k in kept if k is not None]
         nj = self.n_joints
         if rows:
-            sizes = {len(x) for r in rows for x in r}
+            flat = list(chain.from_iterable(rows))
+            sizes = set(map(len, flat))
             if min(sizes) < nj:
                 raise ValueError(f"mossy and climbing encoders: {nj} joints, got signals of "
                                  f"{[len(x) for x in rows[0]]} values")
-            if sizes == {nj}:
-                signals = np.array(rows, dtype=np.float64)
+            if sizes == {nj}:  # one concatenation of the 6 x ticks arrays (np.array of the nested list: ~1.4 x as long)
+                signals = np.concatenate(flat, dtype=np.float64).reshape(len(rows), 6, nj)
             else:  # longer signals (a plant with more joints than the controller): the first nj values
                 signals = np.array([[np.asarray(x, np.float64)[:nj] for x in r] for r in rows])
             sensed[[i for i, k in enumerate(kept) if k is not None]] = np.arange(len(rows))

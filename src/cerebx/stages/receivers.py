@@ -35,15 +35,14 @@ class Hold(Receiver):
 
 
 @numba.njit(cache=True, boundscheck=False)
-def _push_mean(buf, total, i, x, n):  # pragma: no cover - numba
+def _push_mean(buf, total, i, x, n, out):  # pragma: no cover - numba
     """``total += x - buf[i]; buf[i] = x``, element by element (the array form's doubles), and the mean
-    ``total / n`` as a new array (the same doubles as numpy's division)."""
-    out = np.empty(total.size)
+    ``total / n`` into ``out`` (the same doubles as numpy's division). (Returning a new array instead cost a
+    call ~0.3 us more: numba boxes it through Python.)"""
     for j in range(total.size):
         total[j] += x[j] - buf[i, j]
         buf[i, j] = x[j]
         out[j] = total[j] / n
-    return out
 
 
 class _RunningMean:
@@ -61,8 +60,11 @@ class _RunningMean:
         """Add a sample; returns the new mean (also :attr:`value`), in one compiled call but every 1000th sample."""
         if x.shape != self.sum.shape:
             raise ValueError(f"mean filter: a sample of shape {x.shape}, the filter's is {self.sum.shape}")
+        i = self.count % self.taps
         self.count += 1
-        self.value = _push_mean(self.buf, self.sum, (self.count - 1) % self.taps, x, min(self.count, self.taps))
+        out = np.empty(self.sum.size)  # a new array each sample: a frame of the tick before may hold the last one
+        _push_mean(self.buf, self.sum, i, x, min(self.count, self.taps), out)
+        self.value = out
         if self.count % 1000 == 0:
             self.sum = self.buf.sum(0)
             self.value = self.sum / min(self.count, self.taps)
