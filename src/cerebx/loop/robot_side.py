@@ -388,7 +388,7 @@ def prepare_real_time() -> None:
     all_finite(z)
     _saturate(z, z, np.zeros(1))
     _push_mean(np.zeros((1, 1)), np.zeros(1), 0, z, 1, np.zeros(1))
-    _ekeberg(z, z, z, z, z, z, z, z, z, z, np.zeros(1), np.zeros(1), np.zeros(1))
+    _ekeberg(z, z, z, z, (z, z, z, z, z, z), (np.zeros(1), np.zeros(1), np.zeros(1)))
     _correct(z, z, z, z, z, z, 0.0, np.zeros(1), np.zeros(1))
     _put_row(z, z, z, z, z, zz.copy(), zz.copy(), zz.copy(), 0)
 

@@ -29,10 +29,13 @@ def ekeberg_torque(ag: np.ndarray, at: np.ndarray, q: np.ndarray, qd: np.ndarray
 
 
 @numba.njit(cache=True, boundscheck=False)
-def _ekeberg(ag, at, q, qd, alpha, beta, gamma, delta, c, q_rest, active, passive, total):  # pragma: no cover
-    """:func:`ekeberg_torque` and the sum joint by joint into ``active``, ``passive`` and ``total``: the array
-    form's operations in its order, so the same doubles (one compiled call instead of eleven array operations,
-    ~9 us a tick; returning three new arrays instead cost it ~0.9 us more, numba boxing them through Python)."""
+def _ekeberg(ag, at, q, qd, params, out):  # pragma: no cover - numba
+    """:func:`ekeberg_torque` and the sum joint by joint into ``out`` = (active, passive, total); ``params``:
+    (alpha, beta, gamma, delta, c, q_rest). The array form's operations in its order, so the same doubles (one
+    compiled call instead of eleven array operations, ~9 us a tick; returning three new arrays instead cost it
+    ~0.9 us more, numba boxing them through Python)."""
+    alpha, beta, gamma, delta, c, q_rest = params
+    active, passive, total = out
     for j in range(alpha.size):
         a = alpha[j] * (ag[j] - at[j])
         b = beta[j] * (ag[j] + at[j] + 2.0 * c[j] + gamma[j]) * (q_rest[j] - q[j]) + delta[j] * qd[j]
@@ -61,8 +64,8 @@ class Ekeberg(Stage):
         ag, at, q, qd = sig["muscle.ag"], sig["muscle.at"], sig["joint.q"], sig["joint.qd"]
         n = self._params[0].size
         if ag.shape == at.shape == q.shape == qd.shape == (n,):  # every tick: one compiled call, new arrays
-            self.active, self.passive, total = np.empty(n), np.empty(n), np.empty(n)
-            _ekeberg(ag, at, q, qd, *self._params, self.active, self.passive, total)
+            out = self.active, self.passive, total = np.empty(n), np.empty(n), np.empty(n)
+            _ekeberg(ag, at, q, qd, self._params, out)
         else:
             self.active, self.passive = ekeberg_torque(ag, at, q, qd, self.params)
             total = self.active + self.passive
