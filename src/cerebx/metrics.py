@@ -61,14 +61,14 @@ class TrialAccumulator:
             np.subtract(qd_des, qd, out=self.vel_err[i])
             self.tau[i] = tau
         if ee_des is not None and ee is not None:
-            if fits and ee_des.shape == ee.shape == (3,) and ee_des.dtype is ee.dtype is _F64:  # Python floats: the
-                # same doubles in a third of the time numpy's scalars take
+            f64 = getattr(ee_des, "dtype", None) is _F64 is getattr(ee, "dtype", None)
+            if f64 and ee_des.shape == ee.shape == (3,):  # Python floats: the same doubles, a third of numpy's time
                 (a0, a1, a2), (b0, b1, b2) = ee_des.tolist(), ee.tolist()
                 d0, d1, d2 = a0 - b0, a1 - b1, a2 - b2
-                self.ee_err[i] = (d0 * d0 + d1 * d1 + d2 * d2) ** 0.5
             else:
                 d = ee_des - ee
-                self.ee_err[i] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) ** 0.5
+                d0, d1, d2 = d[0], d[1], d[2]
+            self.ee_err[i] = (d0 * d0 + d1 * d1 + d2 * d2) ** 0.5
         self.i = i + 1
 
     def finish(self, trial: int) -> TrialMetrics:

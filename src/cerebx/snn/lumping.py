@@ -358,10 +358,10 @@ def merge(lp, pi, lo):
     that differ converge: the periodic steady states of cells with the same count of active fibres are the same
     float32 numbers): the smaller one's members join the larger, its slot is freed."""
     htab = lp.htab
-    # a table twice the classes in use (a power of 2, within htab): it stays in the first level of cache, where the
-    # whole htab (twice the population) made a cache miss of nearly every probe. Equal keys meet whatever the size
+    # a table twice the class slots in use (a power of 2, at most htab's size): probes into all of htab (twice the
+    # population) were the network thread's hot spot in samples. Equal keys meet whatever the size
     size = 16
-    while size < 2 * lp.n_cls[pi] and size < htab.shape[0]:
+    while size < 2 * lp.n_cls[pi]:
         size *= 2
     mask = min(size, htab.shape[0]) - 1
     cu, cg, cref, ccnt, csize = lp.cu, lp.cg, lp.cref, lp.ccnt, lp.csize
