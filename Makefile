@@ -49,9 +49,11 @@ run: $(STAMP) ## run the default experiment (RUN_ARGS=... to choose another)
 
 # tests/warm.py first compiles the kernels and solves the task paths the tests share, each once, on every core
 # (on a fresh clone the workers would otherwise compile the same kernels side by side)
+# (bytecode written even where the environment says not to: each process the tests start that imports cerebx would
+# compile its modules again without it, and pytest would rewrite every test module's asserts again)
 test: $(STAMP) ## unit and integration tests, not the slow ones (under 5 minutes on 2 cores)
-	$(BIN)/python tests/warm.py
-	$(BIN)/pytest -m "not slow" -n $(TEST_WORKERS)
+	PYTHONDONTWRITEBYTECODE= $(BIN)/python tests/warm.py
+	PYTHONDONTWRITEBYTECODE= $(BIN)/pytest -m "not slow" -n $(TEST_WORKERS)
 
 test-unit: $(STAMP) ## only the unit tests (seconds)
 	$(BIN)/pytest -m unit

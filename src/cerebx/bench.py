@@ -35,7 +35,7 @@ def _per_step_parts(net: Network, inputs: list[np.ndarray]) -> tuple[dict[str, f
     """Microseconds per step of each part of the network's kernels over ``inputs`` (``total``: the profiled
     steps' wall time, calls included), and the mean number of neurons off rest that each population with a list
     of them (``compact``: the granule cells) integrates per step."""
-    net.step(inputs[0])  # a profiled step runs code of its own: compiled (or loaded) before the clock starts
+    net.step(inputs[0])  # the step kernel compiled (or loaded) before the clock starts
     net.start_profile()
     listed = np.zeros_like(net.n_act)
     classes = np.zeros_like(net.n_act)

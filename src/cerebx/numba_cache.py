@@ -9,10 +9,16 @@ an index newer than its source. A run compiles only the kernels it calls: a modu
 called yet (the checkpoint writer's, in runs shorter than ``checkpoint_every``) stays counted as cold, so less than
 ``MIN_REPORTED_S`` of compiling is not reported.
 
-The cost is measured, not derived: the first small spiking run (``+task=circle +experiment=small_snn
-trials=1``) compiled its 29 kernels in 25.5 s (28.2 s cold, 2.7 s warm) on the 2-core development machine while
-it ran two other jobs (2026-11-27); the three largest (the network's step and chunk, the controller's chunk
-outputs) take most of it. Hence about 0.9 s per kernel.
+The cost is measured, not derived, on a quiet 2-core machine (2026-11-29, an AMD EPYC that LLVM calls znver3):
+the first PD run (``+experiment=demo trials=1``), 5 kernels counted cold, took 3.6 s against 2.2 s warm, about
+0.3 s per kernel; the first small spiking run (``+task=circle +experiment=small_snn trials=1``), 82 kernels
+counted, 118-123 s against 3 s warm. Most of that is the network's step (``cerebx.snn.kernels``): the step kernel
+and the three that call it (the chunk, the controller's chunk outputs, those on encoded ticks) each optimise the
+whole step again, and the step holds every integrator the schema offers (AdEx, lif_cond with GABA), used by the run
+or not. The first Capolei run (``+experiment=capolei2020_arch3 trials=1``), 16 kernels counted, took 41 s against
+2.9 s warm: LWPR's kernels, compiled for each model shape (``cerebx.lwpr.kernels``). Hence 0.3 s a kernel, and
+:data:`HEAVY_MODULES` on top for those two modules when they are cold. (2026-11-27, before the network vocabulary,
+on the development machine: 29 kernels counted, 25.5 s.)
 """
 
 from __future__ import annotations
@@ -29,7 +35,9 @@ from typing import Any
 
 from cerebx import registry
 
-COMPILE_S_PER_KERNEL = 0.9
+COMPILE_S_PER_KERNEL = 0.3
+HEAVY_MODULES = {"cerebx.snn.kernels": 90.0, "cerebx.lwpr.kernels": 33.0}
+"""Seconds that compiling a cold module's kernels takes besides the per-kernel seconds (measured, see above)."""
 MIN_REPORTED_S = 5.0
 """Less compiling than this is left out of the estimate (it is within its noise, and partly kernels of modules a
 run imports without calling them)."""
@@ -47,7 +55,7 @@ class ColdKernels:
 
     @property
     def seconds(self) -> float:
-        return self.kernels * COMPILE_S_PER_KERNEL
+        return self.kernels * COMPILE_S_PER_KERNEL + sum(HEAVY_MODULES.get(m, 0.0) for m in self.modules)
 
     @property
     def reported(self) -> bool:

@@ -158,7 +158,10 @@ nanoseconds: one entry per population (its integration: neuron updates, threshol
 spike delivery (the synaptic currents, the sparse delivery caches' rebuilds and the activation of resting
 neurons), plasticity (sparse rules, LTP, the PF buffer, LTD), bookkeeping (the spike ring, collecting the
 spikes, compacting the lists of active neurons) and the chunk's outputs (decoding, spike messages). Without a
-profile (``prof`` None) the timing calls are compiled away."""
+profile ``prof`` is :data:`NO_PROF`, an empty array: the same compiled code, whose timing calls then read no clock
+(one branch each). (``prof`` None compiled the timing away, but as a second version of every step kernel: ~30 s
+more of compiling on a new machine, for what the branch costs, well under 0.1 µs a step.)"""
+NO_PROF = np.zeros(0, dtype=np.int64)
 _CLOCK = time.CLOCK_MONOTONIC
 
 
@@ -180,7 +183,7 @@ def _clock_ns(typingctx):
 
 
 def prof_now(prof):
-    """The clock (ns) when ``prof`` is a profile, else 0; numba code only."""
+    """The clock (ns) when ``prof`` is a profile (not empty), else 0; numba code only."""
     raise NotImplementedError
 
 
@@ -203,7 +206,13 @@ def _off(prof) -> bool:
 def _now_impl(prof):
     if _off(prof):
         return lambda prof: 0
-    return lambda prof: _clock_ns()
+
+    def impl(prof):
+        if prof.shape[0] == 0:
+            return 0
+        return _clock_ns()
+
+    return impl
 
 
 @overload(prof_lap)
@@ -212,6 +221,8 @@ def _lap_impl(prof, k, t0):
         return lambda prof, k, t0: t0
 
     def impl(prof, k, t0):
+        if prof.shape[0] == 0:
+            return t0
         t = _clock_ns()
         prof[k] += t - t0
         return t
@@ -841,12 +852,13 @@ def lif_step(u, gA, gN, gG, ref, p, nf, listed=False):
 W_FLOOR = np.float32(1e-12)  # |w| below this (pA) becomes exactly 0 (avoids denormals when a = 0)
 
 
-@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False, inline="always")
+@njit(cache=True, fastmath=True, error_model="numpy", boundscheck=False)
 def _exp32(y):
     """e^y in float32 without a library call, so the AdEx loop vectorises (numba has no vector exp without
     SVML): e^y = (e^(y/256))^256, a degree-6 Taylor polynomial for e^(y/256), y clamped to [-80, 60] (the
     schema bounds the exponent at 60; e^-80 ~ 2e-35). Max relative error 5e-5 (float32 rounding of the eight
-    squarings; see tests)."""
+    squarings; see tests). Not inlined by numba: LLVM inlines it, with the same results and speed, and compiling
+    :func:`_adex` (21 copies of it) took 16 s instead of 11."""
     f32 = np.float32
     y = min(max(y, f32(-80.0)), f32(60.0)) * f32(1.0 / 256.0)
     e = f32(1.0) + y * (f32(1.0) + y * (f32(0.5) + y * (f32(1.0 / 6.0) + y * (f32(1.0 / 24.0) + y * (
@@ -1169,8 +1181,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
     substeps starting at substep t0.
 
     ``inputs`` are global indices of input fibres spiking at t0; ``learn``: plasticity on; ``par``:
-    numba threads for the large populations; ``prof``: None, or a cost profile the step adds its
-    parts' times to (:data:`PROF_PARTS`). Returns the number of spikes written to
+    numba threads for the large populations; ``prof``: :data:`NO_PROF`, or a cost profile the step adds
+    its parts' times to (:data:`PROF_PARTS`). Returns the number of spikes written to
     out_idx/out_t (out_t = substep 1..n_sub at whose end the spike happened).
 
     Sparse projections onto a compact population deliver through a per-presynaptic-neuron cache of
@@ -1217,6 +1229,8 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                 continue
             plo = pop_i[pp, I_LO]
             if lumps.proj[pp] == p:  # a lumped population: only the neurons whose input changed move
+                if not lumping.in_window(t, delay, n_sub, ratio):
+                    continue
                 if lumping.arrival_window(lumps, pp, p, t, n_sub, ratio, dl, nrn, plo, pop_i[pp, I_HI]) == 0:
                     continue
             compact = pop_i[pp, I_COMPACT] != 0
@@ -1394,7 +1408,7 @@ def run_step(t0, n_sub, inputs, learn, par, net, prof):
                 if nr > lumps.n_free[pi]:
                     lumping.dissolve(lumps, pi, lo, n_act)
                 lumping.merge(lumps, pi, lo)
-                if not lumping.worth_it(lumps, pi, n_act):
+                if not lumping.worth_it(lumps.n_cls, lumps.n_free, pi, n_act):
                     lumping.release(lumps, pi, lo, pop_i[pi, I_HI], nrn)
                 continue
             na = n_act[pi]

@@ -212,9 +212,9 @@ def arrival_window(lp, pi, p, t, n_sub, ratio, dl, nrn, lo, hi):
     the caller delivers this window's spikes to the list."""
     sp_i, sp_ptr, sp_post, ring_idx, ring_n = dl.sp_i, dl.sp_ptr, dl.sp_post, dl.ring_idx, dl.ring_n
     delay = sp_i[p, S_DELAY]
-    a = (t - delay) % n_sub
-    if a >= ratio or t - delay - a < 0:
+    if not in_window(t, delay, n_sub, ratio):
         return 0
+    a = (t - delay) % n_sub
     pre_lo, n_pre, off = sp_i[p, S_PRE_LO], sp_i[p, S_N_PRE], sp_i[p, S_ROW]
     R = ring_idx.shape[0]
     sl = (t - a - delay) % R
@@ -415,11 +415,23 @@ LUMP_MIN = 256  # ... once it has this many off rest
 
 
 @njit(cache=True, boundscheck=False)
-def worth_it(lp, pi, n_act):
+def worth_it(n_cls, n_free, pi, n_act):
     """Whether the classes still pay: with input that changes at most spikes (Poisson fibres) nearly every neuron
-    off rest has a class of its own, and moving neurons between classes costs more than stepping the list."""
-    live = lp.n_cls[pi] - lp.n_free[pi]
+    off rest has a class of its own, and moving neurons between classes costs more than stepping the list.
+    (``n_cls``, ``n_free``: the :class:`Lumps` arrays, not the whole tuple: a compiled call counts a reference to
+    every array of a tuple it is passed, 27 here, on entry and again on return, every granule step.)"""
+    live = n_cls[pi] - n_free[pi]
     return n_act[pi] < LUMP_MIN or LUMP_MAX * live <= n_act[pi]
+
+
+@njit(cache=True, inline="always")
+def in_window(t, delay, n_sub, ratio):
+    """Whether delivery step ``t`` of a projection with ``delay`` (substeps) onto a population stepping every
+    ``ratio`` substeps is an arrival window of one control step's spikes (of ``n_sub`` substeps): the test
+    :func:`arrival_window` starts with, for its caller to make before the call (which passes three tuples of
+    arrays: ~100 reference counts, at every substep)."""
+    a = (t - delay) % n_sub
+    return a < ratio and t - delay - a >= 0
 
 
 def lump(lp: Lumps, pi: int, lo: int, hi: int, pre: tuple[int, int], nrn: Any) -> None:

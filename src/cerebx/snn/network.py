@@ -592,15 +592,20 @@ class Network:
         n = len(in_off) - 1
         idx, off = self.chunk_buffers(n)
         total = kernels.run_chunk(self.t_sub, self.n_sub, flat, in_off, self.learn, self.n_threads, self._state,
-                                  idx, off, self.prof)
+                                  idx, off, self.kernel_prof)
         self.t_sub += self.n_sub * n
         return idx[:total].copy(), off
 
     def start_profile(self) -> None:
-        """Time the kernels' parts from now on (:data:`~cerebx.snn.kernels.PROF_PARTS`; ``cerebx bench``). A
-        profiled step runs other compiled code than an unprofiled one (compiled on first use), with the same
-        results; unprofiled steps carry no timing code at all."""
+        """Time the kernels' parts from now on (:data:`~cerebx.snn.kernels.PROF_PARTS`; ``cerebx bench``), until
+        ``prof`` is set to None. Profiled and unprofiled steps run the same compiled code, with the same results;
+        unprofiled, its timing calls read no clock."""
         self.prof = np.zeros(len(self.topo.names) + len(kernels.PROF_PARTS), dtype=np.int64)
+
+    @property
+    def kernel_prof(self) -> np.ndarray:
+        """``prof`` as the step kernels take it: the profile, or :data:`~cerebx.snn.kernels.NO_PROF`."""
+        return kernels.NO_PROF if self.prof is None else self.prof
 
     def profile(self) -> dict[str, float]:
         """Seconds per part since :meth:`start_profile`: ``integrate.<population>`` for each population integrated,
@@ -626,6 +631,7 @@ class Network:
         """One 2 ms step; ``inputs`` are global indices of input fibres spiking at its start
         (each fibre at most once)."""
         inputs = np.ascontiguousarray(inputs, dtype=np.int32)
-        n = kernels.run_step(self.t_sub, self.n_sub, inputs, self.learn, self.n_threads, self._state, self.prof)
+        n = kernels.run_step(self.t_sub, self.n_sub, inputs, self.learn, self.n_threads, self._state,
+                             self.kernel_prof)
         self.t_sub += self.n_sub
         return StepSpikes(self.out_idx[:n], self.out_t[:n])

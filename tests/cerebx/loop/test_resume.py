@@ -34,20 +34,20 @@ def _summary(run_dir: Path) -> dict:
 
 
 def test_sigkilled_run_resumes_to_the_same_trials(tmp_path):
-    trials, every = 32, 4
+    trials, every, kill_after = 20, 4, 8
     whole, killed = tmp_path / "whole", tmp_path / "killed"
     ref = _cerebx(*RUN, f"trials={trials}", f"recording.checkpoint_every={every}", f"hydra.run.dir={whole}",
                   cwd=tmp_path)
     run = _cerebx(*RUN, f"trials={trials}", f"recording.checkpoint_every={every}", f"hydra.run.dir={killed}",
                   cwd=tmp_path)
-    _wait_for_checkpoint(killed, 12, run)
+    _wait_for_checkpoint(killed, kill_after, run)
     time.sleep(0.2)  # into the next trials, which the continuation runs again
     run.send_signal(signal.SIGKILL)
     run.wait()
     assert ref.wait() == 0, ref.stdout.read()
     assert not (killed / "summary.json").exists() or _summary(killed)["status"] != "completed"
     done_at_kill = checkpoint.read_head(killed)["trials_done"]  # the committed one (its .json copy may lag)
-    assert 12 <= done_at_kill < trials
+    assert kill_after <= done_at_kill < trials
 
     cont = _cerebx(f"resume={killed}", cwd=tmp_path)
     out, _ = cont.communicate(timeout=300)
@@ -80,18 +80,19 @@ def test_sigkilled_run_resumes_to_the_same_trials(tmp_path):
 def test_sigkilled_learning_run_resumes_to_the_same_weights(tmp_path):
     """The spiking network's weights: written ahead of the first checkpoint from the live array, then only
     their changed rows; a resumed process writes its own file ahead (after settling the committed journal)."""
-    args = ["+task=circle", "+experiment=small_snn", "recording.progress=off", "trials=30",
-            "recording.checkpoint_every=5"]
+    trials = 16
+    args = ["+task=circle", "+experiment=small_snn", "recording.progress=off", f"trials={trials}",
+            "recording.checkpoint_every=4"]
     whole, killed = tmp_path / "whole", tmp_path / "killed"
     ref = _cerebx(*args, f"hydra.run.dir={whole}", cwd=tmp_path)  # beside the run that is killed
     run = _cerebx(*args, f"hydra.run.dir={killed}", cwd=tmp_path)
-    _wait_for_checkpoint(killed, 10, run)
+    _wait_for_checkpoint(killed, 8, run)
     run.send_signal(signal.SIGKILL)
     run.wait()
     assert ref.wait() == 0, ref.stdout.read()
     head = checkpoint.read_head(killed)
-    assert head["arrays"]["file"] == "checkpoint.5.arrays"  # written ahead, then journals on top
-    assert head["trials_done"] < 30
+    assert head["arrays"]["file"] == "checkpoint.4.arrays"  # written ahead, then journals on top
+    assert head["trials_done"] < trials
     cont = _cerebx(f"resume={killed}", cwd=tmp_path)
     out, _ = cont.communicate(timeout=300)
     assert cont.returncode == 0, out

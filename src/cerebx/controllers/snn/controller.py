@@ -107,7 +107,8 @@ def _run_chunk_outputs(net, clock, chunk, outputs, prof):  # pragma: no cover
     ``net``: the network's kernel state; ``clock``: (first substep, substeps per step, plasticity on, threads);
     ``chunk``: the packed inputs and offsets, and the spike buffer and step offsets to fill
     (:meth:`~cerebx.snn.network.Network.chunk_buffers`); ``outputs``: the arguments of :func:`_chunk_outputs`
-    after the spikes; ``prof``: None or the network's cost profile."""
+    after the spikes; ``prof``: the network's cost profile or :data:`~cerebx.snn.kernels.NO_PROF`
+    (:attr:`~cerebx.snn.network.Network.kernel_prof`)."""
     t0, n_sub, learn, par = clock
     flat, in_off, idx_buf, off = chunk
     decode, record, first, step_s = outputs
@@ -342,7 +343,7 @@ class SNNControllerImpl(Controller):
         idx_buf, off = net.chunk_buffers(n)
         taus, counts, words, starts, lost = kernel(
             *lead, net._state, (net.t_sub, net.n_sub, learn, net.n_threads), (*inputs, idx_buf, off),
-            (self._decode, record, first_step, STEP_S), net.prof)
+            (self._decode, record, first_step, STEP_S), net.kernel_prof)
         net.t_sub += net.n_sub * n
         if not recording:
             return Chunk(first_step, taus, counts, None, None, lost)
