@@ -112,7 +112,7 @@ def per_step_parts(loop: ClosedLoop, trials: range, steps_per_trial: int) -> dic
     instrument(loop, clock)
     net = getattr(loop.ctx.controller, "net", None)  # a spiking controller's network
     net = net if hasattr(net, "start_profile") else None
-    if net is not None:  # an untimed first trial with the profile on, the timing's own first calls in it
+    if net is not None:  # an untimed first trial with the profile on (kept: the timed trials stay those they were)
         net.start_profile()
         loop.run_trial(trials[0])
         loop.settle()

@@ -72,7 +72,7 @@ from llvmlite import ir
 from numba import njit, prange, types
 from numba.core import cgutils
 from numba.cpython.unsafe.numbers import trailing_zeros
-from numba.extending import intrinsic, overload
+from numba.extending import intrinsic
 
 from cerebx.kernel_struct import KernelStruct
 from cerebx.snn import lumping
@@ -159,8 +159,8 @@ spike delivery (the synaptic currents, the sparse delivery caches' rebuilds and 
 neurons), plasticity (sparse rules, LTP, the PF buffer, LTD), bookkeeping (the spike ring, collecting the
 spikes, compacting the lists of active neurons) and the chunk's outputs (decoding, spike messages). Without a
 profile ``prof`` is :data:`NO_PROF`, an empty array: the same compiled code, whose timing calls then read no clock
-(one branch each). (``prof`` None compiled the timing away, but as a second version of every step kernel: ~30 s
-more of compiling on a new machine, for what the branch costs, well under 0.1 µs a step.)"""
+(one branch each). (``prof`` None used to compile the timing away, but as a second version of every step kernel:
+~30 s more of compiling on a new machine, for what the branch costs, well under 0.1 µs a step.)"""
 NO_PROF = np.zeros(0, dtype=np.int64)
 _CLOCK = time.CLOCK_MONOTONIC
 
@@ -182,52 +182,28 @@ def _clock_ns(typingctx):
     return types.int64(), codegen
 
 
+# Not inline="always": after inlining, numba (0.68) runs a typed dead-code elimination whose alias analysis does not
+# follow arrays taken out of a tuple (the KernelState's NamedTuples): a store into such an array that is not read
+# again in the function is dropped as dead. run_step lost the LTP's row mark (plast.dirty[pl, j] = 1) when these
+# were inlined overloads, so checkpoints missed rows that only LTP had changed and resumed runs diverged.
+# Called, they compile to a few instructions that LLVM inlines.
+@njit(cache=True, nogil=True)
 def prof_now(prof):
-    """The clock (ns) when ``prof`` is a profile (not empty), else 0; numba code only."""
-    raise NotImplementedError
+    """The clock (ns) when ``prof`` is a profile (not :data:`NO_PROF`), else 0."""
+    if prof.shape[0] == 0:
+        return 0
+    return _clock_ns()
 
 
+@njit(cache=True, nogil=True)
 def prof_lap(prof, k, t0):
-    """Charge the time since ``t0`` to ``prof[k]`` and return the clock now; without a profile, nothing (returns
-    t0); numba code only."""
-    raise NotImplementedError
-
-
-def _off(prof) -> bool:
-    return isinstance(prof, (types.NoneType, types.Omitted))
-
-
-# Not inline="always": after inlining an overload, numba (0.68) runs a typed dead-code elimination whose alias
-# analysis does not follow arrays taken out of a tuple (the KernelState's NamedTuples): a store into such an array
-# that is not read again in the function is dropped as dead. run_step lost the LTP's row mark
-# (plast.dirty[pl, j] = 1), so checkpoints missed rows that only LTP had changed and resumed runs diverged.
-# Called, these compile to a few instructions that LLVM inlines.
-@overload(prof_now)
-def _now_impl(prof):
-    if _off(prof):
-        return lambda prof: 0
-
-    def impl(prof):
-        if prof.shape[0] == 0:
-            return 0
-        return _clock_ns()
-
-    return impl
-
-
-@overload(prof_lap)
-def _lap_impl(prof, k, t0):
-    if _off(prof):
-        return lambda prof, k, t0: t0
-
-    def impl(prof, k, t0):
-        if prof.shape[0] == 0:
-            return t0
-        t = _clock_ns()
-        prof[k] += t - t0
-        return t
-
-    return impl
+    """Charge the time since ``t0`` to ``prof[k]`` and return the clock now; without a profile (:data:`NO_PROF`),
+    nothing (returns t0)."""
+    if prof.shape[0] == 0:
+        return t0
+    t = _clock_ns()
+    prof[k] += t - t0
+    return t
 
 
 class Neurons(NamedTuple):

@@ -201,19 +201,16 @@ def _move(lp, pi, lo, n_act, nt):
 
 @njit(cache=True, boundscheck=False)
 def arrival_window(lp, pi, p, t, n_sub, ratio, dl, nrn, lo, hi):
-    """The lumped population ``pi``'s input at its delivery step ``t`` (projection ``p``): when the input
-    population's spikes of one control step arrive in this window (``dl``: the kernels' ``Delivery``), move the
-    neurons whose count changed since the
-    previous such window and add each class's count of spikes to its conductance. The spikes arrive at ``t``
-    itself (the projection's delay is a multiple of the population's step: :func:`eligible`), so each adds the
-    weight unscaled, exactly as the unlumped delivery's ``w * 1`` does. Returns 0 when done (an arrival window or
-    not); 1 when a cell's count would change by more than KMAX (a fibre given several times in one step): the
-    population then goes back to its list for good (``nrn``: the kernels' ``Neurons``; [lo, hi): its range) and
-    the caller delivers this window's spikes to the list."""
+    """The lumped population ``pi``'s input at its delivery step ``t`` (projection ``p``), an arrival window of the
+    input population's spikes of one control step (the caller tests :func:`in_window` first; ``dl``: the kernels'
+    ``Delivery``): move the neurons whose count changed since the previous such window and add each class's count
+    of spikes to its conductance. The spikes arrive at ``t`` itself (the projection's delay is a multiple of the
+    population's step: :func:`eligible`), so each adds the weight unscaled, exactly as the unlumped delivery's
+    ``w * 1`` does. Returns 0 when done; 1 when a cell's count would change by more than KMAX (a fibre given
+    several times in one step): the population then goes back to its list for good (``nrn``: the kernels'
+    ``Neurons``; [lo, hi): its range) and the caller delivers this window's spikes to the list."""
     sp_i, sp_ptr, sp_post, ring_idx, ring_n = dl.sp_i, dl.sp_ptr, dl.sp_post, dl.ring_idx, dl.ring_n
     delay = sp_i[p, S_DELAY]
-    if not in_window(t, delay, n_sub, ratio):
-        return 0
     a = (t - delay) % n_sub
     pre_lo, n_pre, off = sp_i[p, S_PRE_LO], sp_i[p, S_N_PRE], sp_i[p, S_ROW]
     R = ring_idx.shape[0]
@@ -427,9 +424,9 @@ def worth_it(n_cls, n_free, pi, n_act):
 @njit(cache=True, inline="always")
 def in_window(t, delay, n_sub, ratio):
     """Whether delivery step ``t`` of a projection with ``delay`` (substeps) onto a population stepping every
-    ``ratio`` substeps is an arrival window of one control step's spikes (of ``n_sub`` substeps): the test
-    :func:`arrival_window` starts with, for its caller to make before the call (which passes three tuples of
-    arrays: ~100 reference counts, at every substep)."""
+    ``ratio`` substeps is an arrival window of one control step's spikes (of ``n_sub`` substeps): where
+    :func:`arrival_window` is called, made by the caller before the call (which passes three tuples of arrays:
+    ~100 reference counts, at every step of the population)."""
     a = (t - delay) % n_sub
     return a < ratio and t - delay - a >= 0
 
