@@ -15,14 +15,16 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from hydra import compose as hydra_compose
 from hydra import initialize_config_module, version
+from hydra._internal.config_loader_impl import ConfigLoaderImpl
+from hydra._internal.defaults_list import create_defaults_list
 from hydra._internal.hydra import Hydra
 from hydra._internal.utils import create_automatic_config_search_path
 from hydra.core.config_search_path import SearchPathQuery
 from hydra.core.global_hydra import GlobalHydra
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.errors import HydraException
+from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 
@@ -119,7 +121,7 @@ def through_references(overrides: list[str], config_dir: str | None, others: lis
     base = [o for o in (others or overrides) if not _is_hydra(o) and "." not in _override_key(o)]
     try:
         with _COMPOSING, _hydra(config_dir):
-            cfg = hydra_compose(config_name="config", overrides=base)
+            cfg = _compose_app(base)[0]
     except (HydraException, OmegaConfBaseException, ValueError):
         return []
     lines = []
@@ -197,19 +199,47 @@ def compose_with_choices(overrides: list[str], config_dir: str | None = None) ->
         raise ConfigError(problems)
     try:
         with _COMPOSING, _hydra(config_dir):
-            cfg = hydra_compose(config_name="config", overrides=[o for o in overrides if not _is_hydra(o)],
-                                return_hydra_config=True)
+            cfg, chosen = _compose_app([o for o in overrides if not _is_hydra(o)])
     except (HydraException, OmegaConfBaseException, ValueError) as err:
         lines = through_references(overrides, config_dir) or _hydra_lines(err, overrides, config_dir)
         raise ConfigError(lines) from None
-    choices = user_choices(cfg.hydra.runtime.choices)
-    with open_dict(cfg):
-        del cfg["hydra"]
-    return cfg, choices
+    return cfg, user_choices(chosen)
+
+
+def _compose_app(overrides: list[str], keep_hydra: bool = False) -> tuple[DictConfig, dict[str, str | None]]:
+    """Hydra's composition of ``config`` with ``overrides``, without Hydra's own configuration (launcher, sweeper,
+    logging, output folders, help: a dozen configs and their schema, half the time of a composition), which
+    only a running Hydra app reads; and the option chosen in each config group. The steps of Hydra's
+    ``ConfigLoaderImpl.load_configuration`` (hydra-core 1.3) with the defaults list made without Hydra's tree
+    (``tests/cerebx/test_config.py`` checks it composes what Hydra's ``compose`` does). The ``hydra`` node the
+    primary config and the presets set (e.g. a preset's sweep, ``hydra.sweeper.params``) is dropped unless
+    ``keep_hydra``."""
+    loader = GlobalHydra.instance().config_loader()
+    parsed, repo = loader._parse_overrides_and_create_caching_repo("config", overrides)
+    loader.validate_sweep_overrides_legal(overrides=parsed, run_mode=RunMode.RUN, from_shell=False)
+    defaults = create_defaults_list(repo=repo, config_name="config", overrides_list=parsed, prepend_hydra=False,
+                                    skip_missing=False)
+    cfg = loader._compose_config_from_defaults_list(defaults=defaults.defaults, repo=repo)
+    OmegaConf.set_struct(cfg, True)
+    ConfigLoaderImpl._apply_overrides_to_config(defaults.config_overrides, cfg)
+    if not keep_hydra:
+        with open_dict(cfg):
+            cfg.pop("hydra", None)
+    return cfg, dict(defaults.overrides.known_choices)
+
+
+def preset_sweep_params(overrides: list[str]) -> dict[str, Any]:
+    """The sweep the presets ``overrides`` choose declare (``hydra.sweeper.params``, values as written; empty
+    when none). Raises Hydra's exception when they do not compose."""
+    with _COMPOSING, _hydra(None):
+        node = OmegaConf.select(_compose_app(overrides, keep_hydra=True)[0], "hydra.sweeper.params")
+    params = OmegaConf.to_container(node, resolve=False) if node else {}
+    assert isinstance(params, dict)
+    return params
 
 
 @contextlib.contextmanager
-def _hydra(config_dir: str | None) -> Iterator[None]:
+def _hydra(config_dir: str | None = None) -> Iterator[None]:
     """Hydra set up on cerebx's presets; a ``--config-dir`` folder is searched first, as ``cerebx run`` does."""
     GlobalHydra.instance().clear()
     if config_dir is None:

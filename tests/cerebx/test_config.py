@@ -280,3 +280,31 @@ def test_a_sweep_folder_another_sweep_is_starting_in_is_no_problem(tmp_path):
     assert config.check_output_dir([f"hydra.sweep.dir={sweep}"], multirun=True) == [
         f"hydra.sweep.dir: {sweep}: is an existing folder that holds no run; give a new folder, e.g. runs/mine "
         "(or an empty one)"]
+
+
+@pytest.mark.parametrize("overrides", [
+    ["+task=circle"],
+    ["+experiment=small_snn", "+task=eight", "trials=3", "delay=gamma45"],
+    ["+experiment=capolei2020_arch3", "~recording"],
+    ["+experiment=luque2011_fig8"],
+    ["+experiment=fig3_4_snn", "delay=gamma45"],
+    ["+task=circle", "+biodelay=d100"],
+])
+def test_composing_without_hydras_own_tree_gives_what_hydra_composes(overrides):
+    """cerebx composes without Hydra's own configuration (config._compose_app, Hydra's steps on a shorter defaults
+    list): the same experiment and the same chosen options as Hydra's ``compose``."""
+    from hydra import compose, initialize_config_module
+    from hydra.core.global_hydra import GlobalHydra
+    from omegaconf import open_dict
+
+    from cerebx.config import compose_with_choices, to_plain, user_choices
+
+    mine, chosen = compose_with_choices(overrides)
+    GlobalHydra.instance().clear()
+    with initialize_config_module(config_module="cerebx.conf", version_base="1.3"):
+        theirs = compose(config_name="config", overrides=overrides, return_hydra_config=True)
+    GlobalHydra.instance().clear()
+    assert chosen == user_choices(theirs.hydra.runtime.choices)
+    with open_dict(theirs):
+        del theirs["hydra"]
+    assert to_plain(mine) == to_plain(theirs)

@@ -32,15 +32,12 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 import yaml
-from hydra import compose, initialize_config_module
-from hydra.core.global_hydra import GlobalHydra
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.errors import HydraException
-from omegaconf import OmegaConf
 from pydantic import ValidationError
 
 from cerebx import runfiles
-from cerebx.config import compose_with_choices, expand_sweep, load, to_plain
+from cerebx.config import compose_with_choices, expand_sweep, load, preset_sweep_params, to_plain
 from cerebx.errors import CerebxError, ConfigError
 from cerebx.loop.resume import stale
 from cerebx.loop.runner import run_experiment
@@ -204,14 +201,10 @@ def preset_sweep(args: list[str]) -> list[list[str]]:
 def _preset_sweep(args: tuple[str, ...]) -> tuple[tuple[str, ...], ...]:
     given = [a for a in args if is_sweep(a)]
     args = [a for a in args if not is_sweep(a)]
-    GlobalHydra.instance().clear()
     try:
-        with initialize_config_module(config_module="cerebx.conf", version_base="1.3"):
-            hydra_cfg = compose(config_name="config", overrides=args, return_hydra_config=True).hydra
+        params = preset_sweep_params(args)
     except HydraException as err:
         raise ConfigError(f"study {' '.join(args)}: {str(err).splitlines()[0]}") from None
-    node = hydra_cfg.sweeper.get("params")
-    params = OmegaConf.to_container(node, resolve=False) if node else {}
     fixed = {_key(a) for a in [*args, *given]}
     sweep = [f"{k}={v}" for k, v in params.items() if _key(k) not in fixed] + given
     return tuple(tuple(sorted(c)) for c in expand_sweep(sweep)) if sweep else ((),)
