@@ -239,7 +239,7 @@ def preset_sweep_params(overrides: list[str]) -> dict[str, Any]:
 
 
 @contextlib.contextmanager
-def _hydra(config_dir: str | None = None) -> Iterator[None]:
+def _hydra(config_dir: str | None) -> Iterator[None]:
     """Hydra set up on cerebx's presets; a ``--config-dir`` folder is searched first, as ``cerebx run`` does."""
     GlobalHydra.instance().clear()
     if config_dir is None:
