@@ -433,12 +433,18 @@ def compose_steps(aff, first, steps):  # pragma: no cover - numba
 
 class AfferentRing:
     """The built-in MF and CF encoders of a pipelined controller, stepped on the network thread: the loop's
-    thread appends each tick's six signals to :attr:`kept` and, when it hands a chunk over, draws
-    the CF fibres' uniforms of all its ticks in one call (numpy's stream, as one draw a tick gives it); the
-    chunk encodes them (:func:`encode_ticks`) and packs its steps' inputs (:func:`compose_steps`) inside its one
-    compiled call. The loop's thread then spends no encoder call, array or FIFO operation on a tick. (Drawing
-    on the network thread instead, with numba's ``Generator``, gives the same numbers but costs that thread
-    more than it saves this one: 55 against 32 instructions a draw, 600 draws a tick.)
+    thread appends each tick's six signals to :attr:`kept` and, when it hands a chunk over, stacks them
+    (:meth:`take`). The CF fibres' uniforms of all the chunk's ticks are drawn in one call (:meth:`draws`:
+    numpy's stream, as one draw a tick gives it, filled without the interpreter lock), on the loop's thread
+    when it hands the chunk over or on the network thread when the chunk starts, whichever the controller
+    chooses (the thread with time to spare); the chunk's one compiled call then encodes them
+    (:func:`encode_ticks`) and packs its steps' inputs (:func:`compose_steps`). The loop's thread spends no
+    encoder call, array or FIFO operation on a tick. (With numba's ``Generator`` inside the compiled call the
+    numbers are the same but a draw costs 55 instructions against numpy's 32, 600 draws a tick.)
+
+    The batches of ticks taken are drawn in the order they were taken, wherever: :meth:`may_draw_now` says
+    whether every batch before the newest one is drawn already (a batch handed to the network thread is drawn
+    when its chunk starts), so the stream and every result are the same whichever thread draws.
 
     Ticks count from the controller's reset; network step n takes the MF fibres of tick n - ``k_mf`` and the
     CF fibres of tick n - ``k_cf`` (the pathway delays), as the controller's FIFOs of encoded ticks give them
@@ -461,6 +467,8 @@ class AfferentRing:
         self.state = AfferentState.of(self.arrays)
         self.kept: list = []  # ticks not yet taken to be encoded: six signals, or None without a sensor sample
         self.taken = 0  # ticks taken (the network thread may still be encoding them): counted here, not read there
+        self.batches = 0  # batches of ticks taken (:meth:`take`)
+        self.drawn = 0  # batches whose uniforms are drawn (:meth:`draws`, on either thread)
 
     @classmethod
     def of(cls, mf: object, cf: object, mf_first: int, cf_first: int, k_mf: int, k_cf: int,
@@ -475,10 +483,10 @@ class AfferentRing:
         """Ticks kept since the controller's reset (encoded or not)."""
         return self.taken + len(self.kept)
 
-    def take(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The ticks kept so far as :func:`encode_ticks` takes them (signals, sensed, the CF fibres' uniforms of
-        each tick with a sample, drawn now in one call: the stream of one draw a tick); the kept list starts
-        again."""
+    def take(self) -> tuple[np.ndarray, np.ndarray]:
+        """The ticks kept so far as :func:`encode_ticks` takes them (signals, and per tick its row of them or -1
+        without a sensor sample; the CF uniforms are drawn by :meth:`draws`, on the thread that encodes them);
+        the kept list starts again."""
         kept, self.kept = self.kept, []
         self.taken += len(kept)
         sensed = np.full(len(kept), -1, np.int64)
@@ -497,12 +505,29 @@ class AfferentRing:
             sensed[[i for i, k in enumerate(kept) if k is not None]] = np.arange(len(rows))
         else:
             signals = np.zeros((0, 6, nj))
-        return signals, sensed, self.cf.rng.random((len(rows), self.cf.burst_left.shape[0]))
+        self.batches += 1
+        return signals, sensed
+
+    def may_draw_now(self) -> bool:
+        """Whether the newest batch taken may be drawn now: every batch taken before it is drawn."""
+        return self.drawn == self.batches - 1
+
+    def draws(self, ticks: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`take`'s ticks with the CF fibres' uniforms of each tick with a sample, drawn now in one call
+        (the stream of one draw a tick; numpy fills it without the interpreter lock): what
+        :func:`encode_ticks` takes. Ticks drawn already (three arrays) are returned as they are. Batches are
+        drawn in the order they were taken (:meth:`may_draw_now`)."""
+        if len(ticks) == 3:
+            return ticks  # type: ignore[return-value]
+        signals, sensed = ticks
+        u = self.cf.rng.random((signals.shape[0], self.cf.burst_left.shape[0]))
+        self.drawn += 1
+        return signals, sensed, u
 
     def encode_now(self) -> None:
         """Encode the ticks kept, on this thread (nothing may be in flight on the network thread)."""
         if self.kept:
-            encode_ticks(self.state, *self.take())
+            encode_ticks(self.state, *self.draws(self.take()))
 
     @property
     def error(self) -> np.ndarray:
@@ -537,6 +562,7 @@ class AfferentRing:
         T = first + len(pending) - k_in + a.shift  # ring ticks seen
         self.kept = []
         self.taken = T - a.shift
+        self.drawn = self.batches  # nothing in flight: every batch taken is drawn
         a.mf_n[:] = 0
         a.cf_n[:] = 0
         a.rows[0] = T

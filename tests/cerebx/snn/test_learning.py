@@ -48,6 +48,62 @@ def test_pipelined_network_gives_identical_results(load):
     np.testing.assert_array_equal(runs[True][1], runs[False][1])
 
 
+@pytest.mark.parametrize("where", ["loop", "network", "alternating"])
+def test_cf_uniforms_drawn_on_either_thread_give_identical_results(load, monkeypatch, where):
+    """The pipelined controller draws a chunk's CF uniforms on the loop's thread or, as the chunk starts, on the
+    network thread (whichever has time to spare): forced to one, the other or each in turn, the torques, the
+    learned weights and the draws' stream are those of the synchronous controller."""
+    import threading
+
+    from cerebx.controllers.snn.controller import NetworkThread
+    from cerebx.snn.encoders import AfferentRing
+
+    drew: list[str] = []
+    draws = AfferentRing.draws
+
+    def counted(self, ticks):
+        if len(ticks) == 2:
+            drew.append(threading.current_thread().name)
+        return draws(self, ticks)
+
+    turns = iter(range(10**6))
+    behind = {"loop": lambda self: False, "network": lambda self: True,
+              "alternating": lambda self: next(turns) % 2 == 0}[where]
+    runs = {}
+    for pipeline in (True, False):
+        cfg = load(["+task=circle", "+experiment=small_snn", "trials=2", f"controller.pipeline={pipeline}"])
+        ctx = build_components(cfg)
+        if pipeline:
+            monkeypatch.setattr(NetworkThread, "ready", behind)
+            monkeypatch.setattr(AfferentRing, "draws", counted)
+        loop = ClosedLoop(ctx, None)
+        loop.start()
+        torques = []
+        control = ctx.controller.control
+
+        def recorded(inp, control=control, torques=torques):
+            msg = control(inp)
+            torques.append(msg.tau.copy())
+            return msg
+
+        ctx.controller.control = recorded
+        maes = [loop.run_trial(i).mae_per_joint for i in range(2)]
+        ctx.controller._join()
+        aff = getattr(ctx.controller, "_aff", None)
+        if pipeline:  # the ticks kept since the last chunk drawn too, as the synchronous controller has
+            assert aff is not None and aff.drawn == aff.batches > 0
+            aff.encode_now()
+        runs[pipeline] = (maes, np.array(torques), ctx.controller.net.weights("pf_pc").copy(),
+                          ctx.controller.cf.rng.random(3))
+        monkeypatch.undo()
+    assert runs[True][0] == runs[False][0]
+    for a, b in zip(runs[True][1:], runs[False][1:]):
+        np.testing.assert_array_equal(a, b)
+    on_network = drew.count("cerebx-snn")
+    assert {"loop": on_network < len(drew) // 4, "network": on_network > 3 * len(drew) // 4,
+            "alternating": 0 < on_network < len(drew)}[where], drew
+
+
 def test_init_from_other_network_is_one_clear_error(load, tmp_path, capsys):
     """A learned state from a different network is refused at validation with one line."""
     from cerebx.loop.runner import run_experiment

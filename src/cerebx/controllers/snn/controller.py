@@ -162,6 +162,10 @@ class NetworkThread:
         if hand_over:
             self._taken.get()  # lets go of the interpreter lock until the thread holds it and has the job
 
+    def ready(self) -> bool:
+        """Whether the oldest chunk not yet collected is done (:meth:`result` would not wait)."""
+        return not self._done.empty()
+
     def result(self) -> Any:
         """The result of the oldest chunk not yet collected (waits for it); raises what the chunk raised."""
         ok, value = self._done.get()
@@ -252,6 +256,9 @@ class SNNControllerImpl(Controller):
         # outputs not yet emitted (held back by the efferent delay unless they are stamped instead)
         self._ready: deque[np.ndarray] = deque([np.zeros(self.width)] * (k if self.hold else 0))
         self._net_step = 0  # network steps simulated so far (step m is stamped m * 2 ms)
+        # where the next chunk's CF uniforms are drawn (the same numbers either way, AfferentRing): on this thread
+        # while the network thread is the one behind (it was not done when this thread came for its chunk)
+        self._draw_here = False
         self._fifos_to_ring()
         self._des: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._dcn_spikes = 0
@@ -311,11 +318,14 @@ class SNNControllerImpl(Controller):
         return self._run_chunk(_run_chunk_outputs, (flat, in_off), len(in_off) - 1, first_step, (),
                                self._mode() if mode is None else mode)
 
-    def _simulate_ticks(self, ticks: tuple[np.ndarray, np.ndarray, np.ndarray], n: int, first_step: int,
+    def _simulate_ticks(self, ticks: tuple[np.ndarray, ...], n: int, first_step: int,
                         mode: tuple[int, bool] | None = None) -> Chunk:
         """:meth:`_simulate_packed` of the ``n`` steps from ``first_step`` on, their inputs packed from the ring of
-        encoded ticks after the ``ticks`` kept are encoded (:class:`~cerebx.snn.encoders.AfferentRing`)."""
+        encoded ticks after the ``ticks`` kept (:meth:`~cerebx.snn.encoders.AfferentRing.take`) are encoded: their
+        CF uniforms are drawn here unless they were when the chunk was handed over
+        (:meth:`~cerebx.snn.encoders.AfferentRing.draws`, :meth:`_launch`)."""
         mode = self._mode() if mode is None else mode
+        ticks = self._aff.draws(ticks)
         if mode[0] >= 2:  # the encoders go on (bursts, draws); the network does not run
             encode_ticks(self._aff.state, *ticks)
         return self._run_chunk(_run_ticks_chunk_outputs, (ticks, n), n, first_step, (self._aff.state,), mode)
@@ -377,7 +387,10 @@ class SNNControllerImpl(Controller):
         work is compiled code from the start)."""
         first = self._net_step + self._in_flight * self.chunk  # after the chunk still in flight, if one is
         if self._aff is not None:
-            simulate, args = self._simulate_ticks, (self._aff.take(), self.chunk, first, self._mode())
+            ticks = self._aff.take()
+            if self._draw_here and self._aff.may_draw_now():  # else drawn on the network thread as the chunk starts
+                ticks = self._aff.draws(ticks)
+            simulate, args = self._simulate_ticks, (ticks, self.chunk, first, self._mode())
         else:
             simulate, args = self._simulate_packed, (*pack([self._pending.popleft() for _ in range(self.chunk)]), first,
                                                      self._mode())
@@ -407,6 +420,8 @@ class SNNControllerImpl(Controller):
             self._in_flight -= 1
             if self.recorder is not None:
                 self.recorder.idle()  # the log's chunk compressed while this thread would wait
+            # the network thread behind this one: the next chunks' uniforms are drawn here, else there
+            self._draw_here = not self._thread.ready()
             try:
                 with phase_clock.charge("wait"):
                     chunk = self._thread.result()  # an exception of the network thread is raised here
@@ -454,6 +469,7 @@ class SNNControllerImpl(Controller):
             _, ticks, q, qd = des
             state["_des"] = {int(t): (q[i], qd[i]) for i, t in enumerate(ticks)}
         self.__dict__.update(state)
+        self.__dict__.setdefault("_draw_here", False)  # checkpoints of earlier code
         self._in_flight, self._thread = 0, None
         self._no_closing()  # pickled after every chunk was collected, so none was waiting (older code: none)
         if "_last_error" not in state:  # older code kept it as an attribute
