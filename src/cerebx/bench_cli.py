@@ -7,8 +7,11 @@ Output is JSON. Numbers are simulated seconds per wall second; ``per_step_us`` s
 goes, in microseconds per part (the PD loop's and each closed loop's main thread by phase, each network's kernels by
 part: :func:`cerebx.loop.timing.per_step_parts`), from extra timed steps after the untimed ones that give the
 factors. ``versus`` beside each closed loop: its speed over the PD loop's, the two timed trial by trial in turns in
-one process (steady on a host whose speed drifts within seconds). ``load_average`` and ``vector_bits``: the host's
-load around the measurements and the kernels' vector width (``cerebx.vectors``).
+one process (steady on a host whose speed drifts within seconds). ``beside_busy_core`` under the PD loop: its speed
+beside a core kept busy in compiled code over its speed alone, in turns
+(:func:`cerebx.loop.timing.beside_busy_core`): below 1 on a host whose cores slow each other, which bounds
+``versus`` (a closed loop's network thread keeps the other core busy). ``load_average`` and ``vector_bits``: the
+host's load around the measurements and the kernels' vector width (``cerebx.vectors``).
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from cerebx.vectors import vector_bits
 
 DEFAULT_NETWORKS = ("full", "multikernel")
 PD_LOOP = ["+task=circle", "controller=pd"]  # the plant's loop with PD, which a closed loop is timed against
+BUSY_ROUNDS = 40  # trials of the PD loop alone and beside a busy core, in turns
 
 
 def _one_network(name: str, seconds: float, warmup: float, parallel: bool, started: float) -> dict[str, Any]:
@@ -62,8 +66,10 @@ def _plant_pd(seconds: float) -> dict[str, Any]:
     rows = {}
     for label, extra in (("baxter_pd", []), ("baxter_pd_physics_1ms", ["plant.physics_dt_ms=1.0"]),
                          ("baxter_sea_pd", ["plant=baxter_sea"])):
-        r = closed_loop_rt([*PD_LOOP, *extra], seconds=seconds, warmup_s=1.0, parts=not extra)
-        rows[label] = {k: r[k] for k in ("rt_factor", "us_per_step", "cpu_us_per_step", "per_step_us") if k in r}
+        r = closed_loop_rt([*PD_LOOP, *extra], seconds=seconds, warmup_s=1.0, parts=not extra,
+                           beside_busy=0 if extra else BUSY_ROUNDS)
+        rows[label] = {k: r[k] for k in ("rt_factor", "us_per_step", "cpu_us_per_step", "per_step_us",
+                                         "beside_busy_core") if k in r}
     return rows
 
 

@@ -4,9 +4,13 @@ goes (:func:`per_step_parts`)."""
 from __future__ import annotations
 
 import statistics
+import threading
 import time
 from pathlib import Path
 from typing import Any
+
+import numpy as np
+from numba import njit
 
 from cerebx import phase_clock
 from cerebx.build import build_components
@@ -18,7 +22,7 @@ from cerebx.recording.recorder import Recorder
 
 def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float = 1.0,
                    record_to: Path | None = None, parts: bool = False,
-                   versus: list[str] | None = None, rounds: int = 8) -> dict[str, Any]:
+                   versus: list[str] | None = None, rounds: int = 8, beside_busy: int = 0) -> dict[str, Any]:
     """Run ``overrides`` for ``warmup_s`` (compilation, first-touch), then time ``seconds`` more: simulated
     seconds per wall second (``rt_factor``) and per CPU second of the process, all threads (``cpu_rt_factor``);
     ``cpu_us_per_step``: the CPU time per control step of the loop's own thread and of every other thread (a
@@ -30,7 +34,8 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
     another loop, e.g. the same plant and task with PD) that loop is built in this process too and ``rounds``
     trials of each are then timed in turns, one of this loop after one of the other: ``versus`` in the result
     (:func:`_in_turns`) gives their speed ratio pair by pair, which a host whose speed drifts within seconds
-    leaves far steadier than two factors taken minutes apart.
+    leaves far steadier than two factors taken minutes apart. With ``beside_busy`` rounds, this loop's trials are
+    timed alone and beside a busy core in turns (:func:`beside_busy_core`).
     """
     exp, _ = load(overrides)
     t0 = time.perf_counter()
@@ -54,8 +59,12 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
         if parts:
             first = warm_trials + timed_trials
             table = per_step_parts(loop, range(first, first + timed_trials), steps_per_trial)
+        next_trial = warm_trials + timed_trials * (2 if parts else 1)
         if versus is not None:
-            turns = _in_turns(loop, warm_trials + timed_trials * (2 if parts else 1), versus, rounds, warm_trials)
+            turns = _in_turns(loop, next_trial, versus, rounds, warm_trials)
+            next_trial += rounds
+        if beside_busy:
+            busy = beside_busy_core(loop, next_trial, beside_busy)
     finally:
         if rec is not None:
             loop.settle()
@@ -69,7 +78,74 @@ def closed_loop_rt(overrides: list[str], seconds: float = 4.0, warmup_s: float =
             "cpu_us_per_step": {"main_thread": round(main_cpu / steps * 1e6, 1),
                                 "other_threads": round((cpu - main_cpu) / steps * 1e6, 1)},
             "recording": record_to is not None, **({"per_step_us": table} if parts else {}),
-            **({"versus": turns} if versus is not None else {})}
+            **({"versus": turns} if versus is not None else {}),
+            **({"beside_busy_core": busy} if beside_busy else {})}
+
+
+BUSY_FLOATS = 1 << 20
+"""The busy core's array: 4 MB of float32, as large as the granule layer's state that a network thread streams."""
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _stream(a, passes):  # pragma: no cover - numba
+    """``passes`` passes of a multiply-add over ``a`` (~0.1 ms each on a 2-core VM), without the interpreter lock."""
+    for _ in range(passes):
+        for i in range(a.shape[0]):
+            a[i] = a[i] * np.float32(0.999) + np.float32(1e-3)
+
+
+BUSY_PASSES = 200
+
+
+class _BusyCore:
+    """A thread that streams over :data:`BUSY_FLOATS` floats in compiled code, without the interpreter lock, until
+    stopped: what a spiking network's thread does to the loop's thread beside it, without the hand-overs."""
+
+    def __init__(self) -> None:
+        self._a = np.ones(BUSY_FLOATS, np.float32)
+        _stream(self._a[:8], 1)  # compiled (or loaded) before any timing
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="cerebx-busy", daemon=True)
+        self.calls = 0  # compiled calls done (BUSY_PASSES passes each)
+
+    def _run(self) -> None:
+        while not self._stop.is_set():  # ~20 ms a call: the thread needs the interpreter lock rarely
+            _stream(self._a, BUSY_PASSES)
+            self.calls += 1
+
+    def __enter__(self) -> _BusyCore:
+        self._thread.start()
+        time.sleep(0.01)  # running before the timed trial starts
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._stop.set()
+        self._thread.join()
+
+
+def beside_busy_core(loop: ClosedLoop, first: int, rounds: int) -> dict[str, Any]:
+    """Trials of ``loop`` (from trial ``first`` on) timed alone and beside a busy core (:class:`_BusyCore`), one of
+    each in turn, ``rounds`` times: per round, the speed beside the busy core over the speed alone; medians over
+    the rounds. On a host whose cores share their execution units or memory path, a loop whose other thread is busy
+    (a spiking network's) runs slower than the same work alone: the ratio says by how much on this host, the
+    ceiling of a closed loop's speed against a loop with nothing beside it (``versus``)."""
+    sim = loop.ctx.task.steps_per_trial * loop.dt_s
+    ratios, alone_rt, busy_rt = [], [], []
+    for r in range(rounds):
+        t0 = time.perf_counter()
+        loop.run_trial(first + 2 * r)
+        t1 = time.perf_counter()
+        with _BusyCore():
+            t2 = time.perf_counter()
+            loop.run_trial(first + 2 * r + 1)
+            t3 = time.perf_counter()
+        alone_rt.append(sim / (t1 - t0))
+        busy_rt.append(sim / (t3 - t2))
+        ratios.append(busy_rt[-1] / alone_rt[-1])
+    return {"rounds": rounds, "ratio_median": round(statistics.median(ratios), 3),
+            "ratio_min": round(min(ratios), 3), "ratio_max": round(max(ratios), 3),
+            "rt_factor_alone_median": round(statistics.median(alone_rt), 2),
+            "rt_factor_beside_busy_median": round(statistics.median(busy_rt), 2)}
 
 
 def _in_turns(loop: ClosedLoop, first: int, overrides: list[str], rounds: int, warm_trials: int) -> dict[str, Any]:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from cerebx.bench import bench_network
-from cerebx.loop.timing import closed_loop_rt
+from cerebx.loop.timing import _BusyCore, closed_loop_rt
 from cerebx.snn.kernels import PROF_PARTS
 from cerebx.snn.network import Network
 from cerebx.snn.presets import network
@@ -87,6 +87,34 @@ def test_the_network_bench_splits_a_step_into_parts():
 
 
 @pytest.mark.integration
+def _python_loops(seconds: float) -> int:
+    n, t0 = 0, time.perf_counter()
+    while time.perf_counter() - t0 < seconds:
+        n += 1
+    return n
+
+
+def test_the_busy_core_works_without_holding_the_interpreter_lock():
+    # the busy thread streams its floats while this thread runs Python about as freely as without it (a thread
+    # that held the lock would leave this one ~1/6 of the time: 5 ms switches against its ~20 ms calls)
+    busy = _BusyCore()  # compiles or loads its kernel
+    alone = _python_loops(0.3)
+    with busy:
+        beside = _python_loops(0.3)
+    assert busy.calls >= 1
+    assert beside > 0.25 * alone  # also when another process takes the other core (two threads on one: ~0.5)
+    assert busy.calls < 10**6 and not busy._thread.is_alive()  # stopped when the block ends
+
+
+def test_a_loop_is_timed_alone_and_beside_a_busy_core_in_turns():
+    pd = ["+task=circle", "controller=pd"]
+    busy = closed_loop_rt(pd, seconds=0.1, warmup_s=0.1, beside_busy=3)["beside_busy_core"]
+    assert busy["rounds"] == 3
+    assert busy["ratio_min"] <= busy["ratio_median"] <= busy["ratio_max"]
+    assert 0.2 < busy["ratio_median"] < 2.0  # slower beside it on a host whose cores share, else as fast
+    assert busy["rt_factor_alone_median"] > 0 and busy["rt_factor_beside_busy_median"] > 0
+
+
 def test_two_loops_timed_in_turns_give_their_speed_ratio():
     pd = ["+task=circle", "controller=pd"]
     same = closed_loop_rt(pd, seconds=0.1, warmup_s=0.1, versus=pd, rounds=5)["versus"]
