@@ -37,7 +37,9 @@ def learning_curves(runs: list[tuple[Path, dict]], task: str, out: Path) -> Path
     ax.set_yscale("log")
     ax.set_title(f"{task}: MAE per trial")
     ax.grid(alpha=0.3, which="both")
-    if len(runs) <= 10:  # beyond that a legend hides the curves
+    if not ax.get_legend_handles_labels()[0]:  # no run has a trial's MAE (failed or damaged runs)
+        ax.text(0.5, 0.5, "no completed trial", transform=ax.transAxes, ha="center", va="center")
+    elif len(runs) <= 10:  # beyond that a legend hides the curves
         ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
     return save(fig, out)

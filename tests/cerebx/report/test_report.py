@@ -450,3 +450,15 @@ def test_a_study_that_cannot_converge_in_quick_is_drawn_from_the_full_profile(tm
                    "    quick: {trials: 1}\n    full: {trials: 2, from_full: true}\n")
     with pytest.raises(ConfigError, match="full.from_full: only the quick profile"):
         load_studies(bad)
+
+
+def test_a_learning_curve_without_any_trial_says_so_and_warns_nothing(tmp_path):
+    import warnings
+
+    from cerebx.report.figures import learning_curves
+
+    failed = {"controller": "pd", "plant": "planar2", "delay": "none", "seed": 0, "mae_per_trial": []}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # matplotlib's "No artists with labels found to put in legend"
+        png = learning_curves([(tmp_path / "run", failed)], "circle", tmp_path / "learning_circle")
+    assert png.exists() and png.stat().st_size > 0
