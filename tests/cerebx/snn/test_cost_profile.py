@@ -103,7 +103,7 @@ def test_the_busy_core_works_without_holding_the_interpreter_lock():
         beside = _python_loops(0.3)
     assert busy.calls >= 1
     assert beside > 0.25 * alone  # also when another process takes the other core (two threads on one: ~0.5)
-    assert busy.calls < 10**6 and not busy._thread.is_alive()  # stopped when the block ends
+    assert not busy._thread.is_alive()  # stopped when the block ends
 
 
 def test_a_loop_is_timed_alone_and_beside_a_busy_core_in_turns():
