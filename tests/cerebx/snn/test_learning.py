@@ -74,6 +74,7 @@ def test_cf_uniforms_drawn_on_either_thread_give_identical_results(load, monkeyp
         cfg = load(["+task=circle", "+experiment=small_snn", "trials=2", f"controller.pipeline={pipeline}"])
         ctx = build_components(cfg)
         if pipeline:
+            ctx.controller.serve_chunks = False  # the network thread's chunks (the chunk server draws on the loop's)
             monkeypatch.setattr(NetworkThread, "ready", behind)
             monkeypatch.setattr(AfferentRing, "draws", counted)
         loop = ClosedLoop(ctx, None)

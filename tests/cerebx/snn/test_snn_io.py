@@ -140,7 +140,9 @@ def make_ctrl(fibers=5, per_joint=10, **kw) -> SNNControllerImpl:
 def spy_chunks(ctrl, before=None, after=None):
     """Wrap the simulation of each chunk, whichever input path the controller takes (FIFOs of encoded ticks, or
     pipelined with the built-in encoders, the ring the network thread encodes into): ``before(first)`` ahead of
-    it (may raise), ``after(flat, in_off, first)`` with its packed inputs once it ran."""
+    it (may raise), ``after(flat, in_off, first)`` with its packed inputs once it ran. The chunks go to the
+    network thread (the chunk server runs them in compiled code, where nothing can be wrapped)."""
+    ctrl.serve_chunks = False
     if ctrl._aff is None:
         simulate = ctrl._simulate_packed
 

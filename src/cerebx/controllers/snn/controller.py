@@ -49,9 +49,10 @@ from cerebx.recording.spike_chunks import chunk_spike_messages
 from cerebx.signals import Deferred
 from cerebx.snn.decoder import DCNDecoder, chunk_select, chunk_sides, chunk_torques
 from cerebx.snn.encoders import AfferentRing, EncoderPair, compose_steps, encode_ticks
-from cerebx.snn.kernels import OUTPUTS, prof_lap, prof_now, run_chunk
+from cerebx.snn.kernels import OUTPUTS, _clock_ns, prof_lap, prof_now, run_chunk
 from cerebx.snn.network import Network, pack
 from cerebx.snn.schema import layout_problem
+from cerebx.snn.sync import _load_acquire, _sleep_us, _store_release, _thread_cpu_ns, load_acquire, store_release
 from cerebx.vectors import vector_bits
 
 STEP_S = 0.002
@@ -185,6 +186,176 @@ def _serve(jobs: queue.SimpleQueue, taken: queue.SimpleQueue, done: queue.Simple
             done.put((False, exc))
 
 
+# The chunk server's shared words (``ChunkServer.box``) and the fields of each job slot (``ChunkServer.job``).
+_SUBMITTED, _DONE, _STOP, _FAILED, _STARTED = range(5)
+_ROWS, _TICKS, _STEPS, _T0, _LEARN, _FIRST, _RECORD, _LOST, _WORDS, _WALL_NS, _CPU_NS = range(11)
+_SLOTS = 2  # a chunk simulated and the next one waiting
+_SPINS = 2000  # polls of an idle server before it sleeps between them
+_NAPS = 250  # sleeps of each length (20 us, then 200 us) before the next longer one (2 ms)
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _serve_chunks(box, job, inputs, outputs, aff, net, decode, record, par, prof):  # pragma: no cover - numba
+    """The chunk server's thread: every chunk the loop's thread submits, in order, without the interpreter lock
+    from start to stop. Waits for ``box[_SUBMITTED]`` to pass the chunks done (polling, then sleeping 20 us,
+    idle for longer 200 us and, idle for ~0.1 s, 2 ms between polls: a few percent of a core, then ~1 %);
+    encodes the chunk's ticks into the ring ``aff``, composes its steps, runs them
+    (:func:`~cerebx.snn.kernels.run_chunk`), decodes them (:func:`_chunk_outputs`) into the slot's outputs, and
+    releases ``box[_DONE]``. ``job``: per slot the fields above; ``inputs``: per slot the ticks'
+    signals, their rows and uniforms (:meth:`~cerebx.snn.encoders.AfferentRing.draws`); ``outputs``: per slot
+    the steps' torques and DCN counts and the recorded spikes' messages (words, and where each starts), then the
+    spike buffer and step offsets; ``record``: the recorded populations' (lo, hi) and an empty array (a chunk
+    whose ``_RECORD`` is 0 records none); ``par``: (substeps per step, threads). Returns when ``box[_STOP]`` is
+    set."""
+    signals, rows, uniforms = inputs
+    taus_out, counts_out, words_out, starts_out, idx_buf, off = outputs
+    rec_lo, rec_hi, none = record
+    n_sub, threads = par
+    done = box[_DONE]
+    _store_release(box, _STARTED, 1)
+    while True:
+        polls = 0
+        while _load_acquire(box, _SUBMITTED) == done:
+            if _load_acquire(box, _STOP) != 0:
+                return done
+            polls += 1
+            if polls > _SPINS:
+                _sleep_us(20 if polls < _SPINS + _NAPS else 200 if polls < _SPINS + 2 * _NAPS else 2000)
+        t_wall, t_cpu = _clock_ns(), _thread_cpu_ns()
+        s = done % _SLOTS
+        nr, nt, n = job[s, _ROWS], job[s, _TICKS], job[s, _STEPS]
+        first = job[s, _FIRST]
+        encode_ticks(aff, signals[s, :nr], rows[s, :nt], uniforms[s, :nr])
+        flat, in_off = compose_steps(aff, first, n)
+        total = run_chunk(job[s, _T0], n_sub, flat, in_off, job[s, _LEARN] != 0, threads, net, idx_buf, off[:n + 1],
+                          prof)
+        tk = prof_now(prof)
+        if job[s, _RECORD] != 0:
+            taus, counts, words, starts = _chunk_outputs(idx_buf[:total], off[:n + 1], decode, (rec_lo, rec_hi),
+                                                         first, STEP_S)
+            words_out[s, :words.shape[0]] = words
+            starts_out[s, :starts.shape[0]] = starts
+            job[s, _WORDS] = words.shape[0]
+        else:
+            taus, counts, _w, _st = _chunk_outputs(idx_buf[:total], off[:n + 1], decode, (none, none), first,
+                                                   STEP_S)
+        prof_lap(prof, net.populations.pop_i.shape[0] + OUTPUTS, tk)
+        taus_out[s, :n] = taus
+        counts_out[s, :n] = counts
+        job[s, _LOST] = net.plasticity.pf_lost.sum()
+        job[s, _WALL_NS] = _clock_ns() - t_wall
+        job[s, _CPU_NS] = _thread_cpu_ns() - t_cpu
+        done += 1
+        _store_release(box, _DONE, done)
+
+
+def _run_server(box: np.ndarray, failed: list, args: tuple) -> None:
+    """The server thread's body: :func:`_serve_chunks` until stopped, or the exception it raised, kept in
+    ``failed`` for the loop's thread (which polls ``box[_FAILED]``)."""
+    try:
+        _serve_chunks(box, *args)
+    except BaseException as exc:  # raised on the loop's thread by ChunkServer.result
+        failed.append(exc)
+        box[_FAILED] = 1
+
+
+class ChunkServer:
+    """The network's chunks simulated on a thread that never takes the interpreter lock: a compiled loop
+    (:func:`_serve_chunks`) that waits on a word of shared memory for the next chunk, whose inputs the loop's
+    thread has copied into one of two slots, and releases its outputs into the same slot. The :class:`NetworkThread`
+    needs the lock at each chunk's start and end; each time it took it the loop's thread, back from a MuJoCo step,
+    waited for it to let go and to wake up again (~15 us a step of the `full` network's closed loop) and the
+    chunks came later (docs/guide/speed.md#chunk-server). The server is made for one network state, ring, decoder
+    and profile (:meth:`fits`); it stops when garbage-collected."""
+
+    def __init__(self, aff: Any, net: Network, decode: tuple, record: tuple[np.ndarray, np.ndarray], chunk: int,
+                 ticks: int, n_ctrl: int, width: int, n_cf: int):
+        self.refs = (aff, net._state, net.kernel_prof, decode, record, chunk)
+        self.box = np.zeros(8, np.int64)
+        self.job = np.zeros((_SLOTS, 11), np.int64)
+        self._signals = np.zeros((_SLOTS, ticks, 6, n_ctrl))
+        self._rows = np.zeros((_SLOTS, ticks), np.int64)
+        self._uniforms = np.zeros((_SLOTS, ticks, n_cf))
+        self._taus = np.zeros((_SLOTS, chunk, width))
+        self._counts = np.zeros((_SLOTS, chunk), np.int64)
+        idx_buf, _ = net.chunk_buffers(chunk)
+        messages = len(record[0]) * chunk  # populations x steps (chunk_spike_messages: 4 words each and a spike's)
+        self._words = np.zeros((_SLOTS, idx_buf.shape[0] + 4 * messages), np.uint32)
+        self._starts = np.zeros((_SLOTS, messages + 1), np.int64)
+        self._outputs = (self._taus, self._counts, self._words, self._starts, idx_buf, np.zeros(chunk + 1, np.int64))
+        self._failed: list[BaseException] = []
+        self.submitted = self.collected = 0
+        weakref.finalize(self, self.box.__setitem__, _STOP, 1)
+        args = (self.job, (self._signals, self._rows, self._uniforms), self._outputs, aff, net._state, decode,
+                (*record, np.zeros(0, np.int64)), (net.n_sub, net.n_threads), net.kernel_prof)
+        self._thread = threading.Thread(target=_run_server, args=(self.box, self._failed, args),
+                                        name="cerebx-snn-server", daemon=True)
+        self._thread.start()
+
+    def fits(self, aff: Any, net: Network, decode: tuple, record: tuple[np.ndarray, np.ndarray], chunk: int) -> bool:
+        """Whether this server simulates chunks of ``chunk`` steps for this ring, network state, profile, decoder
+        and recorded populations (each made again by a reset, a loaded state or a profile started)."""
+        refs = (aff, net._state, net.kernel_prof, decode, record, chunk)
+        return all(a is b for a, b in zip(self.refs, refs)) and not self.box[_FAILED]
+
+    def wait_started(self) -> None:
+        """Return once the server's loop runs (its kernel loaded or compiled): before a wall-clock run's first
+        tick."""
+        while not self.box[_STARTED] and not self.box[_FAILED]:
+            time.sleep(1e-3)
+
+    def submit(self, ticks: tuple[np.ndarray, np.ndarray, np.ndarray], steps: int, first: int, learn: bool,
+               t0: int, record: bool) -> None:
+        """Queue the chunk of ``steps`` steps from ``first`` on (substep ``t0``), whose ``ticks`` (signals, rows,
+        uniforms) are encoded into the ring first, its recorded populations' spikes kept when ``record``; at most
+        :data:`_SLOTS` are queued and not collected."""
+        signals, rows, u = ticks
+        nr, nt = signals.shape[0], rows.shape[0]
+        if self.submitted - self.collected >= _SLOTS or nt > self._rows.shape[1] or steps > self._counts.shape[1]:
+            raise RuntimeError(f"chunk server: {self.submitted - self.collected} chunks queued, {nt} ticks, "
+                               f"{steps} steps (at most {_SLOTS}, {self._rows.shape[1]}, {self._counts.shape[1]})")
+        s = self.submitted % _SLOTS
+        self._signals[s, :nr] = signals
+        self._rows[s, :nt] = rows
+        self._uniforms[s, :nr] = u
+        self.job[s, :_LOST] = (nr, nt, steps, t0, int(learn), first, int(record))
+        self.submitted += 1
+        store_release(self.box, _SUBMITTED, self.submitted)
+
+    def ready(self) -> bool:
+        """Whether the oldest chunk not yet collected is done."""
+        return bool(self.box[_DONE] > self.collected)
+
+    def result(self) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None, int, float, float]:
+        """The oldest chunk not yet collected (waits for it, polling, then sleeping 20 us between polls): its
+        steps' outputs and DCN counts, its recorded spikes' messages and where each starts (None when not
+        recorded), the PF spikes dropped so far, its wall and CPU seconds on the server; raises what the server
+        raised."""
+        k, box = self.collected, self.box
+        polls = 0
+        while box[_DONE] <= k:
+            if box[_FAILED]:
+                raise self._failed[0]
+            polls += 1
+            if polls > _SPINS:
+                time.sleep(2e-5)
+        load_acquire(box, _DONE)  # the slot's outputs as the server released them
+        s = k % _SLOTS
+        n = int(self.job[s, _STEPS])
+        self.collected = k + 1
+        words = starts = None
+        if self.job[s, _RECORD]:
+            words = self._words[s, :self.job[s, _WORDS]].copy()
+            starts = self._starts[s, :len(self.refs[4][0]) * n + 1].copy()
+        return (self._taus[s, :n].copy(), self._counts[s, :n].copy(), words, starts, int(self.job[s, _LOST]),
+                self.job[s, _WALL_NS] * 1e-9, self.job[s, _CPU_NS] * 1e-9)
+
+    def stop(self) -> None:
+        """Stop the server's thread once the chunks queued are done (they are not collected)."""
+        self.box[_STOP] = 1
+        self._thread.join()
+
+
 class SNNControllerImpl(Controller):
     def __init__(self, cfg: SNNController, ctx: BuildContext):
         t0 = time.perf_counter()
@@ -203,6 +374,8 @@ class SNNControllerImpl(Controller):
         self.pipeline = cfg.pipeline and slack >= 2
         self._in_flight = 0  # chunks handed to the network thread and not yet collected (at most 2)
         self._thread: NetworkThread | None = None
+        self._srv: ChunkServer | None = None
+        self._served: deque[bool] = deque()  # per chunk in flight: whether the chunk server has it
         seed = getattr(getattr(ctx, "cfg", None), "seed", 0)  # random connectors draw from the run's seed
         self.net = Network(self.net_cfg, parallel=cfg.parallel and not self.pipeline, seed=seed, lumped=cfg.lumped)
         self.net.learn = cfg.plasticity
@@ -382,18 +555,53 @@ class SNNControllerImpl(Controller):
         self._net_step += 1
         self._absorb(chunk)
 
+    serve_chunks = True
+    """Whether chunks the :class:`ChunkServer` can simulate go to it (the same results as the network thread's)."""
+
+    def _serves(self, mode: tuple[int, bool]) -> bool:
+        """Whether a chunk handed over with ``mode`` goes to the chunk server: the built-in encoders (on the
+        network side) and the network run (not shed)."""
+        return self.serve_chunks and self._aff is not None and mode[0] < 2
+
+    def _recording(self, mode: tuple[int, bool]) -> bool:
+        """Whether a chunk handed over with ``mode`` keeps its recorded populations' spikes."""
+        return self.recorder is not None and mode[0] < 3 and bool(self.record)
+
+    def _server(self) -> ChunkServer:
+        """The chunk server of this network state, ring, profile and decoder (made again when one changed)."""
+        srv = self._srv
+        if srv is None or not srv.fits(self._aff.state, self.net, self._decode, self._records, self.chunk):
+            if srv is not None:
+                srv.stop()
+            span = self._aff.R  # the ring holds every tick kept
+            srv = self._srv = ChunkServer(self._aff.state, self.net, self._decode, self._records, self.chunk, span,
+                                          self.n_ctrl, self.width, self._aff.cf.burst_left.shape[0])
+        return srv
+
     def _launch(self) -> None:
-        """Hand the next chunk of pending inputs to the network thread (packed here, so that the thread's
-        work is compiled code from the start)."""
+        """Hand the next chunk of pending inputs to the chunk server or the network thread (packed here, so that
+        the thread's work is compiled code from the start)."""
+        mode = self._mode()
+        served = self._serves(mode)
+        if self._in_flight and (self._served[-1] != served or (served and not self._srv.fits(
+                self._aff.state, self.net, self._decode, self._records, self.chunk))):
+            self._join()  # the chunks in flight elsewhere first: one thread at a time steps the network
         first = self._net_step + self._in_flight * self.chunk  # after the chunk still in flight, if one is
+        if served:
+            ticks = self._aff.draws(self._aff.take())  # every batch drawn as it is taken, in order
+            t0 = self.net.t_sub + self.net.n_sub * self.chunk * self._in_flight  # after the chunk in flight
+            self._server().submit(ticks, self.chunk, first, mode[1], t0, self._recording(mode))
+            self._served.append(True)
+            self._in_flight += 1
+            return
         if self._aff is not None:
             ticks = self._aff.take()
             if self._draw_here and self._aff.may_draw_now():  # else drawn on the network thread as the chunk starts
                 ticks = self._aff.draws(ticks)
-            simulate, args = self._simulate_ticks, (ticks, self.chunk, first, self._mode())
+            simulate, args = self._simulate_ticks, (ticks, self.chunk, first, mode)
         else:
             simulate, args = self._simulate_packed, (*pack([self._pending.popleft() for _ in range(self.chunk)]), first,
-                                                     self._mode())
+                                                     mode)
         clock = phase_clock.active()
 
         def work() -> Chunk:
@@ -407,6 +615,7 @@ class SNNControllerImpl(Controller):
         if self._thread is None:
             self._thread = NetworkThread()
         self._thread.submit(work, hand_over=not self._in_flight)
+        self._served.append(False)
         self._in_flight += 1
 
     def _join(self, launch_next: bool = False) -> None:
@@ -420,24 +629,49 @@ class SNNControllerImpl(Controller):
             self._in_flight -= 1
             if self.recorder is not None:
                 self.recorder.idle()  # the log's chunk compressed while this thread would wait
-            # the network thread behind this one: the next chunks' uniforms are drawn here, else there
-            self._draw_here = not self._thread.ready()
-            try:
-                with phase_clock.charge("wait"):
-                    chunk = self._thread.result()  # an exception of the network thread is raised here
-            except BaseException:
-                self._drain()
-                raise
+            if self._served.popleft():
+                chunk = self._collect_served()
+            else:
+                # the network thread behind this one: the next chunks' uniforms are drawn here, else there
+                self._draw_here = not self._thread.ready()
+                try:
+                    with phase_clock.charge("wait"):
+                        chunk = self._thread.result()  # an exception of the network thread is raised here
+                except BaseException:
+                    self._drain()
+                    raise
             self._net_step += len(chunk.counts)
             self._absorb(chunk)
             if launch_next:
                 return
+
+    def _collect_served(self) -> Chunk:
+        """The oldest chunk the server has, as a :class:`Chunk` (waits for it); the network's clock advanced. When
+        the server failed, its exception is raised here and the chunk queued behind is dropped (it would run on
+        a network the failed one left half-stepped); when the wait is interrupted, the server finishes its chunks
+        and stops before the interrupt goes on."""
+        first = self._net_step
+        try:
+            with phase_clock.charge("wait"):
+                taus, counts, words, starts, lost, wall_s, cpu_s = self._srv.result()
+        except BaseException:  # the server's failure, or an interrupt while waiting (Ctrl-C)
+            srv, self._srv = self._srv, None
+            self._in_flight = 0
+            self._served.clear()
+            srv.stop()  # the network is left to this thread only when the server's chunks are over
+            raise
+        clock = phase_clock.active()
+        if clock is not None:
+            clock.add_background("network", wall_s, cpu_s)
+        self.net.t_sub += self.net.n_sub * len(counts)
+        return Chunk(first, taus, counts, words, starts, lost)
 
     def _drain(self) -> None:
         """After a chunk failed: wait for the one queued behind it and drop it (it ran on a network the failed
         chunk left half-stepped), so that nothing is in flight."""
         while self._in_flight:
             self._in_flight -= 1
+            self._served.popleft()
             try:
                 self._thread.result()
             except BaseException:  # noqa: BLE001 - the first failure is the one raised
@@ -450,7 +684,8 @@ class SNNControllerImpl(Controller):
         two thirds of the time a checkpoint held up the loop (20 of 30 ms)."""
         pending, mf_lag, cf_lag = self._fifos()  # joins
         state = self.__dict__.copy()
-        state["_thread"] = None
+        state["_thread"] = state["_srv"] = None
+        state["_served"] = deque()
         state.pop("_pair", None)  # made again from the encoders restored
         state.pop("_aff", None)  # as is the ring, from the FIFOs
         state["_pending"], state["_mf_lag"], state["_cf_lag"] = deque(pending), deque(mf_lag), deque(cf_lag)
@@ -470,7 +705,7 @@ class SNNControllerImpl(Controller):
             state["_des"] = {int(t): (q[i], qd[i]) for i, t in enumerate(ticks)}
         self.__dict__.update(state)
         self.__dict__.setdefault("_draw_here", False)  # checkpoints of earlier code
-        self._in_flight, self._thread = 0, None
+        self._in_flight, self._thread, self._srv, self._served = 0, None, None, deque()
         self._no_closing()  # pickled after every chunk was collected, so none was waiting (older code: none)
         if "_last_error" not in state:  # older code kept it as an attribute
             self._last_error = state.get("last_error", np.zeros(self.n_ctrl))
@@ -484,6 +719,7 @@ class SNNControllerImpl(Controller):
         self._alpha = np.ascontiguousarray(np.broadcast_to(self.decoder.alpha, (self.n_ctrl,)), dtype=np.float64)
         self._record_lo = np.array([sl.start for sl in self.record.values()], np.int64)
         self._record_hi = np.array([sl.stop for sl in self.record.values()], np.int64)
+        self._records = (self._record_lo, self._record_hi)
         scale = np.ascontiguousarray(np.broadcast_to(self.full_scale, (self.n_ctrl,)), dtype=np.float64)
         self._decode = (self.sl_dcn.start, self.sl_dcn.stop, self.decoder.per_joint, self.decoder.sign, self._alpha,
                         self.muscles, scale, bool(self.cfg.decoder.saturate))
@@ -525,6 +761,8 @@ class SNNControllerImpl(Controller):
         if self._aff is not None:  # and with the encoders on the network thread, encoding no tick
             self._simulate_ticks((np.zeros((0, 6, self.n_ctrl)), np.zeros(0, np.int64),
                                   np.zeros((0, self.cf.burst_left.shape[0]))), 0, self._net_step)
+        if self._serves(self._mode()):  # and the chunk server's loop, running before the first tick
+            self._server().wait_started()
         z = np.zeros(self.n_ctrl)
         copy.deepcopy(self.mf).active(z, z, z, z)
         self.cf.error(z, z, z, z)
