@@ -68,16 +68,14 @@ import time
 from typing import NamedTuple
 
 import numpy as np
-from llvmlite import ir
-from numba import njit, prange, types
-from numba.core import cgutils
+from numba import njit, prange
 from numba.cpython.unsafe.numbers import trailing_zeros
-from numba.extending import intrinsic
 
 from cerebx.kernel_struct import KernelStruct
 from cerebx.snn import lumping
 from cerebx.snn.learning import NoLearning, SparseLearning, run_rules
 from cerebx.snn.lumping import Lumps
+from cerebx.snn.sync import clock_ns_intrinsic
 from cerebx.snn.topology import (
     I_COMPACT,
     I_HI,
@@ -165,21 +163,7 @@ NO_PROF = np.zeros(0, dtype=np.int64)
 _CLOCK = time.CLOCK_MONOTONIC
 
 
-@intrinsic
-def _clock_ns(typingctx):
-    """The monotonic clock in ns (``clock_gettime``: a vDSO call, a few tens of ns)."""
-
-    def codegen(context, builder, sig, args):
-        i64 = ir.IntType(64)
-        ts = cgutils.alloca_once(builder, ir.LiteralStructType([i64, i64]))  # struct timespec (LP64)
-        fnty = ir.FunctionType(ir.IntType(32), [ir.IntType(32), ts.type])
-        fn = cgutils.get_or_insert_function(builder.module, fnty, "clock_gettime")
-        builder.call(fn, [ir.Constant(ir.IntType(32), _CLOCK), ts])
-        sec = builder.load(cgutils.gep_inbounds(builder, ts, 0, 0))
-        nsec = builder.load(cgutils.gep_inbounds(builder, ts, 0, 1))
-        return builder.add(builder.mul(sec, ir.Constant(i64, 1_000_000_000)), nsec)
-
-    return types.int64(), codegen
+_clock_ns = clock_ns_intrinsic(_CLOCK, "The monotonic clock in ns.")
 
 
 # Not inline="always": after inlining, numba (0.68) runs a typed dead-code elimination whose alias analysis does not

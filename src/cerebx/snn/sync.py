@@ -64,21 +64,28 @@ def _sleep_us(typingctx, us):
     return types.void(us), codegen
 
 
-@intrinsic
-def _thread_cpu_ns(typingctx):
-    """The calling thread's CPU time in ns (``clock_gettime(CLOCK_THREAD_CPUTIME_ID)``)."""
+def clock_ns_intrinsic(clock_id: int, doc: str):
+    """An intrinsic without arguments that returns ``clock_gettime(clock_id)`` in ns (a vDSO call, a few tens of
+    ns for the monotonic clock): the kernels' profile clock and the chunk server's CPU clock."""
 
-    def codegen(context, builder, sig, args):
-        i64 = ir.IntType(64)
-        ts = cgutils.alloca_once(builder, ir.LiteralStructType([i64, i64]))  # struct timespec (LP64)
-        fnty = ir.FunctionType(ir.IntType(32), [ir.IntType(32), ts.type])
-        fn = cgutils.get_or_insert_function(builder.module, fnty, "clock_gettime")
-        builder.call(fn, [ir.Constant(ir.IntType(32), _THREAD_CPU), ts])
-        sec = builder.load(cgutils.gep_inbounds(builder, ts, 0, 0))
-        nsec = builder.load(cgutils.gep_inbounds(builder, ts, 0, 1))
-        return builder.add(builder.mul(sec, ir.Constant(i64, 1_000_000_000)), nsec)
+    def clock(typingctx):
+        def codegen(context, builder, sig, args):
+            i64 = ir.IntType(64)
+            ts = cgutils.alloca_once(builder, ir.LiteralStructType([i64, i64]))  # struct timespec (LP64)
+            fnty = ir.FunctionType(ir.IntType(32), [ir.IntType(32), ts.type])
+            fn = cgutils.get_or_insert_function(builder.module, fnty, "clock_gettime")
+            builder.call(fn, [ir.Constant(ir.IntType(32), clock_id), ts])
+            sec = builder.load(cgutils.gep_inbounds(builder, ts, 0, 0))
+            nsec = builder.load(cgutils.gep_inbounds(builder, ts, 0, 1))
+            return builder.add(builder.mul(sec, ir.Constant(i64, 1_000_000_000)), nsec)
 
-    return types.int64(), codegen
+        return types.int64(), codegen
+
+    clock.__doc__ = doc
+    return intrinsic(clock)
+
+
+_thread_cpu_ns = clock_ns_intrinsic(_THREAD_CPU, "The calling thread's CPU time in ns.")
 
 
 @njit(cache=True, nogil=True)

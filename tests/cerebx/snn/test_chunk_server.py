@@ -83,12 +83,18 @@ def test_an_exception_in_the_server_is_raised_on_the_loop_thread_and_the_next_ch
     assert ctrl._srv is not None and ctrl._srv.collected > 0
 
 
-def test_the_server_thread_stops_when_its_controller_is_collected(load):
+def _one_trial(load):
+    """The small network's closed loop after one trial, its chunk server idle."""
     ctx = build_components(load(["+task=circle", "+experiment=small_snn", "trials=1"]))
     loop = ClosedLoop(ctx, None)
     loop.start()
     loop.run_trial(0)
     loop.settle()
+    return ctx, loop
+
+
+def test_the_server_thread_stops_when_its_controller_is_collected(load):
+    ctx, loop = _one_trial(load)
     thread = ctx.controller._srv._thread
     assert thread.is_alive()
     del loop, ctx
@@ -101,11 +107,7 @@ def test_the_server_thread_stops_when_its_controller_is_collected(load):
 
 def test_an_idle_server_leaves_its_core_free(load):
     """Waiting for chunks the server sleeps between polls: idle, its thread takes a few percent of a core."""
-    ctx = build_components(load(["+task=circle", "+experiment=small_snn", "trials=1"]))
-    loop = ClosedLoop(ctx, None)
-    loop.start()
-    loop.run_trial(0)
-    loop.settle()
+    ctx, _loop = _one_trial(load)
     ident = ctx.controller._srv._thread.native_id
     time.sleep(0.1)  # past its polling and short naps
 

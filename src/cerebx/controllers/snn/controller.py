@@ -191,14 +191,14 @@ _SUBMITTED, _DONE, _STOP, _FAILED, _STARTED = range(5)
 _ROWS, _TICKS, _STEPS, _T0, _LEARN, _FIRST, _RECORD, _LOST, _WORDS, _WALL_NS, _CPU_NS = range(11)
 _SLOTS = 2  # a chunk simulated and the next one waiting
 _SPINS = 2000  # polls of an idle server before it sleeps between them
-_NAPS = 250  # sleeps of each length (20 us, then 200 us) before the next longer one (2 ms)
+_NAPS = 250  # sleeps of each length (20 us, 200 us, then 2 ms twice as many) before the next longer one (20 ms)
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
 def _serve_chunks(box, job, inputs, outputs, aff, net, decode, record, par, prof):  # pragma: no cover - numba
     """The chunk server's thread: every chunk the loop's thread submits, in order, without the interpreter lock
     from start to stop. Waits for ``box[_SUBMITTED]`` to pass the chunks done (polling, then sleeping 20 us,
-    idle for longer 200 us and, idle for ~0.1 s, 2 ms between polls: a few percent of a core, then ~1 %);
+    idle for longer 200 us, idle for ~0.1 s 2 ms (~2 % of a core) and idle for ~1 s 20 ms between polls);
     encodes the chunk's ticks into the ring ``aff``, composes its steps, runs them
     (:func:`~cerebx.snn.kernels.run_chunk`), decodes them (:func:`_chunk_outputs`) into the slot's outputs, and
     releases ``box[_DONE]``. ``job``: per slot the fields above; ``inputs``: per slot the ticks'
@@ -220,7 +220,8 @@ def _serve_chunks(box, job, inputs, outputs, aff, net, decode, record, par, prof
                 return done
             polls += 1
             if polls > _SPINS:
-                _sleep_us(20 if polls < _SPINS + _NAPS else 200 if polls < _SPINS + 2 * _NAPS else 2000)
+                _sleep_us(20 if polls < _SPINS + _NAPS else 200 if polls < _SPINS + 2 * _NAPS
+                          else 2000 if polls < _SPINS + 4 * _NAPS else 20000)
         t_wall, t_cpu = _clock_ns(), _thread_cpu_ns()
         s = done % _SLOTS
         nr, nt, n = job[s, _ROWS], job[s, _TICKS], job[s, _STEPS]
