@@ -522,7 +522,7 @@ class SNNControllerImpl(Controller):
             net.t_sub += net.n_sub * n
             return Chunk(first_step, np.zeros((n, self.width)), np.zeros(n, np.int64), None, None,
                          int(net.pf_lost.sum()))
-        recording = bool(self.recorder is not None and shed < 3 and self.record)
+        recording = self._recording(mode)
         record = (self._record_lo, self._record_hi) if recording else (_NONE, _NONE)
         idx_buf, off = net.chunk_buffers(n)
         taus, counts, words, starts, lost = kernel(
