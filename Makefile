@@ -51,9 +51,10 @@ run: $(STAMP) ## run the default experiment (RUN_ARGS=... to choose another)
 # (on a fresh clone the workers would otherwise compile the same kernels side by side)
 # (bytecode written even where the environment says not to: each process the tests start that imports cerebx would
 # compile its modules again without it, and pytest would rewrite every test module's asserts again)
+# (the 15 slowest tests listed at the end: where the five minutes go)
 test: $(STAMP) ## unit and integration tests, not the slow ones (under 5 minutes on 2 cores)
 	PYTHONDONTWRITEBYTECODE= $(BIN)/python tests/warm.py
-	PYTHONDONTWRITEBYTECODE= $(BIN)/pytest -m "not slow" -n $(TEST_WORKERS)
+	PYTHONDONTWRITEBYTECODE= $(BIN)/pytest -m "not slow" -n $(TEST_WORKERS) --durations=15
 
 test-unit: $(STAMP) ## only the unit tests (seconds)
 	$(BIN)/pytest -m unit

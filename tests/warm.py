@@ -19,11 +19,16 @@ from pathlib import Path
 
 
 def _snn() -> None:
-    """The small network's closed loop, timed and then with its cost profile (both run the same chunk kernels).
+    """The small network's closed loop, timed and then with its cost profile (both run the same chunk kernels),
+    on the chunk server and then on the network thread (shed chunks and the tests that watch that thread run
+    its kernels: left to the tests, a worker compiled them in the middle of the run).
     (The sparse-rule kernels are left to the tests: compiled here they cost the same ~8 s of each core.)"""
+    from cerebx.controllers.snn.controller import SNNControllerImpl
     from cerebx.loop.timing import closed_loop_rt
 
-    closed_loop_rt(["+task=circle", "+experiment=small_snn"], seconds=0.05, warmup_s=0.05, parts=True)
+    for served in (True, False):
+        SNNControllerImpl.serve_chunks = served
+        closed_loop_rt(["+task=circle", "+experiment=small_snn"], seconds=0.05, warmup_s=0.05, parts=True)
 
 
 def _lwpr(n_in: int, n_out: int) -> None:
