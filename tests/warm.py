@@ -31,6 +31,18 @@ def _snn() -> None:
         closed_loop_rt(["+task=circle", "+experiment=small_snn"], seconds=0.05, warmup_s=0.05, parts=True)
 
 
+def _one_step() -> None:
+    """A network stepped one step at a time (``Network.step``, its own kernel: the tests of neurons, connectors and
+    rules call it; left to them, both workers compiled it at once, ~19 s each)."""
+    import numpy as np
+
+    from cerebx.config import load
+    from cerebx.snn.network import Network
+
+    cfg = load(["+task=circle", "+experiment=small_snn"])[0]
+    Network(cfg.controller.network, parallel=False).step(np.zeros(0, np.int32))
+
+
 def _lwpr(n_in: int, n_out: int) -> None:
     """LWPR's entry points for one model shape (numba compiles one version per shape)."""
     import numpy as np
@@ -59,13 +71,13 @@ def _task(kind: str) -> None:
     from cerebx.schema import task as T
 
     load_plugins()
-    cfg = {"circle_eight": T.CircleEightTask(), "inclined_circle": T.InclinedCircleTask()}[kind]
+    cfg = {"circle_eight": T.CircleEightTask(), "inclined_circle": T.InclinedCircleTask(), "eight": T.EightTask()}[kind]
     registry.tasks.build(cfg, SimpleNamespace(cache_dir=Path(os.environ["CEREBX_CACHE"]), plant=None))
 
 
 # longest first, so the pool ends about together
-JOBS = [(_snn, ()), (_task, ("circle_eight",)), (_capolei, ()), (_lwpr, (1, 1)), (_lwpr, (2, 1)),
-        (_lwpr, (2, 2)), (_task, ("inclined_circle",))]
+JOBS = [(_snn, ()), (_one_step, ()), (_task, ("circle_eight",)), (_capolei, ()), (_task, ("eight",)),
+        (_lwpr, (1, 1)), (_lwpr, (2, 1)), (_lwpr, (2, 2)), (_task, ("inclined_circle",))]
 
 
 def main(jobs: int) -> int:
