@@ -20,27 +20,38 @@ from pathlib import Path
 
 def _snn() -> None:
     """The small network's closed loop, timed and then with its cost profile (both run the same chunk kernels),
-    on the chunk server and then on the network thread (shed chunks and the tests that watch that thread run
-    its kernels: left to the tests, a worker compiled them in the middle of the run).
-    (The sparse-rule kernels are left to the tests: compiled here they cost the same ~8 s of each core.)"""
+    on the network thread (shed chunks and the tests that watch that thread run its kernels: left to the tests,
+    a worker compiled them in the middle of the run) and on the chunk server; then a recorded run of two trials
+    with a checkpoint after each (the checkpoint, weight-statistics and spike-message kernels: the resume tests
+    start runs two at a time, which compiled them side by side)."""
+    import tempfile
+
+    from cerebx.config import load
     from cerebx.controllers.snn.controller import SNNControllerImpl
+    from cerebx.loop.runner import run_experiment
     from cerebx.loop.timing import closed_loop_rt
 
-    for served in (True, False):
+    small = ["+task=circle", "+experiment=small_snn"]
+    for served in (False, True):
         SNNControllerImpl.serve_chunks = served
-        closed_loop_rt(["+task=circle", "+experiment=small_snn"], seconds=0.05, warmup_s=0.05, parts=True)
+        closed_loop_rt(small, seconds=0.05, warmup_s=0.05, parts=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        cfg, plain = load([*small, "trials=2", "recording.checkpoint_every=1", "recording.progress=off"])
+        run_experiment(cfg, Path(tmp) / "run", plain)
 
 
 def _one_step() -> None:
-    """A network stepped one step at a time (``Network.step``, its own kernel: the tests of neurons, connectors and
-    rules call it; left to them, both workers compiled it at once, ~19 s each)."""
+    """A network with a sparse plasticity rule stepped one step at a time (``Network.step``: its own kernel, a
+    version per kind of learning state; the Golgi-layer and sparse-rule tests call it: left to them, both
+    workers compiled it at once, 15-20 s each). The network is the Golgi-layer tests' own."""
     import numpy as np
 
-    from cerebx.config import load
+    sys.path.insert(0, str(Path(__file__).parent / "cerebx" / "snn"))
+    from test_golgi_layer import golgi_cfg
+
     from cerebx.snn.network import Network
 
-    cfg = load(["+task=circle", "+experiment=small_snn"])[0]
-    Network(cfg.controller.network, parallel=False).step(np.zeros(0, np.int32))
+    Network(golgi_cfg(), parallel=False, seed=1).step(np.zeros(0, np.int32))
 
 
 def _lwpr(n_in: int, n_out: int) -> None:
@@ -80,14 +91,21 @@ JOBS = [(_snn, ()), (_one_step, ()), (_task, ("circle_eight",)), (_capolei, ()),
         (_lwpr, (1, 1)), (_lwpr, (2, 1)), (_lwpr, (2, 2)), (_task, ("inclined_circle",))]
 
 
+def _timed(fn, *args) -> float:  # noqa: ANN001
+    t0 = time.monotonic()
+    fn(*args)
+    return time.monotonic() - t0
+
+
 def main(jobs: int) -> int:
     import conftest  # noqa: F401  (the tests' cache folders, stale kernels dropped: before any process loads one)
 
     t0 = time.monotonic()
     with ProcessPoolExecutor(jobs, mp_context=mp.get_context("spawn")) as pool:
-        for f in [pool.submit(fn, *args) for fn, args in JOBS]:
-            f.result()  # a failure here is the tests' failure too: say it now
-    print(f"warm: kernels and task paths ready in {time.monotonic() - t0:.0f} s ({jobs} processes)")
+        futures = [(fn, args, pool.submit(_timed, fn, *args)) for fn, args in JOBS]
+        took = [(f.result(), fn.__name__, args) for fn, args, f in futures]  # a failure is the tests' too: say it now
+    longest = ", ".join(f"{name}{''.join(f' {a}' for a in args)} {s:.0f} s" for s, name, args in sorted(took)[::-1][:3])
+    print(f"warm: kernels and task paths ready in {time.monotonic() - t0:.0f} s ({jobs} processes; longest: {longest})")
     return 0
 
 
