@@ -14,6 +14,7 @@ import multiprocessing as mp
 import os
 import sys
 import time
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -92,7 +93,7 @@ JOBS = [(_snn, ()), (_task, ("circle_eight",)), (_capolei, ()), (_task, ("eight"
         (_lwpr, (1, 1)), (_lwpr, (2, 1)), (_lwpr, (2, 2)), (_task, ("inclined_circle",))]
 
 
-def _timed(fn, *args) -> float:  # noqa: ANN001
+def _timed(fn: Callable[..., None], *args: object) -> float:
     t0 = time.monotonic()
     fn(*args)
     return time.monotonic() - t0
