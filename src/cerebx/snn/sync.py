@@ -100,15 +100,3 @@ def store_release(arr, i, value):  # pragma: no cover - numba
     """``arr[i] = value`` (int64, 1-D) with release order: what this thread wrote before is seen by a thread
     that reads the value with acquire order."""
     _store_release(arr, i, value)
-
-
-@njit(cache=True, nogil=True)
-def sleep_us(us):  # pragma: no cover - numba
-    """Sleep ``us`` microseconds without the interpreter lock."""
-    _sleep_us(us)
-
-
-@njit(cache=True, nogil=True)
-def thread_cpu_ns():  # pragma: no cover - numba
-    """This thread's CPU time, ns."""
-    return _thread_cpu_ns()

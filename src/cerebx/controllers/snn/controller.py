@@ -529,9 +529,7 @@ class SNNControllerImpl(Controller):
             *lead, net._state, (net.t_sub, net.n_sub, learn, net.n_threads), (*inputs, idx_buf, off),
             (self._decode, record, first_step, STEP_S), net.kernel_prof)
         net.t_sub += net.n_sub * n
-        if not recording:
-            return Chunk(first_step, taus, counts, None, None, lost)
-        return Chunk(first_step, taus, counts, words, starts, lost)
+        return Chunk(first_step, taus, counts, words if recording else None, starts if recording else None, lost)
 
     def _absorb(self, chunk: Chunk) -> None:
         """Queue a simulated chunk's outputs and log its recorded spikes (``_net_step`` is advanced by the
